@@ -1,0 +1,784 @@
+#!/usr/bin/env python3
+"""Generates the glTF 2.0 scenes in scenes/ (run from anywhere: python3 tools/make_scenes.py).
+
+Standard library only, deterministic (identical bytes on every run). After writing, every
+file is read back and validated (JSON / GLB container, accessors, min/max, index ranges,
+winding against normals, closed glass meshes, extensions), and one summary line per scene
+is printed. Conventions: y up, metres, counter-clockwise winding = front face.
+
+Scenes (analytic answers are radiances in the renderer's units):
+
+  cornell.gltf       Default scene. 2 m Cornell box (x,z in [-1,1], y in [0,2]) open
+                     towards +z, white/red/green walls, 0.3 m ceiling light (radiance 40),
+                     glass sphere (ior 1.5) throwing a caustic on the floor, mirror sphere.
+                     No analytic answer; the visual reference.
+  plane_point.gltf   Grey Lambertian plane (rho 0.5, 20 x 20 m at y=0, facing +y), point
+                     light I = 10 at (0,1,0), camera 3 m above looking down (yfov 0.6).
+                     Only direct light exists, so exactly
+                       L(x,0,z) = (0.5/pi) * 10 * cos(theta) / d^2 = 5 / (pi d^3),
+                       d^2 = x^2 + 1 + z^2;  L(0,0,0) = 5/pi = 1.591549.
+                     The camera sees |x|,|z| <= 3 tan(0.3) = 0.928 m (corner L = 0.3543).
+  plane_point.glb, plane_point_external.gltf (+ .bin), nested.gltf
+                     The same scene as binary GLB, with an external buffer, and through a
+                     node hierarchy (TRS parent/child whose product is the identity; light
+                     and camera placed with "matrix"). Must render identically.
+  closed_box.gltf    Closed cube [-1,1]^3, walls facing inward, one material: Lambertian
+                     rho 0.5 emitting Le 1.0. Camera inside at (0,0,0.9) looking -z.
+                     Exactly L = Le / (1 - rho) = 2.0 everywhere, in every direction
+                     (irradiance 2 pi on every wall; emitted power pi * 1 * 24 m^2 = 24 pi).
+  spot.gltf          4 x 4 m floor (rho 0.7) at y=0, spot light I = 20 at (0,2,0) pointing
+                     down, inner cone 0.3 rad, outer 0.5 rad. Only direct light; inside the
+                     inner cone (r <= 2 tan 0.3 = 0.619 m) exactly
+                       L = (0.7/pi) * 20 * 2 / d^3,  d^2 = r^2 + 4;  L(0) = 3.5/pi = 1.114085.
+                     Zero beyond r = 2 tan 0.5 = 1.093 m; the falloff between is the
+                     renderer's spot profile.
+  glass_slab.gltf    4 x 4 m floor (rho 0.8), closed glass box 1 x 0.2 x 1 m (ior 1.5) at
+                     y in [0.8,1.0], 0.2 m light (radiance 50) facing down at y = 1.9.
+                     Tests Fresnel splitting and caustics. Approximate check: irradiance
+                     reaching the floor centre through the slab (all internal bounces)
+                     = 0.547, i.e. 0.99 x the 0.552 of the bare light (Fresnel loss
+                     T = (1-R)/(1+R) = 0.923, offset by the slab pulling the light's image
+                     0.067 m closer); floor radiance there ~ 0.8/pi * 0.547 = 0.139, plus
+                     ~2% from floor <-> slab-underside interreflection.
+"""
+
+import base64
+import json
+import math
+import struct
+from pathlib import Path
+
+FLOAT, UINT = 5126, 5125  # glTF componentType
+ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
+TRIANGLES = 4
+
+EXT_LIGHTS = "KHR_lights_punctual"
+EXT_TRANSMISSION = "KHR_materials_transmission"
+EXT_IOR = "KHR_materials_ior"
+EXT_STRENGTH = "KHR_materials_emissive_strength"
+
+GLB_MAGIC, GLB_JSON, GLB_BIN = 0x46546C67, 0x4E4F534A, 0x004E4942
+
+# ----------------------------------------------------------------------------- vector math
+
+
+def add(a, b):
+    return tuple(x + y for x, y in zip(a, b))
+
+
+def sub(a, b):
+    return tuple(x - y for x, y in zip(a, b))
+
+
+def scale(a, s):
+    return tuple(x * s for x in a)
+
+
+def dot(a, b):
+    return sum(x * y for x, y in zip(a, b))
+
+
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def length(a):
+    return math.sqrt(dot(a, a))
+
+
+def normalize(a):
+    return scale(a, 1.0 / length(a))
+
+
+def f32(x):
+    """x rounded to float32, the precision the buffers store."""
+    return struct.unpack("<f", struct.pack("<f", x))[0]
+
+
+def look_rotation(eye, target, up_hint=(0.0, 1.0, 0.0)):
+    """3x3 rotation (rows) whose local -Z looks from eye to target with local +Y up."""
+    forward = normalize(sub(target, eye))
+    right = normalize(cross(forward, up_hint))
+    up = cross(right, forward)
+    back = scale(forward, -1.0)
+    return [[right[i], up[i], back[i]] for i in range(3)]
+
+
+def quaternion(m):
+    """Unit quaternion [x, y, z, w] (w >= 0) of the 3x3 rotation matrix m (rows)."""
+    t = m[0][0] + m[1][1] + m[2][2]
+    if t > 0:
+        s = 2.0 * math.sqrt(t + 1.0)
+        q = [(m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s, s / 4]
+    elif m[0][0] >= m[1][1] and m[0][0] >= m[2][2]:
+        s = 2.0 * math.sqrt(1.0 + m[0][0] - m[1][1] - m[2][2])
+        q = [s / 4, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s, (m[2][1] - m[1][2]) / s]
+    elif m[1][1] >= m[2][2]:
+        s = 2.0 * math.sqrt(1.0 + m[1][1] - m[0][0] - m[2][2])
+        q = [(m[0][1] + m[1][0]) / s, s / 4, (m[1][2] + m[2][1]) / s, (m[0][2] - m[2][0]) / s]
+    else:
+        s = 2.0 * math.sqrt(1.0 + m[2][2] - m[0][0] - m[1][1])
+        q = [(m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, s / 4, (m[1][0] - m[0][1]) / s]
+    q = [x if abs(x) > 1e-15 else 0.0 for x in q]  # no -0.0 / 1e-17 noise in the files
+    return q if q[3] >= 0 else [-x for x in q]
+
+
+def matrix_columns(rotation_rows, translation):
+    """glTF node "matrix": column-major 4x4 from a 3x3 rotation (rows) and a translation."""
+    cols = []
+    for c in range(3):
+        cols += [rotation_rows[r][c] for r in range(3)] + [0.0]
+    return [x if abs(x) > 1e-15 else 0.0 for x in cols] + list(translation) + [1.0]
+
+
+def matmul4(a, b):
+    """Product of two column-major 4x4 matrices (flat lists)."""
+    return [sum(a[k * 4 + r] * b[c * 4 + k] for k in range(4)) for c in range(4) for r in range(4)]
+
+
+def trs_matrix(node):
+    """Column-major local matrix of a glTF node (its "matrix", or T * R * S)."""
+    if "matrix" in node:
+        return list(node["matrix"])
+    x, y, z, w = node.get("rotation", [0, 0, 0, 1])
+    sx, sy, sz = node.get("scale", [1, 1, 1])
+    tx, ty, tz = node.get("translation", [0, 0, 0])
+    r = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+         [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+         [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+    s = (sx, sy, sz)
+    cols = [v for c in range(3) for v in (r[0][c] * s[c], r[1][c] * s[c], r[2][c] * s[c], 0.0)]
+    return cols + [tx, ty, tz, 1.0]
+
+
+def transform(m, v, w):
+    """Column-major 4x4 m applied to (v, w); w = 1 for points, 0 for directions."""
+    return tuple(m[r] * v[0] + m[4 + r] * v[1] + m[8 + r] * v[2] + m[12 + r] * w for r in range(3))
+
+
+# ----------------------------------------------------------------------------- geometry
+
+
+class Geometry:
+    """Indexed triangles with per-vertex normals (outward = counter-clockwise front side)."""
+
+    def __init__(self, positions, normals, indices):
+        self.positions, self.normals, self.indices = list(positions), list(normals), list(indices)
+
+    def __add__(self, other):
+        base = len(self.positions)
+        return Geometry(self.positions + other.positions, self.normals + other.normals,
+                        self.indices + [i + base for i in other.indices])
+
+    @property
+    def triangles(self):
+        return len(self.indices) // 3
+
+
+def merge(geometries):
+    geometries = list(geometries)
+    out = geometries[0]
+    for g in geometries[1:]:
+        out = out + g
+    return out
+
+
+def quad(center, u, v):
+    """Parallelogram center +- u +- v, two triangles, front side (and flat normal) u x v."""
+    n = normalize(cross(u, v))
+    corners = [add(center, add(scale(u, su), scale(v, sv)))
+               for su, sv in ((-1, -1), (1, -1), (1, 1), (-1, 1))]
+    return Geometry(corners, [n] * 4, [0, 1, 2, 0, 2, 3])
+
+
+def horizontal_quad(center, half_x, half_z, facing_up=True):
+    """Axis-aligned quad in the plane y = center.y, facing +y (or -y)."""
+    return quad(center, (half_x, 0.0, 0.0), (0.0, 0.0, -half_z if facing_up else half_z))
+
+
+def box_faces(lo, hi, inward=False):
+    """The six faces of an axis-aligned box as {"+x": Geometry, "-x": ..., ...}.
+
+    Faces face outward (a closed solid) or inward (an enclosure seen from inside)."""
+    mid = scale(add(lo, hi), 0.5)
+    half = scale(sub(hi, lo), 0.5)
+    faces = {}
+    for i, axis in enumerate("xyz"):
+        j, k = (i + 1) % 3, (i + 2) % 3
+        u = tuple(half[j] if a == j else 0.0 for a in range(3))  # e_j x e_k = e_i
+        v = tuple(half[k] if a == k else 0.0 for a in range(3))
+        for sign in (1, -1):
+            center = tuple((hi if sign > 0 else lo)[a] if a == i else mid[a] for a in range(3))
+            outward = sign > 0
+            faces[("+" if sign > 0 else "-") + axis] = (
+                quad(center, u, v) if outward != inward else quad(center, v, u))
+    return faces
+
+
+def box(lo, hi, inward=False):
+    faces = box_faces(lo, hi, inward)
+    return merge(faces[name] for name in ("+x", "-x", "+y", "-y", "+z", "-z"))
+
+
+def uv_sphere(center, radius, slices=64, stacks=32):
+    """Closed UV sphere, outward winding, smooth normals; single pole vertices (no slivers)."""
+    dirs = [(0.0, 1.0, 0.0)]
+    for i in range(1, stacks):
+        theta = math.pi * i / stacks
+        for j in range(slices):
+            phi = 2.0 * math.pi * j / slices
+            dirs.append((math.sin(theta) * math.cos(phi), math.cos(theta),
+                         math.sin(theta) * math.sin(phi)))
+    dirs.append((0.0, -1.0, 0.0))
+    north, south = 0, len(dirs) - 1
+
+    def ring(i, j):  # vertex j of latitude ring i (1 .. stacks-1)
+        return 1 + (i - 1) * slices + j % slices
+
+    idx = []
+    for j in range(slices):
+        idx += [north, ring(1, j + 1), ring(1, j)]
+        for i in range(1, stacks - 1):
+            a, b, c, d = ring(i, j), ring(i, j + 1), ring(i + 1, j), ring(i + 1, j + 1)
+            idx += [a, b, c, b, d, c]
+        idx += [ring(stacks - 1, j), ring(stacks - 1, j + 1), south]
+    return Geometry([add(center, scale(d, radius)) for d in dirs], dirs, idx)
+
+
+# ----------------------------------------------------------------------------- glTF builder
+
+
+class GltfBuilder:
+    """Accumulates one glTF document: a single binary buffer plus the JSON objects."""
+
+    def __init__(self):
+        self.bin = bytearray()
+        self.buffer_views, self.accessors = [], []
+        self.materials, self.meshes, self.nodes = [], [], []
+        self.cameras, self.lights, self.roots = [], [], []
+        self.extensions = set()
+
+    # -- buffers
+    def _accessor(self, fmt, values, count, component, kind, target, bounds=False):
+        while len(self.bin) % 4:
+            self.bin.append(0)
+        data = struct.pack("<" + fmt * len(values), *values)
+        self.buffer_views.append({"buffer": 0, "byteOffset": len(self.bin),
+                                  "byteLength": len(data), "target": target})
+        self.bin += data
+        acc = {"bufferView": len(self.buffer_views) - 1, "componentType": component,
+               "count": count, "type": kind}
+        if bounds:  # min/max of the float32 values actually stored
+            stored = struct.unpack("<" + fmt * len(values), data)
+            acc["min"] = [min(stored[c::3]) for c in range(3)]
+            acc["max"] = [max(stored[c::3]) for c in range(3)]
+        self.accessors.append(acc)
+        return len(self.accessors) - 1
+
+    def _vec3(self, vectors, bounds=False):
+        flat = [x for v in vectors for x in v]
+        return self._accessor("f", flat, len(vectors), FLOAT, "VEC3", ARRAY_BUFFER, bounds)
+
+    # -- materials
+    def material(self, name, base_color, metallic=0.0, roughness=1.0, emission=None,
+                 strength=1.0, transmission=None, ior=None):
+        m = {"name": name, "pbrMetallicRoughness": {
+            "baseColorFactor": list(base_color) + [1.0],
+            "metallicFactor": metallic, "roughnessFactor": roughness}}
+        ext = {}
+        if emission is not None:
+            m["emissiveFactor"] = list(emission)
+            if strength != 1.0:
+                ext[EXT_STRENGTH] = {"emissiveStrength": strength}
+        if transmission is not None:
+            ext[EXT_TRANSMISSION] = {"transmissionFactor": transmission}
+        if ior is not None:
+            ext[EXT_IOR] = {"ior": ior}
+        if ext:
+            m["extensions"] = ext
+            self.extensions.update(ext)
+        self.materials.append(m)
+        return len(self.materials) - 1
+
+    def lambertian(self, name, reflectance, radiance=None):
+        """Diffuse; radiance (a number) makes it a white one-sided area light as well."""
+        if radiance is None:
+            return self.material(name, reflectance)
+        return self.material(name, reflectance, emission=(1.0, 1.0, 1.0), strength=radiance)
+
+    def mirror(self, name, tint):
+        return self.material(name, tint, metallic=1.0, roughness=0.0)
+
+    def glass(self, name, ior=1.5):
+        return self.material(name, (1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=ior)
+
+    # -- meshes, cameras, lights, nodes
+    def mesh(self, name, parts):
+        """parts: [(Geometry, material index)], one primitive each."""
+        prims = []
+        for geo, mat in parts:
+            attrs = {"POSITION": self._vec3(geo.positions, bounds=True),
+                     "NORMAL": self._vec3(geo.normals)}
+            ind = self._accessor("I", geo.indices, len(geo.indices), UINT, "SCALAR",
+                                 ELEMENT_ARRAY_BUFFER)
+            prims.append({"attributes": attrs, "indices": ind, "material": mat,
+                          "mode": TRIANGLES})
+        self.meshes.append({"name": name, "primitives": prims})
+        return len(self.meshes) - 1
+
+    def camera(self, name, yfov, aspect=1.0):
+        self.cameras.append({"name": name, "type": "perspective", "perspective": {
+            "yfov": yfov, "aspectRatio": aspect, "znear": 0.01, "zfar": 1000.0}})
+        return len(self.cameras) - 1
+
+    def point_light(self, name, intensity, color=(1.0, 1.0, 1.0)):
+        return self._light({"name": name, "type": "point", "color": list(color),
+                            "intensity": intensity})
+
+    def spot_light(self, name, intensity, inner, outer, color=(1.0, 1.0, 1.0)):
+        return self._light({"name": name, "type": "spot", "color": list(color),
+                            "intensity": intensity,
+                            "spot": {"innerConeAngle": inner, "outerConeAngle": outer}})
+
+    def _light(self, light):
+        self.extensions.add(EXT_LIGHTS)
+        self.lights.append(light)
+        return len(self.lights) - 1
+
+    def node(self, name, mesh=None, camera=None, light=None, children=(), root=True, **xform):
+        """xform: translation / rotation / scale, or matrix (glTF node properties)."""
+        n = {"name": name}
+        if mesh is not None:
+            n["mesh"] = mesh
+        if camera is not None:
+            n["camera"] = camera
+        if light is not None:
+            n["extensions"] = {EXT_LIGHTS: {"light": light}}
+        if children:
+            n["children"] = list(children)
+        n.update({k: list(v) for k, v in xform.items()})
+        self.nodes.append(n)
+        if root:
+            self.roots.append(len(self.nodes) - 1)
+        return len(self.nodes) - 1
+
+    def mesh_node(self, name, parts, **xform):
+        return self.node(name, mesh=self.mesh(name, parts), **xform)
+
+    def camera_node(self, name, eye, target, yfov, aspect=1.0, up=(0.0, 1.0, 0.0),
+                    use_matrix=False):
+        rot = look_rotation(eye, target, up)
+        xform = ({"matrix": matrix_columns(rot, eye)} if use_matrix else
+                 {"translation": eye, "rotation": quaternion(rot)})
+        return self.node(name, camera=self.camera(name, yfov, aspect), **xform)
+
+    # -- output
+    def document(self, uri=None):
+        buf = {"byteLength": len(self.bin)}
+        if uri is not None:
+            buf["uri"] = uri
+        doc = {"asset": {"version": "2.0", "generator": "photonbound tools/make_scenes.py"}}
+        if self.extensions:
+            doc["extensionsUsed"] = sorted(self.extensions)
+        doc.update({"scene": 0, "scenes": [{"nodes": self.roots}], "nodes": self.nodes,
+                    "meshes": self.meshes, "materials": self.materials})
+        if self.cameras:
+            doc["cameras"] = self.cameras
+        if self.lights:
+            doc["extensions"] = {EXT_LIGHTS: {"lights": self.lights}}
+        doc.update({"buffers": [buf], "bufferViews": self.buffer_views,
+                    "accessors": self.accessors})
+        return doc
+
+    def write_gltf(self, path):
+        uri = "data:application/octet-stream;base64," + base64.b64encode(self.bin).decode()
+        path.write_text(json.dumps(self.document(uri), indent=1) + "\n")
+
+    def write_gltf_external(self, path):
+        bin_path = path.with_suffix(".bin")
+        bin_path.write_bytes(bytes(self.bin))
+        path.write_text(json.dumps(self.document(bin_path.name), indent=1) + "\n")
+
+    def write_glb(self, path):
+        js = json.dumps(self.document(), separators=(",", ":")).encode()
+        js += b" " * (-len(js) % 4)
+        bn = bytes(self.bin) + b"\0" * (-len(self.bin) % 4)
+        total = 12 + 8 + len(js) + 8 + len(bn)
+        path.write_bytes(struct.pack("<III", GLB_MAGIC, 2, total)
+                         + struct.pack("<II", len(js), GLB_JSON) + js
+                         + struct.pack("<II", len(bn), GLB_BIN) + bn)
+
+
+# ----------------------------------------------------------------------------- scenes
+
+def build_cornell():
+    b = GltfBuilder()
+    white = b.lambertian("white", (0.75, 0.75, 0.75))
+    red = b.lambertian("red", (0.63, 0.065, 0.05))
+    green = b.lambertian("green", (0.14, 0.45, 0.09))
+    lamp = b.lambertian("light", (0.0, 0.0, 0.0), radiance=40.0)
+    glass = b.glass("glass", 1.5)
+    mirror = b.mirror("mirror", (0.95, 0.95, 0.95))
+
+    walls = box_faces((-1.0, 0.0, -1.0), (1.0, 2.0, 1.0), inward=True)  # +z left open
+    b.mesh_node("walls", [(merge([walls["-y"], walls["+y"], walls["-z"]]), white),
+                          (walls["-x"], red), (walls["+x"], green)])
+    b.mesh_node("light", [(horizontal_quad((0.0, 1.98, 0.0), 0.15, 0.15, facing_up=False),
+                           lamp)])
+    sphere = uv_sphere((0.0, 0.0, 0.0), 0.35)  # placed by node translations
+    b.mesh_node("glass_sphere", [(sphere, glass)], translation=(0.45, 0.35, 0.4))
+    b.mesh_node("mirror_sphere", [(sphere, mirror)], translation=(-0.45, 0.35, -0.35))
+    b.camera_node("camera", eye=(0.0, 1.0, 3.4), target=(0.0, 1.0, 0.0), yfov=0.78)
+    return b
+
+
+def plane_point_parts(b):
+    """Shared content of the plane_point family: (plane parts, light index)."""
+    grey = b.lambertian("grey", (0.5, 0.5, 0.5))
+    plane = horizontal_quad((0.0, 0.0, 0.0), 10.0, 10.0)
+    return [(plane, grey)], b.point_light("point", 10.0)
+
+
+PLANE_CAMERA = {"eye": (0.0, 3.0, 0.0), "target": (0.0, 0.0, 0.0), "yfov": 0.6,
+                "up": (0.0, 0.0, -1.0)}  # looking straight down, image up = -z
+
+
+def build_plane_point():
+    b = GltfBuilder()
+    parts, light = plane_point_parts(b)
+    b.mesh_node("plane", parts)
+    b.node("point", light=light, translation=(0.0, 1.0, 0.0))
+    b.camera_node("camera", **PLANE_CAMERA)
+    return b
+
+
+def build_nested():
+    b = GltfBuilder()
+    parts, light = plane_point_parts(b)
+    child = b.node("plane", mesh=b.mesh("plane", parts), root=False,
+                   translation=(0.0, 0.5, 0.0), scale=(0.5, 0.5, 0.5))
+    b.node("plane_parent", children=[child], translation=(0.0, -1.0, 0.0),
+           scale=(2.0, 2.0, 2.0))
+    identity = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+    b.node("point", light=light, matrix=matrix_columns(identity, (0.0, 1.0, 0.0)))
+    b.camera_node("camera", use_matrix=True, **PLANE_CAMERA)
+    return b
+
+
+def build_closed_box():
+    b = GltfBuilder()
+    wall = b.lambertian("emissive_wall", (0.5, 0.5, 0.5), radiance=1.0)
+    b.mesh_node("box", [(box((-1.0, -1.0, -1.0), (1.0, 1.0, 1.0), inward=True), wall)])
+    b.camera_node("camera", eye=(0.0, 0.0, 0.9), target=(0.0, 0.0, 0.0), yfov=1.0)
+    return b
+
+
+def build_spot():
+    b = GltfBuilder()
+    floor = b.lambertian("floor", (0.7, 0.7, 0.7))
+    b.mesh_node("floor", [(horizontal_quad((0.0, 0.0, 0.0), 2.0, 2.0), floor)])
+    spot = b.spot_light("spot", 20.0, inner=0.3, outer=0.5)
+    down = look_rotation((0.0, 2.0, 0.0), (0.0, 0.0, 0.0), up_hint=(0.0, 0.0, -1.0))
+    b.node("spot", light=spot, translation=(0.0, 2.0, 0.0), rotation=quaternion(down))
+    b.camera_node("camera", eye=(0.0, 1.5, 3.0), target=(0.0, 0.0, 0.0), yfov=0.8)
+    return b
+
+
+def build_glass_slab():
+    b = GltfBuilder()
+    floor = b.lambertian("floor", (0.8, 0.8, 0.8))
+    glass = b.glass("glass", 1.5)
+    lamp = b.lambertian("light", (0.0, 0.0, 0.0), radiance=50.0)
+    b.mesh_node("floor", [(horizontal_quad((0.0, 0.0, 0.0), 2.0, 2.0), floor)])
+    b.mesh_node("slab", [(box((-0.5, 0.8, -0.5), (0.5, 1.0, 0.5)), glass)])
+    b.mesh_node("light", [(horizontal_quad((0.0, 1.9, 0.0), 0.1, 0.1, facing_up=False),
+                           lamp)])
+    b.camera_node("camera", eye=(0.0, 1.2, 2.5), target=(0.0, 0.0, 0.0), yfov=0.8)
+    return b
+
+
+# ----------------------------------------------------------------------------- validation
+
+
+class Invalid(Exception):
+    pass
+
+
+def check(cond, msg):
+    if not cond:
+        raise Invalid(msg)
+
+
+def read_document(path):
+    """(JSON document, list of buffer bytes) from a .gltf or .glb file."""
+    raw = path.read_bytes()
+    glb_bin = None
+    if path.suffix == ".glb":
+        magic, version, total = struct.unpack_from("<III", raw, 0)
+        check(magic == GLB_MAGIC and version == 2, "bad GLB header")
+        check(total == len(raw), "GLB length field != file size")
+        jlen, jtype = struct.unpack_from("<II", raw, 12)
+        check(jtype == GLB_JSON and jlen % 4 == 0, "bad GLB JSON chunk")
+        doc = json.loads(raw[20:20 + jlen].decode())
+        off = 20 + jlen
+        blen, btype = struct.unpack_from("<II", raw, off)
+        check(btype == GLB_BIN and blen % 4 == 0, "bad GLB BIN chunk")
+        check(off + 8 + blen == total, "GLB chunks do not fill the file")
+        glb_bin = raw[off + 8:off + 8 + blen]
+    else:
+        doc = json.loads(raw.decode())
+    buffers = []
+    for i, buf in enumerate(doc["buffers"]):
+        uri = buf.get("uri")
+        if uri is None:
+            check(i == 0 and glb_bin is not None, "buffer without uri outside a GLB")
+            data = glb_bin
+        elif uri.startswith("data:"):
+            check(uri.startswith("data:application/octet-stream;base64,"), "bad data URI")
+            data = base64.b64decode(uri.split(",", 1)[1])
+        else:
+            data = (path.parent / uri).read_bytes()
+        check(buf["byteLength"] <= len(data), f"buffer {i} shorter than byteLength")
+        buffers.append(data)
+    return doc, buffers
+
+
+def read_accessor(doc, buffers, index):
+    acc = doc["accessors"][index]
+    view = doc["bufferViews"][acc["bufferView"]]
+    comps = {"SCALAR": 1, "VEC3": 3}[acc["type"]]
+    fmt = {FLOAT: "f", UINT: "I"}[acc["componentType"]]
+    start = view.get("byteOffset", 0) + acc.get("byteOffset", 0)
+    size = 4 * comps * acc["count"]
+    check(acc.get("byteOffset", 0) + size <= view["byteLength"], f"accessor {index} overflows")
+    check(view.get("byteOffset", 0) + view["byteLength"] <= doc["buffers"][view["buffer"]][
+        "byteLength"], f"bufferView of accessor {index} overflows its buffer")
+    values = struct.unpack_from("<" + fmt * comps * acc["count"], buffers[view["buffer"]], start)
+    if comps == 1:
+        return acc, list(values)
+    return acc, [tuple(values[i:i + 3]) for i in range(0, len(values), 3)]
+
+
+def used_extensions(obj, found):
+    if isinstance(obj, dict):
+        found.update(obj.get("extensions", {}))
+        for v in obj.values():
+            used_extensions(v, found)
+    elif isinstance(obj, list):
+        for v in obj:
+            used_extensions(v, found)
+    return found
+
+
+def validate_primitive(doc, buffers, prim, where):
+    check(prim.get("mode", TRIANGLES) == TRIANGLES, f"{where}: not TRIANGLES")
+    check(0 <= prim["material"] < len(doc["materials"]), f"{where}: bad material")
+    acc, pos = read_accessor(doc, buffers, prim["attributes"]["POSITION"])
+    check(acc["componentType"] == FLOAT and acc["type"] == "VEC3", f"{where}: POSITION type")
+    for c in range(3):
+        check(acc["min"][c] == min(p[c] for p in pos) and acc["max"][c] == max(p[c] for p in pos),
+              f"{where}: POSITION min/max do not match the data")
+    acc, idx = read_accessor(doc, buffers, prim["indices"])
+    check(acc["componentType"] == UINT and acc["type"] == "SCALAR", f"{where}: index type")
+    check(len(idx) % 3 == 0 and len(idx) > 0, f"{where}: index count not a multiple of 3")
+    check(max(idx) < len(pos), f"{where}: index out of range")
+    nrm = None
+    if "NORMAL" in prim["attributes"]:
+        acc, nrm = read_accessor(doc, buffers, prim["attributes"]["NORMAL"])
+        check(len(nrm) == len(pos), f"{where}: NORMAL count != POSITION count")
+        check(all(abs(length(n) - 1.0) < 1e-5 for n in nrm), f"{where}: normals not unit")
+    for t in range(0, len(idx), 3):
+        a, b, c = idx[t:t + 3]
+        g = cross(sub(pos[b], pos[a]), sub(pos[c], pos[a]))
+        check(length(g) > 1e-12, f"{where}: degenerate triangle {t // 3}")
+        if nrm is not None:
+            check(dot(g, add(add(nrm[a], nrm[b]), nrm[c])) > 0,
+                  f"{where}: triangle {t // 3} winding disagrees with its normals")
+    return pos, idx
+
+
+def flatten(doc, buffers):
+    """World-space content: {"prims": [(material, [triangle]...)], "lights", "cameras"}."""
+    out = {"prims": [], "lights": [], "cameras": []}
+    lights = doc.get("extensions", {}).get(EXT_LIGHTS, {}).get("lights", [])
+    seen = set()
+
+    def visit(i, parent):
+        check(i not in seen, f"node {i} reached twice")
+        seen.add(i)
+        node = doc["nodes"][i]
+        check(not ("matrix" in node and any(k in node for k in ("translation", "rotation",
+                                                                  "scale"))),
+              f"node {i}: matrix together with TRS")
+        m = matmul4(parent, trs_matrix(node))
+        if "mesh" in node:
+            for p, prim in enumerate(doc["meshes"][node["mesh"]]["primitives"]):
+                pos, idx = validate_primitive(doc, buffers, prim, f"mesh {node['mesh']} prim {p}")
+                world = [transform(m, v, 1.0) for v in pos]
+                tris = [tuple(world[k] for k in idx[t:t + 3]) for t in range(0, len(idx), 3)]
+                out["prims"].append((doc["materials"][prim["material"]], tris))
+        if "camera" in node:
+            cam = doc["cameras"][node["camera"]]
+            check(cam["type"] == "perspective" and cam["perspective"]["yfov"] > 0, "camera")
+            out["cameras"].append((transform(m, (0, 0, 0), 1.0),
+                                   normalize(transform(m, (0, 0, -1), 0.0)),
+                                   normalize(transform(m, (0, 1, 0), 0.0)), cam["perspective"]))
+        if EXT_LIGHTS in node.get("extensions", {}):
+            light = lights[node["extensions"][EXT_LIGHTS]["light"]]
+            out["lights"].append((transform(m, (0, 0, 0), 1.0),
+                                  normalize(transform(m, (0, 0, -1), 0.0)), light))
+        for c in node.get("children", []):
+            visit(c, m)
+
+    identity = [1.0 if r == c else 0.0 for c in range(4) for r in range(4)]
+    for root in doc["scenes"][doc.get("scene", 0)]["nodes"]:
+        visit(root, identity)
+    return out
+
+
+def tri_normal(t):
+    return normalize(cross(sub(t[1], t[0]), sub(t[2], t[0])))
+
+
+def closed_volume(tris):
+    """Signed volume of a closed, consistently wound mesh (> 0 when wound outward)."""
+    key = lambda p: tuple(round(x, 6) for x in p)
+    edges = {}
+    for t in tris:
+        for a, b in ((0, 1), (1, 2), (2, 0)):
+            e = (key(t[a]), key(t[b]))
+            edges[e] = edges.get(e, 0) + 1
+    check(all(n == 1 and edges.get((b, a)) == 1 for (a, b), n in edges.items()),
+          "mesh is not closed with consistent winding")
+    return sum(dot(t[0], cross(t[1], t[2])) for t in tris) / 6.0
+
+
+def is_glass(mat):
+    return EXT_TRANSMISSION in mat.get("extensions", {})
+
+
+def emitted_radiance(mat):
+    s = mat.get("extensions", {}).get(EXT_STRENGTH, {}).get("emissiveStrength", 1.0)
+    return [c * s for c in mat.get("emissiveFactor", [0, 0, 0])]
+
+
+def near(a, b, eps=1e-6):
+    return all(abs(x - y) <= eps for x, y in zip(a, b))
+
+
+def same_content(a, b):
+    """World-space equality of two flattened scenes (geometry, materials, lights, cameras)."""
+    if len(a["prims"]) != len(b["prims"]) or len(a["lights"]) != len(b["lights"]):
+        return False
+    for (ma, ta), (mb, tb) in zip(a["prims"], b["prims"]):
+        if ma != mb or len(ta) != len(tb):
+            return False
+        if not all(near(p, q) for x, y in zip(ta, tb) for p, q in zip(x, y)):
+            return False
+    for (pa, da, la), (pb, db, lb) in zip(a["lights"], b["lights"]):
+        if not (near(pa, pb) and near(da, db) and la == lb):
+            return False
+    return len(a["cameras"]) == len(b["cameras"]) and all(
+        near(x[0], y[0]) and near(x[1], y[1]) and near(x[2], y[2]) and x[3] == y[3]
+        for x, y in zip(a["cameras"], b["cameras"]))
+
+
+def check_cornell(s):
+    for mat, tris in s["prims"]:
+        if mat["name"] in ("white", "red", "green"):
+            check(all(dot(tri_normal(t), sub((0, 1, 0), t[0])) > 0 for t in tris),
+                  "Cornell walls must face into the box")
+        if mat["name"] == "light":
+            check(all(near(tri_normal(t), (0, -1, 0)) for t in tris), "light must face -y")
+
+
+def check_faces_up(s):
+    for mat, tris in s["prims"]:
+        if not is_glass(mat) and not any(emitted_radiance(mat)):
+            check(all(near(tri_normal(t), (0, 1, 0)) for t in tris), "floor must face +y")
+
+
+def check_closed_box(s):
+    check(abs(closed_volume(s["prims"][0][1]) + 8.0) < 1e-6, "box must be closed, inward")
+
+
+def check_spot(s):
+    check_faces_up(s)
+    check(near(s["lights"][0][1], (0, -1, 0)), "spot must point down")
+
+
+SCENE_CHECKS = {"cornell.gltf": check_cornell, "closed_box.gltf": check_closed_box,
+                "spot.gltf": check_spot, "glass_slab.gltf": check_faces_up,
+                "plane_point.gltf": check_faces_up}
+SAME_AS_PLANE_POINT = ("plane_point.glb", "plane_point_external.gltf", "nested.gltf")
+
+
+def fmt_vec(v):
+    return "(" + ", ".join(f"{x:.3g}" if abs(x) > 1e-9 else "0" for x in v) + ")"
+
+
+def validate(path):
+    """Validates one written file; returns (flattened scene, one-line summary)."""
+    doc, buffers = read_document(path)
+    check(doc["asset"]["version"] == "2.0", "asset.version")
+    undeclared = used_extensions(doc, set()) - set(doc.get("extensionsUsed", []))
+    check(not undeclared, f"extensions not in extensionsUsed: {sorted(undeclared)}")
+    s = flatten(doc, buffers)
+    for mat, tris in s["prims"]:
+        pbr = mat["pbrMetallicRoughness"]
+        check("metallicFactor" in pbr, f"material {mat['name']}: metallicFactor must be explicit")
+        if is_glass(mat):
+            check(closed_volume(tris) > 0, f"glass {mat['name']}: must be closed, outward")
+    check(len(s["cameras"]) == 1, "exactly one camera expected")
+    emitters = [(mat, tris) for mat, tris in s["prims"] if any(emitted_radiance(mat))]
+    check(s["lights"] or emitters, "no light")
+    SCENE_CHECKS.get(path.name, lambda _: None)(s)
+
+    tris = sum(len(t) for _, t in s["prims"])
+    lights = [f"{l['type']} I={l['intensity']:g} at {fmt_vec(p)}" for p, _, l in s["lights"]]
+    lights += [f"emitter '{m['name']}' Le={max(emitted_radiance(m)):g} "
+               f"area={sum(length(cross(sub(t[1], t[0]), sub(t[2], t[0]))) / 2 for t in ts):.3g}"
+               for m, ts in emitters]
+    eye, fwd, _, persp = s["cameras"][0]
+    summary = (f"{path.name:27s} {tris:5d} tris, {len(s['prims'])} prims, "
+               f"{len(doc['materials'])} mats, {'; '.join(lights)}; camera {fmt_vec(eye)} "
+               f"-> {fmt_vec(fwd)} yfov {persp['yfov']:g}, {path.stat().st_size} bytes")
+    return s, summary
+
+
+# ----------------------------------------------------------------------------- main
+
+OUTPUTS = [  # (file name, builder, writer)
+    ("cornell.gltf", build_cornell, GltfBuilder.write_gltf),
+    ("plane_point.gltf", build_plane_point, GltfBuilder.write_gltf),
+    ("closed_box.gltf", build_closed_box, GltfBuilder.write_gltf),
+    ("spot.gltf", build_spot, GltfBuilder.write_gltf),
+    ("plane_point.glb", build_plane_point, GltfBuilder.write_glb),
+    ("plane_point_external.gltf", build_plane_point, GltfBuilder.write_gltf_external),
+    ("glass_slab.gltf", build_glass_slab, GltfBuilder.write_gltf),
+    ("nested.gltf", build_nested, GltfBuilder.write_gltf),
+]
+
+
+def main():
+    out_dir = Path(__file__).resolve().parent.parent / "scenes"
+    out_dir.mkdir(exist_ok=True)
+    for name, build, write in OUTPUTS:
+        write(build(), out_dir / name)
+    flat = {}
+    for name, _, _ in OUTPUTS:
+        try:
+            flat[name], summary = validate(out_dir / name)
+        except (Invalid, KeyError, ValueError, struct.error) as e:
+            raise SystemExit(f"make_scenes: {name}: INVALID: {e}")
+        print(summary)
+    for name in SAME_AS_PLANE_POINT:
+        if not same_content(flat[name], flat["plane_point.gltf"]):
+            raise SystemExit(f"make_scenes: {name}: world-space content differs from "
+                             "plane_point.gltf")
+    print(f"all {len(OUTPUTS)} scenes valid; {', '.join(SAME_AS_PLANE_POINT)} "
+          "match plane_point.gltf in world space")
+
+
+if __name__ == "__main__":
+    main()
