@@ -1,0 +1,28 @@
+// Pinhole camera rays through pixel centres (pixel (0, 0) is the top-left corner).
+#pragma once
+
+#include "photonbound/scene.h"
+
+namespace pb {
+
+class PinholeCamera {
+ public:
+  PinholeCamera(const Camera& camera, int width, int height);
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  const vec3& origin() const { return camera_.position; }
+  // Unit direction through the centre of pixel (x, y).
+  vec3 direction(int x, int y) const;
+  // Angle subtended by one pixel at the image centre (radians): the pixel footprint at
+  // distance d is about d * pixel_angle().
+  float pixel_angle() const { return 2.0f * tan_half_ / float(height_); }
+
+ private:
+  Camera camera_;
+  int width_, height_;
+  float tan_half_;  // tan(yfov / 2)
+  float aspect_;    // width / height of the image: pixels are square
+};
+
+}  // namespace pb

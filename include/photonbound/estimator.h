@@ -1,0 +1,63 @@
+// Per-measurement-point progressive estimator: the PPM radius update (Hachisuka, Ogaki, Jensen
+// 2008) plus the statistics for error bounds (Hachisuka, Jarosz, Jensen 2010), exactly as
+// ESTIMATOR.md sections 3 and 4 specify. Depends on math only: tested without a scene.
+#pragma once
+
+#include "photonbound/math.h"
+
+#include <cstdint>
+
+namespace pb {
+
+// What one pass gathered at one point (ESTIMATOR.md section 3, "During pass j").
+struct PassGather {
+  dvec3 phi{0.0};         // sum of w(t) f Phi
+  dvec3 phi_lap_r2{0.0};  // sum of w_lap(t) R_j^2 f Phi (divided by R_j^2 in the update)
+  uint64_t count = 0;     // M_j: photons that landed within R_j on the point's side
+  dvec3 direct{0.0};      // D_j: next-event estimate of direct light (0 with --direct photons)
+};
+
+// Everything the estimator keeps for one point, in double (ESTIMATOR.md section 8).
+struct PointState {
+  double n = 0.0;   // N: alpha-thinned photon count
+  double r2 = 0.0;  // current squared radius, used by the next pass
+  dvec3 tau{0.0};
+  dvec3 tau_lap{0.0};
+  dvec3 direct_sum{0.0};
+  uint64_t photons = 0;  // all photons ever gathered (sum of M_j)
+  // Bivariate streaming moments of the per-pass samples (X_j, R_j^2), ESTIMATOR.md section 4.
+  dvec3 mean_x{0.0};
+  double mean_r2 = 0.0;
+  dvec3 c_xx{0.0};
+  dvec3 c_xr{0.0};
+  double c_rr = 0.0;
+};
+
+struct EstimatorParams {
+  double alpha = 0.7;               // PPM radius reduction, in (0, 1]
+  double photons_per_pass = 1.0;    // M_e
+  double min_r2 = 0.0;              // floor on R^2 (ESTIMATOR.md section 8)
+};
+
+// Folds pass number `pass` (1-based) into the state. state.r2 must be the radius the pass used.
+void accumulate_pass(PointState& state, const PassGather& gather, const EstimatorParams& params,
+                     uint64_t pass);
+
+// The point's estimate after `passes` passes.
+struct PointEstimate {
+  dvec3 radiance{0.0};  // L_i = mean_j X_j
+  dvec3 bias{0.0};      // B_i = 0.5 k2 Lap_i mean_j(R_j^2), signed
+  dvec3 variance{0.0};  // S^2 / i: variance of the mean after the retroactive bias correction
+  bool known = false;   // false until the point has received a photon and passes >= 2
+};
+
+PointEstimate estimate(const PointState& state, uint64_t passes, double photons_per_pass);
+
+// The photon part of L_i computed from the PPM accumulators, tau / (pi R^2 i M_e). Equal to the
+// mean of the photon parts of X_j (ESTIMATOR.md section 3, key identity).
+dvec3 photon_radiance(const PointState& state, uint64_t passes, double photons_per_pass);
+
+// Two-sided Student-t quantile t_{nu, p} (Boost.Math), ESTIMATOR.md section 6. nu >= 1.
+double student_t_quantile(double nu, double p);
+
+}  // namespace pb

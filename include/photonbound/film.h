@@ -1,0 +1,51 @@
+// Per-pixel radiance and error bounds from the per-point statistics (ESTIMATOR.md sections 5-7).
+#pragma once
+
+#include "photonbound/estimator.h"
+#include "photonbound/eye_pass.h"
+#include "photonbound/options.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace pb {
+
+// Planar float images, RGB channels interleaved per pixel (3 floats), scalars one per pixel.
+struct FilmImage {
+  int width = 0, height = 0;
+  std::vector<float> radiance;     // L_pix
+  std::vector<float> bound;        // Eb_pix at the chosen confidence; +inf where unknown
+  std::vector<float> bias;         // B_pix, signed
+  std::vector<float> noise;        // noise half-width t sqrt(Var_pix)
+  std::vector<float> variance;     // Var_pix: variance of the mean
+  std::vector<float> photons;      // photons gathered by the pixel's points
+  std::vector<float> radius;       // current radius of the pixel's first point (0 if none)
+};
+
+struct FilmSummary {
+  double mean_bound = INFINITY;    // over known pixels and RGB channels, in the chosen metric
+  double mean_noise = 0.0;         // mean noise half-width (absolute)
+  double mean_abs_bias = 0.0;      // mean |B| (absolute)
+  double below_target = 0.0;       // fraction of known pixels whose every channel meets the target
+  uint64_t unknown_pixels = 0;     // pixels with a point that never received a photon
+  double relative_floor = 0.0;     // denominator floor of the relative metric
+};
+
+struct FilmSettings {
+  double photons_per_pass = 1.0;
+  double confidence = 0.9;
+  ErrorMetric metric = ErrorMetric::Absolute;
+  double target = 0.0;  // 0 = no target
+};
+
+// Combines the points of every pixel. With passes < 2 no bound exists: every pixel with
+// points is unknown.
+FilmSummary develop(const EyePassResult& eye, const std::vector<PointState>& states,
+                    uint64_t passes, const FilmSettings& settings, FilmImage* image);
+
+// The relative metric divides by max(L, floor) with floor = kRelativeFloor x mean radiance of
+// the image, so that dark pixels do not dominate the mean.
+inline constexpr double kRelativeFloor = 0.01;
+
+}  // namespace pb

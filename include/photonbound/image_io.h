@@ -1,0 +1,37 @@
+// EXR reading and writing. The only file that includes OpenImageIO is src/image_io.cpp.
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace pb {
+
+class ImageError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct ExrImage {
+  int width = 0, height = 0;
+  std::vector<std::string> channels;  // names, e.g. R, G, B, ErrorBound.R
+  std::vector<float> pixels;          // interleaved: channels.size() floats per pixel, row-major
+  std::vector<std::pair<std::string, std::string>> metadata;  // stored as string attributes
+
+  int channel_index(const std::string& name) const;  // -1 when absent
+};
+
+// Writes float32 EXR to a temporary file beside `path`, then renames it over `path`, so a
+// reader never sees a partial image. Throws ImageError naming the file.
+void write_exr(const std::string& path, const ExrImage& image);
+
+ExrImage read_exr(const std::string& path);
+
+// Writes an 8-bit RGB PNG (rgb: 3 bytes per pixel, row-major), atomically like write_exr.
+void write_png(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb);
+
+// Fails early (ImageError) when `path` cannot be created, before any rendering starts.
+void check_writable(const std::string& path);
+
+}  // namespace pb

@@ -1,0 +1,67 @@
+// The pass loop: eye pass once, then photon pass, grid build, gather and estimator update per
+// pass, until a stop condition (passes, time, target error, interruption) is met.
+#pragma once
+
+#include "photonbound/estimator.h"
+#include "photonbound/eye_pass.h"
+#include "photonbound/film.h"
+#include "photonbound/hash_grid.h"
+#include "photonbound/image_io.h"
+#include "photonbound/options.h"
+#include "photonbound/photon_pass.h"
+#include "photonbound/world.h"
+
+#include <atomic>
+#include <memory>
+#include <ostream>
+#include <string>
+#include <vector>
+
+namespace pb {
+
+struct RenderReport {
+  uint64_t passes = 0;
+  uint64_t photons = 0;  // emitted, all passes
+  uint64_t rays = 0;     // photon-pass rays, all passes
+  double seconds = 0.0;  // wall clock of the pass loop
+  std::string stop_reason;
+  double initial_radius = 0.0;
+  FilmSummary summary;
+};
+
+// Picks the camera (by node or camera name when given) and the image size.
+PinholeCamera choose_camera(const Scene& scene, const RenderOptions& options);
+
+class Renderer {
+ public:
+  Renderer(const Scene& scene, const RenderOptions& options);
+
+  // Runs to a stop condition. `stop` is polled after every pass (Ctrl-C); progress lines go to
+  // `progress` when it is not null.
+  RenderReport run(const std::atomic<bool>* stop, std::ostream* progress);
+
+  // Radiance, bound channels and metadata, ready for write_exr.
+  ExrImage image(const RenderReport& report) const;
+
+  const EyePassResult& eye() const { return eye_; }
+  const std::vector<PointState>& states() const { return states_; }
+  FilmSettings film_settings() const;
+
+ private:
+  void run_pass(uint64_t pass, RenderReport& report);
+  double default_radius() const;
+
+  const RenderOptions options_;
+  World world_;
+  PinholeCamera camera_;
+  EyePassResult eye_;
+  std::vector<PointState> states_;
+  EstimatorParams params_;
+  PhotonTracer tracer_;
+  HashGrid grid_;
+  std::vector<PhotonHit> hits_;
+  std::vector<vec3> hit_positions_;
+  std::vector<float> radii_;
+};
+
+}  // namespace pb

@@ -1,0 +1,15 @@
+// A point on a surface as the passes see it.
+#pragma once
+
+#include "photonbound/scene.h"
+
+namespace pb {
+
+struct Surface {
+  vec3 position{0.0f};
+  vec3 ng{0.0f};  // geometric normal from the winding (the front side), unit
+  vec3 ns{0.0f};  // shading normal, unit, flipped if needed to lie on ng's side
+  const Material* material = nullptr;
+};
+
+}  // namespace pb

@@ -1,0 +1,114 @@
+#include "photonbound/eye_pass.h"
+
+#include "photonbound/bsdf.h"
+#include "photonbound/parallel.h"
+
+#include <atomic>
+
+namespace pb {
+
+namespace {
+
+struct PathVertex {
+  vec3 origin, dir, weight;
+  vec3 origin_normal;  // surface the ray leaves (0 for the camera)
+  float length;        // path length so far, for the footprint
+  int depth;           // specular bounces so far
+};
+
+struct PixelOutput {
+  std::vector<MeasurementPoint> points;
+  dvec3 emission{0.0};
+  uint64_t truncated = 0;
+};
+
+// Follows every branch of one pixel's camera path. The tree has at most 2^max_depth leaves;
+// an explicit stack keeps it iterative.
+void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth, uint32_t pixel,
+                 int x, int y, PixelOutput& out) {
+  PathVertex stack[64];
+  int top = 0;
+  stack[top++] = {camera.origin(), camera.direction(x, y), vec3(1.0f), vec3(0.0f), 0.0f, 0};
+  while (top > 0) {
+    const PathVertex v = stack[--top];
+    Hit hit;
+    const bool found = v.depth == 0 ? world.accel().intersect(v.origin, v.dir, 0.0f, INFINITY, hit)
+                                    : world.trace(v.origin, v.origin_normal, v.dir, hit);
+    if (!found) continue;  // background is black
+    const Surface s = world.surface(hit);
+    const Material& m = *s.material;
+    const vec3 wo = -v.dir;
+    // Emission seen along the chain is exact for this ray (one-sided: front side only).
+    if (m.emits() && glm::dot(wo, s.ng) > 0.0f) out.emission += dvec3(v.weight * m.emission);
+    const float length = v.length + hit.t;
+    if (m.model == Reflection::Lambertian) {
+      const bool front = glm::dot(wo, s.ng) > 0.0f;
+      MeasurementPoint p;
+      p.position = s.position;
+      p.normal = front ? s.ng : -s.ng;
+      p.shading = front ? s.ns : -s.ns;
+      p.brdf = lambertian(m.base_color);
+      p.weight = v.weight;
+      p.pixel = pixel;
+      p.footprint = length * camera.pixel_angle();
+      if (max_component(p.brdf) > 0.0f) out.points.push_back(p);
+      continue;
+    }
+    if (v.depth >= max_depth) {
+      ++out.truncated;
+      continue;
+    }
+    SpecularBranch branches[2];
+    const int n = specular_branches(m, s, wo, Transport::Radiance, branches);
+    for (int k = 0; k < n; ++k) {
+      const vec3 w = v.weight * branches[k].weight;
+      if (max_component(w) <= 0.0f || top >= 64) continue;
+      stack[top++] = {s.position, branches[k].dir, w, s.ng, length, v.depth + 1};
+    }
+  }
+}
+
+}  // namespace
+
+EyePassResult run_eye_pass(const World& world, const PinholeCamera& camera, int max_depth) {
+  EyePassResult r;
+  r.width = camera.width();
+  r.height = camera.height();
+  const size_t pixels = size_t(r.width) * size_t(r.height);
+  r.emission.assign(pixels, dvec3(0.0));
+
+  // One output per row, joined in row order: the point order is independent of threads.
+  std::vector<std::vector<MeasurementPoint>> rows(size_t(r.height));
+  std::atomic<uint64_t> truncated{0};
+  parallel_for(size_t(r.height), 1, [&](size_t begin, size_t end) {
+    PixelOutput out;
+    for (size_t y = begin; y < end; ++y) {
+      out.points.clear();
+      for (int x = 0; x < r.width; ++x) {
+        const uint32_t pixel = uint32_t(y * size_t(r.width) + size_t(x));
+        out.emission = dvec3(0.0);
+        trace_pixel(world, camera, max_depth, pixel, x, int(y), out);
+        r.emission[pixel] = out.emission;
+      }
+      rows[y] = out.points;
+    }
+    truncated += out.truncated;
+  });
+  r.truncated_paths = truncated.load();
+
+  size_t total = 0;
+  for (const auto& row : rows) total += row.size();
+  r.points.reserve(total);
+  r.pixel_begin.assign(pixels + 1, 0);
+  for (auto& row : rows) {
+    for (const MeasurementPoint& p : row) {
+      r.points.push_back(p);
+      ++r.pixel_begin[p.pixel + 1];
+    }
+    std::vector<MeasurementPoint>().swap(row);
+  }
+  for (size_t p = 0; p < pixels; ++p) r.pixel_begin[p + 1] += r.pixel_begin[p];
+  return r;
+}
+
+}  // namespace pb

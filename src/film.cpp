@@ -1,0 +1,111 @@
+#include "photonbound/film.h"
+
+#include "photonbound/parallel.h"
+
+#include <cmath>
+#include <limits>
+
+namespace pb {
+
+namespace {
+
+struct PixelResult {
+  dvec3 radiance{0.0}, bias{0.0}, variance{0.0};
+  double photons = 0.0;
+  float radius = 0.0f;
+  bool has_points = false;
+  bool known = true;
+};
+
+// L_pix = Le_seen + sum_k W_k L_k; B_pix = sum_k W_k B_k; Var_pix = sum_k W_k^2 S_k^2 / i
+// (ESTIMATOR.md section 5).
+PixelResult combine(const EyePassResult& eye, const std::vector<PointState>& states, size_t pixel,
+                    uint64_t passes, double photons_per_pass) {
+  PixelResult r;
+  r.radiance = eye.emission[pixel];
+  for (uint32_t k = eye.pixel_begin[pixel]; k < eye.pixel_begin[pixel + 1]; ++k) {
+    const dvec3 w(eye.points[k].weight);
+    const PointEstimate e = estimate(states[k], passes, photons_per_pass);
+    r.radiance += w * e.radiance;
+    r.bias += w * e.bias;
+    r.variance += w * w * e.variance;
+    r.photons += double(states[k].photons);
+    if (!r.has_points) r.radius = float(std::sqrt(states[k].r2));
+    r.has_points = true;
+    r.known = r.known && e.known;
+  }
+  return r;
+}
+
+}  // namespace
+
+FilmSummary develop(const EyePassResult& eye, const std::vector<PointState>& states,
+                    uint64_t passes, const FilmSettings& s, FilmImage* image) {
+  const size_t pixels = size_t(eye.width) * size_t(eye.height);
+  std::vector<PixelResult> results(pixels);
+  parallel_for(pixels, 1024, [&](size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p)
+      results[p] = combine(eye, states, p, passes, s.photons_per_pass);
+  });
+
+  // No bound exists before two passes (nu = i - 1 >= 1).
+  const double t = passes >= 2 ? student_t_quantile(double(passes - 1), 0.5 + 0.5 * s.confidence)
+                               : std::numeric_limits<double>::infinity();
+  FilmSummary sum;
+  double mean_radiance = 0.0;
+  for (const PixelResult& r : results) mean_radiance += (r.radiance.x + r.radiance.y + r.radiance.z);
+  mean_radiance /= 3.0 * double(std::max<size_t>(pixels, 1));
+  sum.relative_floor = kRelativeFloor * mean_radiance;
+
+  if (image) {
+    image->width = eye.width;
+    image->height = eye.height;
+    for (auto* v : {&image->radiance, &image->bound, &image->bias, &image->noise, &image->variance})
+      v->assign(3 * pixels, 0.0f);
+    image->photons.assign(pixels, 0.0f);
+    image->radius.assign(pixels, 0.0f);
+  }
+
+  double bound_sum = 0.0, noise_sum = 0.0, bias_sum = 0.0;
+  uint64_t known = 0, below = 0;
+  for (size_t p = 0; p < pixels; ++p) {
+    const PixelResult& r = results[p];
+    const bool known_pixel = !r.has_points || (passes >= 2 && r.known);
+    dvec3 noise(0.0), bound(std::numeric_limits<double>::infinity());
+    if (known_pixel) {
+      // Pixels without points see only background or exact emission: bound 0.
+      noise = r.has_points ? t * glm::sqrt(r.variance) : dvec3(0.0);
+      bound = noise + glm::abs(r.bias);
+      dvec3 metric = bound;
+      if (s.metric == ErrorMetric::Relative)
+        metric = bound / glm::max(r.radiance, dvec3(std::max(sum.relative_floor, 1e-300)));
+      bound_sum += metric.x + metric.y + metric.z;
+      noise_sum += noise.x + noise.y + noise.z;
+      bias_sum += std::fabs(r.bias.x) + std::fabs(r.bias.y) + std::fabs(r.bias.z);
+      ++known;
+      if (s.target > 0.0 && max_component(metric) <= s.target) ++below;
+    } else {
+      ++sum.unknown_pixels;
+    }
+    if (image) {
+      for (int c = 0; c < 3; ++c) {
+        image->radiance[3 * p + c] = float(r.radiance[c]);
+        image->bound[3 * p + c] = float(bound[c]);
+        image->bias[3 * p + c] = float(r.bias[c]);
+        image->noise[3 * p + c] = known_pixel ? float(noise[c]) : INFINITY;
+        image->variance[3 * p + c] = float(r.variance[c]);
+      }
+      image->photons[p] = float(r.photons);
+      image->radius[p] = r.radius;
+    }
+  }
+  if (known > 0) {
+    sum.mean_bound = bound_sum / (3.0 * double(known));
+    sum.mean_noise = noise_sum / (3.0 * double(known));
+    sum.mean_abs_bias = bias_sum / (3.0 * double(known));
+    sum.below_target = double(below) / double(known);
+  }
+  return sum;
+}
+
+}  // namespace pb

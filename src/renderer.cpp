@@ -1,0 +1,190 @@
+#include "photonbound/renderer.h"
+
+#include "photonbound/gather.h"
+#include "photonbound/parallel.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <sstream>
+
+namespace pb {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+// Default initial radius: this many pixel footprints (median over measurement points).
+constexpr double kFootprintsPerRadius = 4.0;
+// R is clamped from below at this fraction of the scene size (ESTIMATOR.md section 8): far
+// below it float positions cannot resolve the distance test anyway.
+constexpr double kMinRadiusFraction = 1e-6;
+
+std::string format_count(double v) {
+  char buf[32];
+  if (v >= 1e9) std::snprintf(buf, sizeof buf, "%.2fG", v / 1e9);
+  else if (v >= 1e6) std::snprintf(buf, sizeof buf, "%.2fM", v / 1e6);
+  else if (v >= 1e3) std::snprintf(buf, sizeof buf, "%.1fk", v / 1e3);
+  else std::snprintf(buf, sizeof buf, "%.0f", v);
+  return buf;
+}
+
+}  // namespace
+
+PinholeCamera choose_camera(const Scene& scene, const RenderOptions& o) {
+  const Camera* cam = nullptr;
+  for (const Camera& c : scene.cameras) {
+    if (o.camera.empty() || c.name == o.camera) {
+      cam = &c;
+      break;
+    }
+  }
+  if (!cam) throw UsageError("--camera: " + scene.source + " has no perspective camera named '" + o.camera + "'");
+  int w = 512, h = 512;
+  if (o.width && o.height) {
+    w = *o.width;
+    h = *o.height;
+  } else {
+    const float aspect = cam->aspect.value_or(1.0f);
+    h = std::clamp(int(std::lround(512.0f / aspect)), 1, 16384);
+  }
+  return PinholeCamera(*cam, w, h);
+}
+
+Renderer::Renderer(const Scene& scene, const RenderOptions& options)
+    : options_(options),
+      world_(scene),
+      camera_(choose_camera(scene, options)),
+      tracer_(world_, options.direct == DirectMode::Photons) {
+  eye_ = run_eye_pass(world_, camera_, options_.max_depth);
+  params_.alpha = options_.alpha;
+  params_.photons_per_pass = double(options_.photons_per_pass);
+  const double r_min = kMinRadiusFraction * world_.scene_size();
+  params_.min_r2 = r_min * r_min;
+  const double r0 = std::max(options_.radius ? *options_.radius : default_radius(), r_min);
+  PointState initial;
+  initial.r2 = r0 * r0;
+  states_.assign(eye_.points.size(), initial);
+  radii_.resize(eye_.points.size());
+}
+
+double Renderer::default_radius() const {
+  if (eye_.points.empty()) return 0.01 * world_.scene_size();
+  std::vector<float> f(eye_.points.size());
+  for (size_t k = 0; k < f.size(); ++k) f[k] = eye_.points[k].footprint;
+  std::nth_element(f.begin(), f.begin() + f.size() / 2, f.end());
+  const double r = kFootprintsPerRadius * f[f.size() / 2];
+  return r > 0.0 && std::isfinite(r) ? r : 0.01 * world_.scene_size();
+}
+
+FilmSettings Renderer::film_settings() const {
+  FilmSettings s;
+  s.photons_per_pass = double(options_.photons_per_pass);
+  s.confidence = options_.confidence;
+  s.metric = options_.metric;
+  s.target = options_.target_error.value_or(0.0);
+  return s;
+}
+
+void Renderer::run_pass(uint64_t pass, RenderReport& report) {
+  const PhotonPassStats stats = tracer_.run(options_.seed, pass, options_.photons_per_pass, hits_);
+  report.rays += stats.rays;
+  report.photons += stats.paths;
+
+  const size_t n = states_.size();
+  if (n == 0) return;
+  hit_positions_.resize(hits_.size());
+  for (size_t k = 0; k < hits_.size(); ++k) hit_positions_[k] = hits_[k].position;
+  for (size_t k = 0; k < n; ++k) radii_[k] = float(std::sqrt(states_[k].r2));
+  grid_.build(hit_positions_, radii_);
+
+  const bool nee = options_.direct == DirectMode::NextEvent;
+  parallel_for(n, 256, [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) {
+      PassGather g;
+      gather_photons(eye_.points[k], states_[k].r2, grid_, hits_, g);
+      if (nee) {
+        Rng rng(options_.seed, pass, k, Stream::DirectLight);
+        g.direct = direct_light(world_, eye_.points[k], rng);
+      }
+      accumulate_pass(states_[k], g, params_, pass);
+    }
+  });
+}
+
+RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress) {
+  RenderReport report;
+  report.initial_radius = states_.empty() ? 0.0 : std::sqrt(states_[0].r2);
+  const FilmSettings settings = film_settings();
+  const auto t0 = Clock::now();
+  double last_print = -1.0;
+  uint64_t next_check = options_.min_passes;
+  // (pass, mean bound) at an earlier check, for the time-left estimate.
+  uint64_t early_pass = 0;
+  double early_bound = 0.0;
+
+  for (uint64_t pass = 1;; ++pass) {
+    run_pass(pass, report);
+    report.passes = pass;
+    report.seconds = seconds_since(t0);
+
+    const bool check = options_.target_error && pass >= next_check;
+    const bool want_progress = progress && report.seconds - last_print >= 0.5;
+    if (check || want_progress) report.summary = develop(eye_, states_, pass, settings, nullptr);
+    if (check) {
+      // Sparse schedule (ESTIMATOR.md section 7): checks about 10% apart in pass count, so the
+      // criterion is not retried after every pass (optional stopping).
+      next_check = pass + std::max<uint64_t>(1, pass / 10);
+      if (early_pass == 0 || pass >= 2 * early_pass) {
+        early_pass = pass;
+        early_bound = report.summary.mean_bound;
+      }
+    }
+
+    if (options_.passes && pass >= *options_.passes) report.stop_reason = "passes";
+    if (options_.time_seconds && report.seconds >= *options_.time_seconds) report.stop_reason = "time";
+    if (check && report.summary.mean_bound <= *options_.target_error) report.stop_reason = "target-error";
+    if (check && options_.alpha >= 1.0 && options_.metric == ErrorMetric::Absolute &&
+        report.summary.mean_abs_bias >= *options_.target_error)
+      report.stop_reason = "unreachable: alpha = 1 keeps the bias above the target";
+    if (stop && stop->load()) report.stop_reason = "interrupted";
+
+    if (want_progress || (progress && !report.stop_reason.empty())) {
+      last_print = report.seconds;
+      const FilmSummary& s = report.summary;
+      std::ostringstream line;
+      line.precision(4);
+      line << "pass " << pass << " | " << format_count(double(report.photons)) << " photons";
+      if (pass >= 2) {
+        line << " | bound " << s.mean_bound;
+        if (options_.target_error) line << " | " << int(100.0 * s.below_target) << "% below target";
+        line << " | " << s.unknown_pixels << " unknown";
+      }
+      line << " | " << report.seconds << " s";
+      // Time left: the smallest of what the stop conditions imply; the target's from the
+      // observed power-law decay of the mean bound since an earlier check.
+      const double per_pass = report.seconds / double(pass);
+      double left = INFINITY;
+      if (options_.passes) left = std::min(left, double(*options_.passes - pass) * per_pass);
+      if (options_.time_seconds) left = std::min(left, *options_.time_seconds - report.seconds);
+      if (options_.target_error && early_pass > 0 && pass > early_pass &&
+          s.mean_bound < early_bound && s.mean_bound > *options_.target_error) {
+        const double k = std::log(early_bound / s.mean_bound) / std::log(double(pass) / early_pass);
+        const double needed = double(pass) * std::pow(s.mean_bound / *options_.target_error, 1.0 / k);
+        left = std::min(left, (needed - double(pass)) * per_pass);
+      }
+      if (std::isfinite(left)) line << " | ~" << std::max(0.0, left) << " s left";
+      *progress << line.str() << std::endl;
+    }
+    if (!report.stop_reason.empty()) break;
+  }
+  report.summary = develop(eye_, states_, report.passes, settings, nullptr);
+  return report;
+}
+
+}  // namespace pb
