@@ -91,10 +91,11 @@ FilmSettings Renderer::film_settings() const {
   return s;
 }
 
-void Renderer::run_pass(uint64_t pass, RenderReport& report) {
+void Renderer::step() {
+  const uint64_t pass = ++passes_;
   const PhotonPassStats stats = tracer_.run(options_.seed, pass, options_.photons_per_pass, hits_);
-  report.rays += stats.rays;
-  report.photons += stats.paths;
+  rays_ += stats.rays;
+  photons_ += stats.paths;
 
   const size_t n = states_.size();
   if (n == 0) return;
@@ -128,9 +129,12 @@ RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress
   uint64_t early_pass = 0;
   double early_bound = 0.0;
 
-  for (uint64_t pass = 1;; ++pass) {
-    run_pass(pass, report);
+  for (;;) {
+    step();
+    const uint64_t pass = passes_;
     report.passes = pass;
+    report.photons = photons_;
+    report.rays = rays_;
     report.seconds = seconds_since(t0);
 
     const bool check = options_.target_error && pass >= next_check;

@@ -40,6 +40,10 @@ class Renderer {
   // `progress` when it is not null.
   RenderReport run(const std::atomic<bool>* stop, std::ostream* progress);
 
+  // Runs one more pass (pass number passes() + 1).
+  void step();
+  uint64_t passes() const { return passes_; }
+
   // Radiance, bound channels and metadata, ready for write_exr.
   ExrImage image(const RenderReport& report) const;
 
@@ -48,7 +52,7 @@ class Renderer {
   FilmSettings film_settings() const;
 
  private:
-  void run_pass(uint64_t pass, RenderReport& report);
+
   double default_radius() const;
 
   const RenderOptions options_;
@@ -62,6 +66,9 @@ class Renderer {
   std::vector<PhotonHit> hits_;
   std::vector<vec3> hit_positions_;
   std::vector<float> radii_;
+  uint64_t passes_ = 0;
+  uint64_t photons_ = 0;  // emitted so far
+  uint64_t rays_ = 0;     // photon-pass rays so far
 };
 
 }  // namespace pb

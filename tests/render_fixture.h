@@ -1,0 +1,45 @@
+// Shared helpers for tests that render the shipped scenes in-process.
+#pragma once
+
+#include "photonbound/gltf_loader.h"
+#include "photonbound/renderer.h"
+
+#include <string>
+
+namespace pb::test {
+
+inline std::string scene_path(const std::string& name) {
+  return std::string(PHOTONBOUND_SCENES) + "/" + name;
+}
+
+inline RenderOptions quick_options(const std::string& scene, int size, uint64_t passes) {
+  RenderOptions o;
+  o.scene = scene_path(scene);
+  o.output = "unused.exr";
+  o.width = size;
+  o.height = size;
+  o.passes = passes;
+  o.progress = ProgressMode::Never;
+  return o;
+}
+
+// Mean over the measurement points of |L - L_exact| / L_exact, for points accepted by `use`.
+// exact(position) gives the analytic radiance (grey: all channels equal).
+template <class Exact, class Use>
+double mean_relative_error(const Renderer& r, uint64_t passes, Exact&& exact, Use&& use) {
+  double sum = 0.0;
+  size_t n = 0;
+  const FilmSettings s = r.film_settings();
+  for (size_t k = 0; k < r.eye().points.size(); ++k) {
+    const MeasurementPoint& p = r.eye().points[k];
+    if (!use(p.position)) continue;
+    const double truth = exact(p.position);
+    const dvec3 l = r.eye().emission[p.pixel] +
+                    dvec3(p.weight) * estimate(r.states()[k], passes, s.photons_per_pass).radiance;
+    for (int c = 0; c < 3; ++c) sum += std::fabs(l[c] - truth) / truth;
+    n += 3;
+  }
+  return n ? sum / double(n) : INFINITY;
+}
+
+}  // namespace pb::test
