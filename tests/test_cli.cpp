@@ -1,0 +1,142 @@
+// The command line as a user meets it: exit codes (0 done, 1 failure, 2 usage), one-line
+// messages, and no output file after any failure.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int code = -1;
+  std::string err;  // stderr
+};
+
+std::string quote(const std::string& s) {
+  std::string q = "'";
+  for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
+  return q + "'";
+}
+
+Outcome run(const std::string& args) {
+  const std::string cmd = std::string(PHOTONBOUND_EXE) + " " + args + " 2>&1 >/dev/null";
+  Outcome r;
+  FILE* pipe = popen(cmd.c_str(), "r");
+  if (!pipe) return r;
+  std::array<char, 4096> buf{};
+  while (fgets(buf.data(), int(buf.size()), pipe)) r.err += buf.data();
+  const int status = pclose(pipe);
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return r;
+}
+
+std::string scene(const std::string& name) { return std::string(PHOTONBOUND_SCENES) + "/" + name; }
+
+class Cli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() /
+           ("pb_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string out() const { return (dir_ / "out.exr").string(); }
+  // Nothing at all may be left in the output folder after a failure (no temporary either).
+  bool folder_empty() const { return fs::is_empty(dir_); }
+  fs::path dir_;
+};
+
+void expect_one_line(const Outcome& r) {
+  ASSERT_FALSE(r.err.empty());
+  EXPECT_EQ(r.err.find('\n'), r.err.size() - 1) << r.err;
+}
+
+TEST_F(Cli, HelpAndVersion) {
+  EXPECT_EQ(run("--help").code, 0);
+  EXPECT_EQ(run("--version").code, 0);
+}
+
+TEST_F(Cli, RendersAndWritesOnlyTheImage) {
+  const Outcome r = run("render " + quote(scene("cornell.gltf")) + " -o " + quote(out()) +
+                    " --passes 2 --resolution 16x16 --photons-per-pass 2000 --quiet");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_TRUE(fs::exists(out()));
+  EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
+}
+
+TEST_F(Cli, BadOptionValuesExitWithUsageError) {
+  const std::string base = "render " + quote(scene("cornell.gltf")) + " -o " + quote(out()) + " --passes 1 ";
+  const char* bad[] = {
+      "--alpha 0",        "--alpha 1.5",        "--alpha nan",       "--alpha abc",
+      "--alpha ''",       "--alpha -0.5",       "--alpha inf",       "--passes 0",
+      "--passes -3",      "--passes 2.5",       "--passes 99999999999999999999999",
+      "--time 0",         "--time -1",          "--time nan",        "--photons-per-pass 0",
+      "--radius 0",       "--radius -1",        "--max-depth 33",    "--resolution 0x10",
+      "--resolution 10",  "--resolution axb",   "--resolution 10x",  "--threads -1",
+      "--seed -1",        "--direct foo",       "--confidence 0",    "--confidence 1",
+      "--min-passes 1",   "--error-metric foo", "--target-error 0",  "--target-error -1",
+      "--camera ''",      "--bogus",            "--alpha",           "extra.gltf",
+  };
+  for (const char* b : bad) {
+    const Outcome r = run(base + b);
+    EXPECT_EQ(r.code, 2) << b << ": " << r.err;
+    expect_one_line(r);
+  }
+  EXPECT_TRUE(folder_empty());
+}
+
+TEST_F(Cli, MissingStopConditionAndArguments) {
+  EXPECT_EQ(run("render " + quote(scene("cornell.gltf")) + " -o " + quote(out())).code, 2);
+  EXPECT_EQ(run("render -o " + quote(out()) + " --passes 1").code, 2);
+  EXPECT_EQ(run("render " + quote(scene("cornell.gltf")) + " --passes 1").code, 2);
+  EXPECT_EQ(run("").code, 2);
+  EXPECT_EQ(run("frobnicate").code, 2);
+  EXPECT_TRUE(folder_empty());
+}
+
+TEST_F(Cli, BadSceneFilesFailWithTheirNameAndNoOutput) {
+  const std::string missing = (dir_ / "missing.gltf").string();
+  Outcome r = run("render " + quote(missing) + " -o " + quote(out()) + " --passes 1");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("missing.gltf"), std::string::npos) << r.err;
+  expect_one_line(r);
+
+  const std::string broken = (dir_ / "broken.gltf").string();
+  std::ofstream(broken) << "{ \"asset\": { \"version\": \"2.0\" }, \"meshes\": [ ";
+  r = run("render " + quote(broken) + " -o " + quote(out()) + " --passes 1");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("broken.gltf"), std::string::npos) << r.err;
+  expect_one_line(r);
+  fs::remove(broken);
+  EXPECT_TRUE(folder_empty());
+}
+
+TEST_F(Cli, UnknownCameraIsAUsageError) {
+  const Outcome r = run("render " + quote(scene("cornell.gltf")) + " -o " + quote(out()) +
+                    " --passes 1 --camera nosuchcamera");
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("nosuchcamera"), std::string::npos);
+  EXPECT_TRUE(folder_empty());
+}
+
+TEST_F(Cli, UnwritableOutputFailsBeforeRendering) {
+  const std::string bad = (dir_ / "no" / "such" / "dir" / "out.exr").string();
+  Outcome r = run("render " + quote(scene("cornell.gltf")) + " -o " + quote(bad) + " --passes 1");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("out.exr"), std::string::npos) << r.err;
+  expect_one_line(r);
+  r = run("render " + quote(scene("cornell.gltf")) + " -o " + quote(dir_.string()) + " --passes 1");
+  EXPECT_EQ(r.code, 1);
+  expect_one_line(r);
+  EXPECT_TRUE(folder_empty());
+}
+
+}  // namespace
