@@ -29,7 +29,6 @@ int table_bits(size_t n) {
 // every radius maps to level 0 and exactly one level is built.
 void HashGrid::build(std::span<const vec3> positions, std::span<const float> radii) {
   // Validate everything before touching state, so a throw leaves the previous grid usable.
-  if (radii.empty()) throw std::invalid_argument("HashGrid::build: no query radii given");
   float r_min = std::numeric_limits<float>::infinity(), r_max = 0.0f;
   for (const float r : radii) {
     if (!(r > 0.0f) || !std::isfinite(r))
@@ -52,7 +51,7 @@ void HashGrid::build(std::span<const vec3> positions, std::span<const float> rad
   r_min_ = r_min;
   level_count_ = 0;
   level_map_.clear();
-  if (n == 0) return;
+  if (n == 0 || radii.empty()) return;
 
   // Mark the levels the radii use; build those, in ascending k, into slots 0, 1, ...
   const int top = level_of(r_max, r_min);

@@ -58,15 +58,14 @@ size_t check_query(const HashGrid& grid, const std::vector<vec3>& pts, const Que
     if (HashGrid::distance2(pts[i], q.center) < r2) want.push_back(uint32_t(i));
   std::sort(got.begin(), got.end());
   EXPECT_EQ(std::adjacent_find(got.begin(), got.end()), got.end())
-      << "photon visited twice; centre (" << q.center.x << ", " << q.center.y << ", "
-      << q.center.z << ") r " << q.radius;
+      << "photon visited twice; centre (" << q.center.x << ", " << q.center.y << ", " << q.center.z
+      << ") r " << q.radius;
   EXPECT_EQ(got, want) << "centre (" << q.center.x << ", " << q.center.y << ", " << q.center.z
                        << ") r " << q.radius;
   return want.size();
 }
 
-size_t check_all(const HashGrid& grid, const std::vector<vec3>& pts,
-                 const std::vector<Query>& qs) {
+size_t check_all(const HashGrid& grid, const std::vector<vec3>& pts, const std::vector<Query>& qs) {
   size_t total = 0;
   for (const Query& q : qs) total += check_query(grid, pts, q);
   return total;
@@ -118,7 +117,7 @@ TEST(HashGrid, BoundariesOutsideAndNegativeCoordinates) {
   for (float a : {-1.0f, -0.25f, 0.0f, 0.125f, 0.25f, 1.0f, 1.05f, 1.124f, 1.125f, 1.2f})
     for (float b : {-1.0f, 0.0f, 0.375f})
       for (float c : {-1.0f, 0.5f, 1.1f}) qs.push_back({vec3(a, b, c), r});  // faces, outside
-  qs.push_back({vec3(100.0f, 0.0f, 0.0f), r});  // far outside
+  qs.push_back({vec3(100.0f, 0.0f, 0.0f), r});                               // far outside
   qs.push_back({vec3(-1e30f, 1e30f, 0.0f), r});
   for (size_t i = 0; i < 1000; ++i) {
     Rng rng(6, 0, i, Stream::Test);
@@ -248,7 +247,6 @@ TEST(HashGrid, InvalidInputThrows) {
     const std::vector<float> radii = {0.1f, bad, 0.2f};
     EXPECT_THROW(grid.build(pts, radii), std::invalid_argument) << bad;
   }
-  EXPECT_THROW(grid.build(pts, std::span<const float>()), std::invalid_argument);
   const std::vector<vec3> bad_pts = {vec3(0.0f), vec3(nan, 0.0f, 0.0f)};
   EXPECT_THROW(grid.build(bad_pts, good), std::invalid_argument);
   // The failed builds left the previous grid intact.
@@ -261,7 +259,7 @@ TEST(HashGrid, InvalidInputThrows) {
   grid.query(vec3(nan), 0.1f, [&](uint32_t, float) { ADD_FAILURE() << "visited NaN centre"; });
 }
 
-TEST(HashGrid, EmptyPhotonSet) {
+TEST(HashGrid, EmptyPhotonSetOrNoRadii) {
   HashGrid grid;
   const std::vector<float> radii = {0.1f, 1.0f};
   grid.build(std::span<const vec3>(), radii);
@@ -279,6 +277,16 @@ TEST(HashGrid, EmptyPhotonSet) {
   EXPECT_EQ(count, 1u);
   grid.build(std::span<const vec3>(), radii);  // back to empty after a non-empty build
   grid.query(vec3(0.0f), 1.0f, [&](uint32_t, float) { ADD_FAILURE() << "visited after rebuild"; });
+
+  // No radii (no measurement points this pass): no levels, queries visit nothing, no throw.
+  grid.build(pts, std::span<const float>());
+  EXPECT_EQ(grid.level_count(), 0);
+  EXPECT_EQ(grid.photon_count(), 1u);
+  grid.query(vec3(0.0f), 1.0f, [&](uint32_t, float) { ADD_FAILURE() << "visited, no radii"; });
+  grid.build(pts, radii);  // and back
+  count = 0;
+  grid.query(vec3(0.0f), 1.0f, [&](uint32_t, float) { ++count; });
+  EXPECT_EQ(count, 1u);
 }
 
 }  // namespace

@@ -30,11 +30,11 @@ namespace pb {
 class HashGrid {
  public:
   // Builds over `positions` for queries whose radii are `radii` (every radius queries will use;
-  // duplicates are fine). Throws std::invalid_argument when radii is empty or holds a value that
-  // is not finite and > 0, or when a position is not finite; std::length_error beyond 2^31
-  // photons. On a throw the grid is unchanged. Empty positions give a grid whose queries visit
-  // nothing. Vectors are reused across builds (cleared, never freed), so once warm a rebuild of
-  // the same size does not allocate.
+  // duplicates are fine). Throws std::invalid_argument when a radius is not finite and > 0 or a
+  // position is not finite; std::length_error beyond 2^31 photons. On a throw the grid is
+  // unchanged. Empty positions, or empty radii (no queries expected, e.g. no measurement
+  // points), give a grid whose queries visit nothing. Vectors are reused across builds
+  // (cleared, never freed), so once warm a rebuild of the same size does not allocate.
   void build(std::span<const vec3> positions, std::span<const float> radii);
 
   // Calls visit(uint32_t photon_index, float dist2) once for every photon with
@@ -48,7 +48,7 @@ class HashGrid {
 
   // Heap bytes held (capacities, including vectors kept for reuse).
   size_t memory_bytes() const;
-  // Levels built by the last build (0 when it had no photons).
+  // Levels built by the last build (0 when it had no photons or no radii).
   int level_count() const { return level_count_; }
   size_t photon_count() const { return photon_count_; }
 
@@ -122,8 +122,7 @@ class HashGrid {
 
 template <class Visit>
 void HashGrid::query(const vec3& center, float radius, Visit&& visit) const {
-  if (photon_count_ == 0 || !(radius > 0.0f) || !std::isfinite(radius) || !is_finite(center))
-    return;
+  if (level_count_ == 0 || !(radius > 0.0f) || !std::isfinite(radius) || !is_finite(center)) return;
   // Radii above every build radius clamp to the top level; the cell loop below stays exact.
   const int k = std::min(level_of(radius, r_min_), int(level_map_.size()) - 1);
   const Level& lv = levels_[size_t(level_map_[size_t(k)])];
