@@ -1,5 +1,6 @@
 // photonbound command-line entry point. The only catch-all: maps failures to exit codes
 // (0 done, 1 runtime failure or bad input file, 2 bad usage).
+#include "photonbound/compare.h"
 #include "photonbound/gltf_loader.h"
 #include "photonbound/image_io.h"
 #include "photonbound/options.h"
@@ -48,6 +49,13 @@ int render(const pb::RenderOptions& options) {
   return 0;
 }
 
+int compare(const pb::CompareOptions& o) {
+  const pb::CompareResult r = pb::compare_images(pb::read_exr(o.render), pb::read_exr(o.reference),
+                                                 o.render, o.reference);
+  std::cout << (o.json ? pb::to_json(r) : pb::to_text(r));
+  return 0;
+}
+
 // sRGB-encoded PNG of the radiance channels, for quick looks and the README.
 int preview(const pb::PreviewOptions& o) {
   const pb::ExrImage in = pb::read_exr(o.input);
@@ -83,6 +91,8 @@ int main(int argc, char** argv) {
         return 0;
       case pb::Command::Kind::Render:
         return render(cmd.render);
+      case pb::Command::Kind::Compare:
+        return compare(cmd.compare);
       case pb::Command::Kind::Preview:
         return preview(cmd.preview);
     }

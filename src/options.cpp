@@ -143,6 +143,21 @@ PreviewOptions parse_preview(int argc, const char* const* argv, int first) {
   return o;
 }
 
+CompareOptions parse_compare(int argc, const char* const* argv, int first) {
+  CompareOptions o;
+  std::vector<std::string> files;
+  for (int k = first; k < argc; ++k) {
+    const std::string arg = argv[k];
+    if (arg == "--json") o.json = true;
+    else if (!arg.empty() && arg[0] == '-') fail("unknown option '" + arg + "' (see photonbound --help)");
+    else files.push_back(arg);
+  }
+  if (files.size() != 2) fail("compare: usage: photonbound compare RENDER.exr REFERENCE.exr [--json]");
+  o.render = files[0];
+  o.reference = files[1];
+  return o;
+}
+
 }  // namespace
 
 void validate(const RenderOptions& o) {
@@ -172,6 +187,9 @@ Command parse_command_line(int argc, const char* const* argv) {
   } else if (cmd == "render") {
     c.kind = Command::Kind::Render;
     c.render = parse_render(argc, argv, 2);
+  } else if (cmd == "compare") {
+    c.kind = Command::Kind::Compare;
+    c.compare = parse_compare(argc, argv, 2);
   } else if (cmd == "preview") {
     c.kind = Command::Kind::Preview;
     c.preview = parse_preview(argc, argv, 2);
@@ -186,6 +204,7 @@ std::string usage_text() {
 
 usage:
   photonbound render SCENE.gltf|.glb -o OUT.exr [options]
+  photonbound compare RENDER.exr REFERENCE.exr [--json]
   photonbound preview IN.exr -o OUT.png [--exposure STOPS]
   photonbound --help | --version
 

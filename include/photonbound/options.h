@@ -50,10 +50,17 @@ struct PreviewOptions {
   double exposure = 0.0;  // stops: radiance is scaled by 2^exposure before the sRGB curve
 };
 
+// photonbound compare RENDER.exr REFERENCE.exr [--json]
+struct CompareOptions {
+  std::string render, reference;
+  bool json = false;
+};
+
 struct Command {
-  enum class Kind { Help, Version, Render, Preview } kind = Kind::Help;
+  enum class Kind { Help, Version, Render, Preview, Compare } kind = Kind::Help;
   RenderOptions render;
   PreviewOptions preview;
+  CompareOptions compare;
 };
 
 // Parses argv. Throws UsageError with a one-line message for unknown flags, missing or bad
