@@ -1,0 +1,618 @@
+// The estimator of ESTIMATOR.md against independent computations: the kernel by quadrature,
+// the bias and Laplacian estimates on a quadratic field, and the per-point progressive state
+// (PPM update, streaming moments, retroactive bias correction, Student-t quantiles) against
+// direct recomputation from the recorded per-pass samples.
+#include "photonbound/estimator.h"
+#include "photonbound/kernel.h"
+#include "photonbound/rng.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <numbers>
+#include <vector>
+
+namespace pb {
+namespace {
+
+constexpr double kPi_ = std::numbers::pi;
+
+// ---------------------------------------------------------------------------------------------
+// Quadrature helpers
+
+// n-point Gauss-Legendre rule mapped to [0, 1] (nodes by Newton iteration on P_n). Exact for
+// polynomials of degree <= 2n - 1, so every radial integrand below (a polynomial of degree <= 9
+// in t on [0, 1]) is integrated to rounding with n = 16.
+struct GaussLegendre {
+  std::vector<double> x, w;
+  explicit GaussLegendre(int n) {
+    for (int k = 0; k < n; ++k) {
+      double z = std::cos(kPi_ * (k + 0.75) / (n + 0.5));
+      double dp = 0.0;
+      for (int it = 0; it < 100; ++it) {
+        double p0 = 1.0, p1 = z;
+        for (int m = 2; m <= n; ++m) {
+          const double p2 = ((2.0 * m - 1.0) * z * p1 - (m - 1.0) * p0) / m;
+          p0 = p1;
+          p1 = p2;
+        }
+        // p1 = P_n(z), p0 = P_{n-1}(z)
+        dp = n * (z * p1 - p0) / (z * z - 1.0);
+        const double dz = p1 / dp;
+        z -= dz;
+        if (std::fabs(dz) < 1e-16) break;
+      }
+      x.push_back(0.5 * (1.0 - z));
+      w.push_back(1.0 / ((1.0 - z * z) * dp * dp));  // (2/((1-z^2) P'^2)) * 1/2 for [0,1]
+    }
+  }
+};
+
+// Integral over the unit disk of a radial function g(t) times cos^2(theta)^p (p = 0 or 1):
+// 2 pi int_0^1 g(t) t dt  or  pi int_0^1 g(t) t dt.
+template <class F>
+double disk_integral_radial(const GaussLegendre& gl, F g) {
+  double s = 0.0;
+  for (size_t k = 0; k < gl.x.size(); ++k) s += gl.w[k] * g(gl.x[k]) * gl.x[k];
+  return 2.0 * kPi_ * s;
+}
+
+TEST(Kernel, GaussLegendreRuleIsSane) {
+  // The helper itself: int_0^1 t^k dt = 1/(k+1) for k <= 31 to rounding.
+  const GaussLegendre gl(16);
+  for (int k = 0; k <= 31; ++k) {
+    double s = 0.0;
+    for (size_t i = 0; i < gl.x.size(); ++i) s += gl.w[i] * std::pow(gl.x[i], k);
+    EXPECT_NEAR(s, 1.0 / (k + 1), 1e-14) << "k=" << k;
+  }
+}
+
+TEST(Kernel, UnitMassIntegratesToOne) {
+  // kappa is a quintic in t; with the 2 pi t Jacobian a degree-6 polynomial: Gauss-Legendre with
+  // 16 nodes is exact, so only rounding (~1e-15) remains.
+  const GaussLegendre gl(16);
+  EXPECT_NEAR(disk_integral_radial(gl, [](double t) { return kernel::unit_mass(t); }), 1.0, 1e-13);
+}
+
+TEST(Kernel, UnitLaplacianIntegratesToZero) {
+  // Degree-4 polynomial integrand: exact up to rounding. The scale of the integrand is
+  // int |lap_kappa| ~ 10, so 1e-12 is rounding-level.
+  const GaussLegendre gl(16);
+  EXPECT_NEAR(disk_integral_radial(gl, [](double t) { return kernel::unit_laplacian(t); }), 0.0,
+              1e-12);
+  // And it is not trivially zero: its absolute integral is of order 10.
+  const double abs_int =
+      disk_integral_radial(gl, [](double t) { return std::fabs(kernel::unit_laplacian(t)); });
+  EXPECT_GT(abs_int, 1.0);
+}
+
+TEST(Kernel, PerAxisSecondMomentIsFiveOver48) {
+  // int t_1^2 kappa dA = int_0^1 int_0^{2pi} t^2 cos^2(th) kappa(t) t dth dt
+  //                    = pi int_0^1 t^3 kappa(t) dt. Degree-8 polynomial: exact up to rounding.
+  const GaussLegendre gl(16);
+  double s = 0.0;
+  for (size_t k = 0; k < gl.x.size(); ++k) {
+    const double t = gl.x[k];
+    s += gl.w[k] * t * t * t * kernel::unit_mass(t);
+  }
+  const double k2 = kPi_ * s;
+  EXPECT_NEAR(k2, 5.0 / 48.0, 1e-14);
+  EXPECT_NEAR(kernel::kSecondMoment, 5.0 / 48.0, 1e-17);
+  EXPECT_NEAR(k2, kernel::kSecondMoment, 1e-14);
+}
+
+TEST(Kernel, SecondMomentByBruteForceGrid) {
+  // Independent of the polar reduction: a Cartesian midpoint grid on [-1,1]^2 (n = 2000). The
+  // integrand t1^2 kappa is C^2 across the rim (kappa vanishes with two derivatives), so the
+  // grid error is far below h^2 = 1e-6; 1e-6 is a safe bound.
+  const int n = 2000;
+  const double h = 2.0 / n;
+  double m0 = 0.0, m2 = 0.0;
+  for (int a = 0; a < n; ++a) {
+    const double x = -1.0 + (a + 0.5) * h;
+    for (int b = 0; b < n; ++b) {
+      const double y = -1.0 + (b + 0.5) * h;
+      const double k = kernel::unit_mass(std::sqrt(x * x + y * y));
+      m0 += k;
+      m2 += x * x * k;
+    }
+  }
+  EXPECT_NEAR(m0 * h * h, 1.0, 1e-6);
+  EXPECT_NEAR(m2 * h * h, 5.0 / 48.0, 1e-6);
+}
+
+TEST(Kernel, UnitLaplacianIsLaplacianOfUnitMass) {
+  // Radial Laplacian f'' + f'/t by central differences with step h = 1e-3. kappa is a quintic, so
+  // the FD errors are exactly h^2/12 kappa'''' (<= 401) and h^2/6 kappa''' (<= 67, divided by
+  // t >= 0.1): below 1e-6 * (34 + 112) < 2e-4. Rounding adds eps/h^2 ~ 1e-10.
+  const double h = 1e-3;
+  for (double t : {0.1, 0.25, 0.4, 0.5, 0.6, 0.75, 0.9, 0.97}) {
+    const double fm = kernel::unit_mass(t - h), f0 = kernel::unit_mass(t),
+                 fp = kernel::unit_mass(t + h);
+    const double d2 = (fp - 2.0 * f0 + fm) / (h * h);
+    const double d1 = (fp - fm) / (2.0 * h);
+    const double lap_fd = d2 + d1 / t;
+    EXPECT_NEAR(kernel::unit_laplacian(t), lap_fd, 2e-4) << "t=" << t;
+  }
+  // The closed form at a few points, 105/pi t(1-t)(5t-3).
+  for (double t : {0.0, 0.3, 0.6, 0.8, 0.999}) {
+    EXPECT_NEAR(kernel::unit_laplacian(t), 105.0 / kPi_ * t * (1 - t) * (5 * t - 3), 1e-12);
+  }
+  // At the centre the Laplacian of a radial function is 2 f''(0); f''(0) = 0 for this profile.
+  EXPECT_NEAR(kernel::unit_laplacian(0.0), 0.0, 1e-15);
+}
+
+TEST(Kernel, WeightsAreNormalisedLikeABoxKernel) {
+  for (int k = 0; k <= 100; ++k) {
+    const double t = k / 100.0;
+    EXPECT_NEAR(kernel::weight(t), kPi_ * kernel::unit_mass(t), 1e-14) << t;
+    EXPECT_NEAR(kernel::laplacian_weight_r2(t), kPi_ * kernel::unit_laplacian(t), 1e-12) << t;
+  }
+  EXPECT_NEAR(kernel::weight(0.0), 3.5, 1e-15);
+  for (double t : {1.0, 1.0 + 1e-9, 1.5, 10.0}) {
+    EXPECT_EQ(kernel::profile(t), 0.0);
+    EXPECT_EQ(kernel::weight(t), 0.0);
+    EXPECT_EQ(kernel::unit_mass(t), 0.0);
+    EXPECT_EQ(kernel::unit_laplacian(t), 0.0);
+    EXPECT_EQ(kernel::laplacian_weight_r2(t), 0.0);
+  }
+}
+
+TEST(Kernel, ProfileAndTwoDerivativesVanishAtRim) {
+  // Near the rim k(1 - h) = 10 h^3 - 15 h^4 + 6 h^5 (k'(1) = k''(1) = 0, k'''(1) = -60), and
+  // k = 0 outside. Central differences across t = 1 therefore give k' ~ -5 h^2 and k'' ~ 10 h; a
+  // kernel with k'(1) or k''(1) != 0 would give O(1) values. Bounds: twice the exact FD values.
+  EXPECT_EQ(kernel::profile(1.0), 0.0);
+  for (double h : {1e-2, 1e-3, 1e-4}) {
+    const double km = kernel::profile(1.0 - h), k0 = kernel::profile(1.0),
+                 kp = kernel::profile(1.0 + h);
+    EXPECT_NEAR(km, 10.0 * h * h * h, 15.0 * h * h * h * h + 1e-14) << "h=" << h;
+    const double d1 = (kp - km) / (2.0 * h);
+    const double d2 = (kp - 2.0 * k0 + km) / (h * h);
+    EXPECT_LE(std::fabs(d1), 10.0 * h * h + 1e-12) << "h=" << h;
+    EXPECT_LE(std::fabs(d2), 20.0 * h + 1e-9) << "h=" << h;
+    // One-sided from inside: (k(1) - k(1-h))/h = -10 h^2, second difference 60 h.
+    const double km2 = kernel::profile(1.0 - 2.0 * h);
+    EXPECT_LE(std::fabs((k0 - km) / h), 20.0 * h * h + 1e-12);
+    EXPECT_LE(std::fabs((k0 - 2.0 * km + km2) / (h * h)), 120.0 * h + 1e-9);
+  }
+  // The interior scale for comparison: k' reaches -1.875 at t = 1/2.
+  EXPECT_NEAR((kernel::profile(0.5 + 1e-5) - kernel::profile(0.5 - 1e-5)) / 2e-5, -1.875, 1e-6);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Quadratic field (ESTIMATOR.md section 9)
+
+struct Quadratic {
+  double c = 2.0;
+  double gx = 0.7, gy = -1.3;
+  double hxx = 1.2, hxy = 0.5, hyy = -0.4;  // non-diagonal, trace 0.8
+  double operator()(double x, double y) const {
+    return c + gx * x + gy * y + 0.5 * (hxx * x * x + 2.0 * hxy * x * y + hyy * y * y);
+  }
+  double trace() const { return hxx + hyy; }
+};
+
+TEST(KernelEstimate, QuadraticFieldBiasAndLaplacianPolarQuadrature) {
+  // Continuum limit of the photon estimate with unit-density photons:
+  //   E = int w(|y|/R) f(y) dA / (pi R^2),  Lap = int w_lap_r2(|y|/R)/R^2 f(y) dA / (pi R^2).
+  // Polar product rule: Gauss-Legendre (16) in t, trapezoid (16) in theta. The integrand is a
+  // polynomial of degree <= 9 in t and a trigonometric polynomial of degree 2 in theta, both
+  // integrated exactly, so only rounding remains (relative 1e-12).
+  const Quadratic f;
+  const GaussLegendre gl(16);
+  const int nth = 16;
+  for (double R : {0.3, 1.7}) {
+    double e = 0.0, lap = 0.0;
+    for (size_t k = 0; k < gl.x.size(); ++k) {
+      const double t = gl.x[k];
+      for (int m = 0; m < nth; ++m) {
+        const double th = 2.0 * kPi_ * (m + 0.25) / nth;
+        const double fy = f(R * t * std::cos(th), R * t * std::sin(th));
+        const double dA = gl.w[k] * (2.0 * kPi_ / nth) * R * R * t;
+        e += kernel::weight(t) * fy * dA;
+        lap += kernel::laplacian_weight_r2(t) / (R * R) * fy * dA;
+      }
+    }
+    e /= kPi_ * R * R;
+    lap /= kPi_ * R * R;
+    const double bias = e - f(0.0, 0.0);
+    const double expected = 5.0 / 96.0 * R * R * f.trace();
+    EXPECT_NEAR(expected, 0.5 * kernel::kSecondMoment * R * R * f.trace(), 1e-15);
+    EXPECT_NEAR(bias, expected, 1e-12 * std::fabs(e)) << "R=" << R;
+    EXPECT_NEAR(lap, f.trace(), 1e-11) << "R=" << R;
+  }
+}
+
+TEST(KernelEstimate, QuadraticFieldBiasAndLaplacianPhotonGrid) {
+  // The same continuum limit as a literal photon sum: unit-density "photons" on a midpoint grid
+  // (n x n over the disk's bounding square, h = 2R/n, each carrying area h^2). The value kernel
+  // is C^2 across the rim, so the lattice error is tiny: measured 5.6e-11 (R = 0.3) and 2.1e-12
+  // (R = 1.7) relative to the bias at n = 1200; tolerance 1e-6 of the bias. The Laplacian kernel
+  // is only C^0 at the rim (slope -210), so its lattice error is larger: measured 3.2e-5 and
+  // 1.3e-6 relative to trace(H) (1.4e-4 at n = 300); tolerance 5e-4. A kernel or normalisation
+  // mistake changes either result by O(1).
+  const Quadratic f;
+  const int n = 1200;
+  for (double R : {0.3, 1.7}) {
+    const double h = 2.0 * R / n;
+    double e = 0.0, lap = 0.0;
+    for (int a = 0; a < n; ++a) {
+      const double x = -R + (a + 0.5) * h;
+      for (int b = 0; b < n; ++b) {
+        const double y = -R + (b + 0.5) * h;
+        const double t = std::sqrt(x * x + y * y) / R;
+        if (t >= 1.0) continue;
+        const double fy = f(x, y);
+        e += kernel::weight(t) * fy;
+        lap += kernel::laplacian_weight_r2(t) / (R * R) * fy;
+      }
+    }
+    e *= h * h / (kPi_ * R * R);
+    lap *= h * h / (kPi_ * R * R);
+    const double expected = 5.0 / 96.0 * R * R * f.trace();
+    EXPECT_NEAR(e - f(0.0, 0.0), expected, 1e-6 * std::fabs(expected)) << "R=" << R;
+    EXPECT_NEAR(lap, f.trace(), 5e-4 * std::fabs(f.trace())) << "R=" << R;
+  }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Progressive state driven with synthetic passes
+
+struct Recorded {
+  double r2;        // R_j^2 (state.r2 before the pass)
+  double n_before;  // state.n before the pass
+  PassGather g;
+  dvec3 x;          // X_j = D_j + phi_j / (pi R_j^2 M_e)
+};
+
+// Synthetic gathers whose per-pass estimates look like a real point's: X_j ~ L + b R_j^2 + noise,
+// Laplacian samples ~ lap0 + noise, about 20% of passes without photons (phi = 0, count = 0).
+PassGather synthetic_gather(uint64_t seed, uint64_t pass, double r2, double me) {
+  Rng rng(seed, 0, pass, Stream::Test);
+  PassGather g;
+  const bool empty = rng.next_double() < 0.2;
+  g.count = empty ? 0 : 1 + (rng.next_u32() % 60);
+  const dvec3 L(0.8, 1.5, 0.3), b(0.6, -0.4, 1.0), lap0(2.0, -1.0, 5.0);
+  for (int c = 0; c < 3; ++c) {
+    const double xs = L[c] + b[c] * r2 + 0.5 * (rng.next_double() - 0.5);
+    const double ls = lap0[c] + 3.0 * (rng.next_double() - 0.5);
+    g.phi[c] = empty ? 0.0 : kPi_ * r2 * me * xs;
+    g.phi_lap_r2[c] = empty ? 0.0 : kPi_ * r2 * r2 * me * ls;
+    g.direct[c] = 0.1 * rng.next_double();
+  }
+  return g;
+}
+
+struct Drive {
+  PointState state;
+  std::vector<Recorded> rec;
+  EstimatorParams params;
+};
+
+Drive drive(uint64_t seed, int passes, double alpha, double me, double r2_0 = 0.25,
+            double min_r2 = 0.0) {
+  Drive d;
+  d.params.alpha = alpha;
+  d.params.photons_per_pass = me;
+  d.params.min_r2 = min_r2;
+  d.state.r2 = r2_0;
+  for (int j = 1; j <= passes; ++j) {
+    Recorded r;
+    r.r2 = d.state.r2;
+    r.n_before = d.state.n;
+    r.g = synthetic_gather(seed, uint64_t(j), r.r2, me);
+    r.x = r.g.direct + r.g.phi / (kPi_ * r.r2 * me);
+    accumulate_pass(d.state, r.g, d.params, uint64_t(j));
+    d.rec.push_back(r);
+  }
+  return d;
+}
+
+constexpr double kAlpha = 0.7;
+constexpr double kMe = 1000.0;
+constexpr int kPasses = 200;
+
+TEST(Estimator, UpdateIdentityPhotonRadianceIsMeanOfPassEstimates) {
+  // ESTIMATOR.md section 3: tau / (pi R^2 i M_e) = (1/i) sum_j phi_j / (pi R_j^2 M_e). Both sides
+  // are O(1) sums of 200 terms; the left side carries ~i multiplications by g, so rounding is at
+  // most ~200 * 2 eps ~ 1e-13 relative: tolerance 1e-12 relative.
+  PointState s;
+  EstimatorParams p;
+  p.alpha = kAlpha;
+  p.photons_per_pass = kMe;
+  s.r2 = 0.25;
+  dvec3 sum(0.0);
+  for (int j = 1; j <= kPasses; ++j) {
+    const double r2 = s.r2;
+    const PassGather g = synthetic_gather(11, uint64_t(j), r2, kMe);
+    sum += g.phi / (kPi_ * r2 * kMe);
+    accumulate_pass(s, g, p, uint64_t(j));
+    const dvec3 lp = photon_radiance(s, uint64_t(j), kMe);
+    const dvec3 ref = sum / double(j);
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_NEAR(lp[c], ref[c], 1e-12 * std::fabs(ref[c]) + 1e-300)
+          << "pass " << j << " channel " << c;
+    }
+  }
+}
+
+TEST(Estimator, RadiusFollowsPpmUpdateAndEmptyPassKeepsIt) {
+  // R^2 after the pass = R^2 before * (N + alpha M)/(N + M), N += alpha M: one multiplication
+  // per pass from the state's own values, so equality to 2 ulp (EXPECT_DOUBLE_EQ allows 4).
+  const Drive d = drive(12, kPasses, kAlpha, kMe);
+  int empty = 0;
+  uint64_t photons = 0;
+  for (size_t j = 0; j < d.rec.size(); ++j) {
+    const Recorded& r = d.rec[j];
+    const double r2_after = j + 1 < d.rec.size() ? d.rec[j + 1].r2 : d.state.r2;
+    const double n_after = j + 1 < d.rec.size() ? d.rec[j + 1].n_before : d.state.n;
+    const double m = double(r.g.count);
+    photons += r.g.count;
+    if (r.g.count == 0) {
+      ++empty;
+      EXPECT_EQ(r2_after, r.r2) << "pass " << j + 1 << ": empty pass changed the radius";
+      EXPECT_EQ(n_after, r.n_before);
+    } else {
+      const double g = (r.n_before + kAlpha * m) / (r.n_before + m);
+      EXPECT_DOUBLE_EQ(r2_after, r.r2 * g) << "pass " << j + 1;
+      EXPECT_DOUBLE_EQ(n_after, r.n_before + kAlpha * m) << "pass " << j + 1;
+      EXPECT_LT(r2_after, r.r2);
+    }
+  }
+  EXPECT_GT(empty, 10);  // the drive really contains empty passes
+  EXPECT_EQ(d.state.photons, photons);
+  // The radius did shrink substantially over the run.
+  EXPECT_LT(d.state.r2, 0.5 * d.rec.front().r2);
+}
+
+TEST(Estimator, EmptyFirstPassesKeepRadius) {
+  // Passes with M = 0 while N = 0 (no photon yet): g must stay 1 (no 0/0).
+  PointState s;
+  EstimatorParams p;
+  p.alpha = kAlpha;
+  p.photons_per_pass = kMe;
+  s.r2 = 0.04;
+  PassGather g;
+  g.direct = dvec3(0.2);
+  for (uint64_t j = 1; j <= 5; ++j) {
+    accumulate_pass(s, g, p, j);
+    EXPECT_EQ(s.r2, 0.04);
+    EXPECT_EQ(s.n, 0.0);
+    EXPECT_TRUE(std::isfinite(s.tau.x) && std::isfinite(s.tau_lap.x));
+  }
+}
+
+TEST(Estimator, StreamingMomentsMatchTwoPass) {
+  // Welford co-moments against the two-pass formula over the recorded (X_j, R_j^2): both are
+  // backward stable; 1e-10 relative (to the natural scale sqrt(C_aa C_bb) for cross moments).
+  const Drive d = drive(13, kPasses, kAlpha, kMe);
+  const double n = double(d.rec.size());
+  dvec3 mx(0.0);
+  double mr = 0.0;
+  for (const Recorded& r : d.rec) {
+    mx += r.x;
+    mr += r.r2;
+  }
+  mx /= n;
+  mr /= n;
+  dvec3 cxx(0.0), cxr(0.0);
+  double crr = 0.0;
+  for (const Recorded& r : d.rec) {
+    cxx += (r.x - mx) * (r.x - mx);
+    cxr += (r.x - mx) * (r.r2 - mr);
+    crr += (r.r2 - mr) * (r.r2 - mr);
+  }
+  const PointState& s = d.state;
+  EXPECT_NEAR(s.mean_r2, mr, 1e-12 * mr);
+  EXPECT_NEAR(s.c_rr, crr, 1e-10 * crr);
+  ASSERT_GT(crr, 0.0);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(s.mean_x[c], mx[c], 1e-12 * std::fabs(mx[c])) << c;
+    EXPECT_NEAR(s.c_xx[c], cxx[c], 1e-10 * cxx[c]) << c;
+    EXPECT_NEAR(s.c_xr[c], cxr[c], 1e-10 * std::sqrt(cxx[c] * crr)) << c;
+    ASSERT_GT(cxx[c], 0.0);
+  }
+}
+
+TEST(Estimator, RetroactiveCorrectionMatchesDirectRecomputation) {
+  // At every pass i >= 2: a = 0.5 k2 Lap_i, Lap_i = tauLap / (pi R^2 i M_e), which by the update
+  // identity equals the mean of the per-pass Laplacian samples phiLap_j / (pi R_j^2 M_e) with
+  // phiLap_j = phi_lap_r2_j / R_j^2 (computed here from the records only). Then
+  //   variance = sum_j (X'_j - mean X')^2 / (i - 1) / i,  X'_j = X_j - a R_j^2,
+  //   bias = a mean_j R_j^2,  radiance = mean_j X_j.
+  // Rounding: the streaming form cancels C_XX - 2aC_XR + a^2 C_RR; its error is bounded by
+  // ~1e-12 of the sum of the magnitudes of the three terms: tolerance 1e-10 of that scale.
+  const Drive d = drive(14, kPasses, kAlpha, kMe);
+  PointState s;
+  s.r2 = 0.25;
+  EstimatorParams p = d.params;
+  for (size_t j = 0; j < d.rec.size(); ++j) {
+    accumulate_pass(s, d.rec[j].g, p, uint64_t(j + 1));
+    const size_t i = j + 1;
+    if (i < 2) continue;
+    const double di = double(i);
+    dvec3 lap(0.0), mx(0.0);
+    double mr = 0.0;
+    for (size_t k = 0; k < i; ++k) {
+      const Recorded& r = d.rec[k];
+      lap += (r.g.phi_lap_r2 / r.r2) / (kPi_ * r.r2 * kMe);
+      mx += r.x;
+      mr += r.r2;
+    }
+    lap /= di;
+    mx /= di;
+    mr /= di;
+    const dvec3 a = 0.5 * (5.0 / 48.0) * lap;
+    dvec3 mxc(0.0);
+    for (size_t k = 0; k < i; ++k) mxc += d.rec[k].x - a * d.rec[k].r2;
+    mxc /= di;
+    dvec3 var(0.0), scale(0.0);
+    for (size_t k = 0; k < i; ++k) {
+      const dvec3 dev = d.rec[k].x - a * d.rec[k].r2 - mxc;
+      var += dev * dev;
+    }
+    var /= (di - 1.0) * di;
+    scale = (s.c_xx + 2.0 * glm::abs(a * s.c_xr) + a * a * s.c_rr) / ((di - 1.0) * di);
+
+    const PointEstimate e = estimate(s, i, kMe);
+    for (int c = 0; c < 3; ++c) {
+      ASSERT_NEAR(e.variance[c], var[c], 1e-10 * scale[c] + 1e-300) << "pass " << i << " ch " << c;
+      ASSERT_NEAR(e.bias[c], a[c] * mr, 1e-11 * std::fabs(a[c] * mr) + 1e-300)
+          << "pass " << i << " ch " << c;
+      ASSERT_NEAR(e.radiance[c], mx[c], 1e-12 * std::fabs(mx[c])) << "pass " << i << " ch " << c;
+    }
+    EXPECT_TRUE(e.known);
+  }
+}
+
+TEST(Estimator, RetroactiveCorrectionRemovesDeterministicDrift) {
+  // Samples X_j = L + b R_j^2 exactly (no noise) with Laplacian samples chosen so that
+  // a = 0.5 k2 Lap = b: the corrected samples are all equal, so the variance must be ~0, while
+  // the uncorrected sample variance of X_j is large (the radius shrinks by ~3x over the run).
+  // Tolerance: 1e-9 of the uncorrected variance (the streaming cancellation error is ~1e-13).
+  const double L = 2.0, b = 3.0, me = 500.0;
+  const double lap_true = b / (0.5 * kernel::kSecondMoment);
+  PointState s;
+  EstimatorParams p;
+  p.alpha = 0.6;
+  p.photons_per_pass = me;
+  s.r2 = 0.5;
+  std::vector<double> xs;
+  for (uint64_t j = 1; j <= 100; ++j) {
+    const double r2 = s.r2;
+    PassGather g;
+    g.count = 25;
+    g.phi = dvec3(kPi_ * r2 * me * (L + b * r2));
+    g.phi_lap_r2 = dvec3(kPi_ * r2 * r2 * me * lap_true);
+    xs.push_back(L + b * r2);
+    accumulate_pass(s, g, p, j);
+  }
+  double m = 0.0, v = 0.0;
+  for (double x : xs) m += x;
+  m /= double(xs.size());
+  for (double x : xs) v += (x - m) * (x - m);
+  const double raw_var_of_mean = v / double(xs.size() - 1) / double(xs.size());
+  ASSERT_GT(raw_var_of_mean, 1e-4);
+  const PointEstimate e = estimate(s, 100, me);
+  EXPECT_LE(e.variance.x, 1e-9 * raw_var_of_mean);
+  // Bias b mean(R_j^2) and bias-corrected radiance equal to L.
+  EXPECT_NEAR(e.bias.x, b * s.mean_r2, 1e-12);
+  EXPECT_NEAR(e.radiance.x - e.bias.x, L, 1e-12);
+}
+
+TEST(Estimator, StudentTQuantilesMatchTable) {
+  // ESTIMATOR.md section 6, 4-decimal table: |error| <= 5e-5 (half a unit in the last place).
+  struct Row {
+    double nu, t;
+  };
+  for (const Row& r : {Row{1, 6.3138}, Row{2, 2.9200}, Row{4, 2.1318}, Row{10, 1.8125},
+                       Row{100, 1.6602}}) {
+    EXPECT_NEAR(student_t_quantile(r.nu, 0.95), r.t, 5e-5) << "nu=" << r.nu;
+  }
+  for (double nu : {1e6, 1e7, 1e8, 1e12}) {
+    EXPECT_NEAR(student_t_quantile(nu, 0.95), 1.6449, 5e-5) << "nu=" << nu;
+  }
+  // Other confidence levels used by the renderer: t_{1,0.75} = 1 (Cauchy), normal 0.975 = 1.95996.
+  EXPECT_NEAR(student_t_quantile(1, 0.75), 1.0, 1e-9);
+  EXPECT_NEAR(student_t_quantile(1e9, 0.975), 1.959964, 1e-6);
+  // Monotone decreasing in nu (heavier tails for fewer degrees of freedom), continuous at 1e7.
+  double prev = INFINITY;
+  for (double nu : {1.0, 2.0, 3.0, 5.0, 30.0, 1e3, 1e5, 1e7, 1.0000001e7, 1e9}) {
+    const double t = student_t_quantile(nu, 0.95);
+    EXPECT_LE(t, prev) << "nu=" << nu;
+    prev = t;
+  }
+  EXPECT_NEAR(student_t_quantile(1e7, 0.95), student_t_quantile(1.0000001e7, 0.95), 1e-6);
+}
+
+TEST(Estimator, KnownOnlyWithPhotonsAndTwoPasses) {
+  EstimatorParams p;
+  p.alpha = kAlpha;
+  p.photons_per_pass = kMe;
+  // Direct light only, never a photon: unknown at every pass count.
+  {
+    PointState s;
+    s.r2 = 0.01;
+    PassGather g;
+    g.direct = dvec3(0.3);
+    for (uint64_t j = 1; j <= 5; ++j) {
+      accumulate_pass(s, g, p, j);
+      const PointEstimate e = estimate(s, j, kMe);
+      EXPECT_FALSE(e.known) << "pass " << j;
+      EXPECT_NEAR(e.radiance.x, 0.3, 1e-15);
+    }
+  }
+  // With photons from pass 1: unknown after 1 pass, known from 2 passes.
+  {
+    PointState s;
+    s.r2 = 0.01;
+    EXPECT_FALSE(estimate(s, 0, kMe).known);
+    PassGather g;
+    g.count = 3;
+    g.phi = dvec3(0.1);
+    accumulate_pass(s, g, p, 1);
+    EXPECT_FALSE(estimate(s, 1, kMe).known);
+    accumulate_pass(s, g, p, 2);
+    EXPECT_TRUE(estimate(s, 2, kMe).known);
+  }
+  // Photons arriving only in pass 3: unknown at 2 passes, known at 3.
+  {
+    PointState s;
+    s.r2 = 0.01;
+    PassGather none;
+    accumulate_pass(s, none, p, 1);
+    accumulate_pass(s, none, p, 2);
+    EXPECT_FALSE(estimate(s, 2, kMe).known);
+    PassGather g;
+    g.count = 1;
+    g.phi = dvec3(0.1);
+    accumulate_pass(s, g, p, 3);
+    EXPECT_TRUE(estimate(s, 3, kMe).known);
+  }
+}
+
+TEST(Estimator, AlphaOneNeverShrinksRadius) {
+  const Drive d = drive(15, kPasses, 1.0, kMe);
+  for (const Recorded& r : d.rec) EXPECT_EQ(r.r2, 0.25);
+  EXPECT_EQ(d.state.r2, 0.25);
+  EXPECT_GT(d.state.photons, 1000u);
+}
+
+TEST(Estimator, TinyAlphaShrinksRadiusDownToFloor) {
+  // alpha = 0.01 would shrink R^2 by ~1e-2 per pass; min_r2 = 1e-4 must hold it.
+  const double min_r2 = 1e-4;
+  const Drive d = drive(16, kPasses, 0.01, kMe, 0.25, min_r2);
+  for (const Recorded& r : d.rec) EXPECT_GE(r.r2, min_r2);
+  EXPECT_GE(d.state.r2, min_r2);
+  EXPECT_EQ(d.state.r2, min_r2);  // reached the floor
+  EXPECT_LT(d.rec[5].r2, 0.25);   // and did shrink on the way
+}
+
+TEST(Estimator, UpdateIdentityHoldsWhenRadiusIsClamped) {
+  // ESTIMATOR.md section 3 states L_photon = tau/(pi R^2 i M_e) = mean_j phi_j/(pi R_j^2 M_e) as
+  // an invariant, and section 8 requires the floor on R. Both must hold together: once the floor
+  // is active the radius no longer shrinks by g, so tau must not be shrunk by g either, otherwise
+  // the estimate tau/(pi R^2 i M_e) loses a factor g every clamped pass and drifts to 0.
+  // Same rounding argument as the unclamped identity test: 1e-12 relative.
+  const double min_r2 = 1e-3;
+  const Drive d = drive(17, 60, 0.3, kMe, 0.25, min_r2);
+  dvec3 sum(0.0), sum_lap(0.0);
+  for (const Recorded& r : d.rec) {
+    sum += r.g.phi / (kPi_ * r.r2 * kMe);
+    sum_lap += (r.g.phi_lap_r2 / r.r2) / (kPi_ * r.r2 * kMe);
+  }
+  ASSERT_EQ(d.state.r2, min_r2);  // the clamp was active
+  const double i = double(d.rec.size());
+  const dvec3 lp = photon_radiance(d.state, d.rec.size(), kMe);
+  const dvec3 lap = d.state.tau_lap / (kPi_ * d.state.r2 * i * kMe);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(lp[c], sum[c] / i, 1e-12 * std::fabs(sum[c] / i)) << "channel " << c;
+    EXPECT_NEAR(lap[c], sum_lap[c] / i, 1e-12 * std::fabs(sum_lap[c] / i)) << "channel " << c;
+  }
+}
+
+}  // namespace
+}  // namespace pb
