@@ -1,0 +1,70 @@
+// tinygltf-free helpers of the glTF loader (src/gltf_loader.cpp, the only file that sees
+// tinygltf types): one-line messages, reading the file, checking the GLB container, world
+// transforms and the degenerate-triangle test.
+#pragma once
+
+#include "photonbound/math.h"
+
+#include <cstdint>
+#include <cstring>
+#include <string>
+#include <vector>
+
+namespace pb::gltf {
+
+std::vector<std::string> nonempty_lines(const std::string& s);  // trimmed
+std::string one_line(const std::string& s);                     // folds the lines of s into "a; b"
+std::string num(double v);  // shortest readable form: 1.5, 1e+12
+// "mesh 'name'" when named, "mesh 3" otherwise.
+std::string label(const char* kind, const std::string& name, size_t index);
+// "<kind> <index>, which does not exist (the file has <count> <kind>s)"
+std::string absent(const std::string& kind, double index, size_t count);
+// glTF enum names for messages: primitive mode, accessor type, accessor componentType.
+std::string mode_name(int mode);
+std::string type_name(int type);
+std::string component_name(int component);
+
+// A validated accessor: component c of element i is at base + i * stride + c * sizeof(T).
+struct View {
+  const unsigned char* base = nullptr;
+  size_t stride = 0, count = 0;
+  int component = 0;  // glTF componentType
+  template <class T>
+  T get(size_t i, int c) const {
+    T v;
+    std::memcpy(&v, base + i * stride + size_t(c) * sizeof(T), sizeof(T));
+    return v;
+  }
+  dvec3 vec3f(size_t i) const {  // a FLOAT VEC3 element
+    return dvec3(get<float>(i, 0), get<float>(i, 1), get<float>(i, 2));
+  }
+};
+
+// The whole file; throws SceneError "<path>: cannot open (<strerror>)" when it cannot.
+std::vector<unsigned char> read_file(const std::string& path);
+
+// Checks the GLB header and chunk bounds (tinygltf 2.7 lets the BIN chunk run up to 8 bytes
+// past the declared length) and returns the declared length. Throws SceneError.
+uint32_t check_glb(const std::string& path, const std::vector<unsigned char>& data);
+
+// A node's world transform and what meshes, normals and directions need from it.
+struct Xform {
+  glm::dmat4 m{1.0};
+  glm::dmat3 linear{1.0};
+  double det = 1.0;
+  explicit Xform(const glm::dmat4& world);
+  dvec3 point(const dvec3& p) const { return dvec3(m * glm::dvec4(p, 1.0)); }
+  dvec3 direction(const dvec3& d) const { return linear * d; }
+  bool finite() const;
+  bool singular() const;  // |det| tiny relative to the column lengths
+};
+
+// The column-major matrix of a glTF quaternion [x, y, z, w] (normalised here); false when the
+// quaternion is zero or not finite.
+bool rotation_matrix(const std::vector<double>& xyzw, glm::dmat3& out);
+
+// A triangle is degenerate when an index repeats, when |cross| <= 1e-12 * (longest edge)^2,
+// or when its area is so small that its square underflows in float (the renderer's precision).
+bool degenerate(const std::vector<vec3>& p, uint32_t i0, uint32_t i1, uint32_t i2);
+
+}  // namespace pb::gltf

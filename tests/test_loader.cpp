@@ -1,0 +1,819 @@
+// glTF loader tests. Every test writes its own small glTF into a temporary directory; only
+// SmokeLoadsShippedScenes reads scenes/ (and skips when it is empty).
+#include "photonbound/gltf_loader.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace {
+
+namespace fs = std::filesystem;
+using pb::load_gltf;
+using pb::Reflection;
+using pb::Scene;
+using pb::SceneError;
+using pb::vec3;
+
+std::string base64(const std::vector<unsigned char>& d) {
+  static const char* t = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+  std::string out;
+  for (size_t i = 0; i < d.size(); i += 3) {
+    const uint32_t n = uint32_t(d[i]) << 16 | (i + 1 < d.size() ? uint32_t(d[i + 1]) << 8 : 0u) |
+                       (i + 2 < d.size() ? uint32_t(d[i + 2]) : 0u);
+    out += t[n >> 18 & 63];
+    out += t[n >> 12 & 63];
+    out += i + 1 < d.size() ? t[n >> 6 & 63] : '=';
+    out += i + 2 < d.size() ? t[n & 63] : '=';
+  }
+  return out;
+}
+
+std::string join(const std::vector<std::string>& items) {
+  std::string s;
+  for (const std::string& i : items) s += (s.empty() ? "" : ",") + i;
+  return s;
+}
+
+// A glTF document with one buffer; sections hold raw JSON objects.
+struct Gltf {
+  std::vector<unsigned char> bin;
+  std::vector<std::string> views, accessors, meshes, nodes, materials, lights, cameras;
+  std::optional<std::vector<int>> roots;  // scene 0 nodes; default: every node added
+  std::string top;                        // extra top-level members, each followed by ','
+  std::string buffer_uri;                 // overrides the embedded data URI
+  bool scenes = true;                     // false: no "scene"/"scenes" at all
+
+  template <class T>
+  int view(const std::vector<T>& v, const std::string& extra = "") {
+    while (bin.size() % 4) bin.push_back(0);
+    const size_t off = bin.size(), len = v.size() * sizeof(T);
+    bin.resize(off + len);
+    if (len) std::memcpy(bin.data() + off, v.data(), len);
+    views.push_back("{\"buffer\":0,\"byteOffset\":" + std::to_string(off) +
+                    ",\"byteLength\":" + std::to_string(len) + extra + "}");
+    return int(views.size()) - 1;
+  }
+  int accessor(int view, int component, size_t count, const char* type,
+               const std::string& extra = "") {
+    accessors.push_back("{\"bufferView\":" + std::to_string(view) + ",\"componentType\":" +
+                        std::to_string(component) + ",\"count\":" + std::to_string(count) +
+                        ",\"type\":\"" + type + "\"" + extra + "}");
+    return int(accessors.size()) - 1;
+  }
+  int vec3s(const std::vector<float>& xyz) {
+    return accessor(view(xyz), 5126, xyz.size() / 3, "VEC3");
+  }
+  int indices(const std::vector<uint16_t>& i) {
+    return accessor(view(i), 5123, i.size(), "SCALAR");
+  }
+  // A mesh with one primitive; attributes and extra are raw JSON.
+  int mesh(const std::string& name, int position, int index = -1, int material = -1,
+           const std::string& extra_attributes = "", const std::string& extra = "") {
+    std::string p =
+        "{\"attributes\":{\"POSITION\":" + std::to_string(position) + extra_attributes + "}";
+    if (index >= 0) p += ",\"indices\":" + std::to_string(index);
+    if (material >= 0) p += ",\"material\":" + std::to_string(material);
+    meshes.push_back("{\"name\":\"" + name + "\",\"primitives\":[" + p + extra + "}]}");
+    return int(meshes.size()) - 1;
+  }
+  int node(const std::string& body) {
+    nodes.push_back("{" + body + "}");
+    return int(nodes.size()) - 1;
+  }
+  int material(const std::string& body) {
+    materials.push_back("{" + body + "}");
+    return int(materials.size()) - 1;
+  }
+  int light(const std::string& body) {
+    lights.push_back("{" + body + "}");
+    return int(lights.size()) - 1;
+  }
+  int camera(double yfov, const std::string& extra = "") {
+    cameras.push_back("{\"type\":\"perspective\",\"perspective\":{\"yfov\":" +
+                      std::to_string(yfov) + ",\"znear\":0.01" + extra + "}}");
+    return int(cameras.size()) - 1;
+  }
+
+  std::string json(bool glb = false) const {
+    std::vector<int> r;
+    if (roots)
+      r = *roots;
+    else
+      for (size_t i = 0; i < nodes.size(); ++i) r.push_back(int(i));
+    std::vector<std::string> rs;
+    for (int i : r) rs.push_back(std::to_string(i));
+    std::string j = "{\"asset\":{\"version\":\"2.0\"}," + top +
+                    (scenes ? "\"scene\":0,\"scenes\":[{\"nodes\":[" + join(rs) + "]}]," : "") +
+                    "\"extras\":{}";
+    auto section = [&](const char* key, const std::vector<std::string>& items) {
+      if (!items.empty()) j += std::string(",\"") + key + "\":[" + join(items) + "]";
+    };
+    section("nodes", nodes);
+    section("meshes", meshes);
+    section("materials", materials);
+    section("cameras", cameras);
+    section("accessors", accessors);
+    section("bufferViews", views);
+    if (!bin.empty()) {
+      std::string uri =
+          buffer_uri.empty() ? "data:application/octet-stream;base64," + base64(bin) : buffer_uri;
+      j += ",\"buffers\":[{\"byteLength\":" + std::to_string(bin.size()) +
+           (glb ? std::string() : ",\"uri\":\"" + uri + "\"") + "}]";
+    }
+    if (!lights.empty())
+      j += ",\"extensions\":{\"KHR_lights_punctual\":{\"lights\":[" + join(lights) + "]}}";
+    return j + "}";
+  }
+
+  std::vector<unsigned char> glb() const {
+    std::string j = json(true);
+    while (j.size() % 4) j += ' ';
+    std::vector<unsigned char> b = bin;
+    while (b.size() % 4) b.push_back(0);
+    std::vector<unsigned char> out = {'g', 'l', 'T', 'F'};
+    auto u32 = [&](uint32_t v) {
+      for (int i = 0; i < 4; ++i) out.push_back(uint8_t(v >> (8 * i)));
+    };
+    u32(2);
+    u32(uint32_t(12 + 8 + j.size() + 8 + b.size()));
+    u32(uint32_t(j.size()));
+    u32(0x4E4F534Au);
+    out.insert(out.end(), j.begin(), j.end());
+    u32(uint32_t(b.size()));
+    u32(0x004E4942u);
+    out.insert(out.end(), b.begin(), b.end());
+    return out;
+  }
+};
+
+// One triangle in z = 0 facing +z (grey Lambertian), a camera at z = 5 and a point light.
+Gltf basic() {
+  Gltf g;
+  const int pos = g.vec3s({0, 0, 0, 1, 0, 0, 0, 1, 0});
+  const int nor = g.vec3s({0, 0, 1, 0, 0, 1, 0, 0, 1});
+  const int ind = g.indices({0, 1, 2});
+  const int mat = g.material(
+      "\"name\":\"grey\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.6,0.7,1],"
+      "\"metallicFactor\":0}");
+  g.mesh("tri", pos, ind, mat, ",\"NORMAL\":" + std::to_string(nor));
+  g.node("\"name\":\"geometry\",\"mesh\":0");
+  g.camera(0.7, ",\"aspectRatio\":1.5");
+  g.node("\"name\":\"eye\",\"camera\":0,\"translation\":[0,0,5]");
+  g.light("\"name\":\"bulb\",\"type\":\"point\",\"color\":[1,0.5,0.25],\"intensity\":8");
+  g.node(
+      "\"name\":\"lamp\",\"translation\":[0,2,0],\"extensions\":{\"KHR_lights_punctual\":{"
+      "\"light\":0}}");
+  return g;
+}
+
+class LoaderTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const std::string name = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    dir_ = fs::temp_directory_path() /
+           ("photonbound_loader_" + name + "_" + std::to_string(std::random_device{}()));
+    fs::create_directories(dir_);
+  }
+  void TearDown() override {
+    std::error_code ec;
+    fs::remove_all(dir_, ec);
+  }
+  std::string write(const std::string& name, const std::string& text) {
+    return write(name, std::vector<unsigned char>(text.begin(), text.end()));
+  }
+  std::string write(const std::string& name, const std::vector<unsigned char>& bytes) {
+    const fs::path p = dir_ / name;
+    std::ofstream(p, std::ios::binary)
+        .write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+    return p.string();
+  }
+  Scene load(const Gltf& g) { return load_gltf(write("scene.gltf", g.json())); }
+  // Loading must throw SceneError with one line "<path>: ...phrase...".
+  void expect_error(const std::string& path, const std::string& phrase) {
+    try {
+      load_gltf(path);
+      ADD_FAILURE() << "expected SceneError containing \"" << phrase << "\"";
+    } catch (const SceneError& e) {
+      const std::string m = e.what();
+      EXPECT_EQ(m.rfind(path + ": ", 0), 0u) << m;
+      EXPECT_NE(m.find(phrase), std::string::npos) << m;
+      EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    }
+  }
+  void expect_error(const Gltf& g, const std::string& phrase) {
+    expect_error(write("scene.gltf", g.json()), phrase);
+  }
+  fs::path dir_;
+};
+
+bool has_warning(const Scene& s, const std::string& phrase) {
+  for (const std::string& w : s.warnings)
+    if (w.find(phrase) != std::string::npos) return true;
+  return false;
+}
+
+void expect_vec(const vec3& a, const vec3& b, float tol = 1e-5f) {
+  EXPECT_NEAR(a.x, b.x, tol);
+  EXPECT_NEAR(a.y, b.y, tol);
+  EXPECT_NEAR(a.z, b.z, tol);
+}
+
+vec3 face_normal(const pb::Mesh& m, size_t t) {
+  const vec3 p0 = m.positions[m.indices[3 * t]], p1 = m.positions[m.indices[3 * t + 1]],
+             p2 = m.positions[m.indices[3 * t + 2]];
+  return glm::normalize(glm::cross(p1 - p0, p2 - p0));
+}
+
+TEST_F(LoaderTest, LoadsMinimalScene) {
+  Gltf g = basic();
+  g.nodes[0] = "{\"mesh\":0,\"translation\":[1,2,3]}";
+  const std::string path = write("scene.gltf", g.json());
+  const Scene s = load_gltf(path);
+  EXPECT_EQ(s.source, path);
+  ASSERT_EQ(s.meshes.size(), 1u);
+  const pb::Mesh& m = s.meshes[0];
+  EXPECT_EQ(m.name, "tri");
+  ASSERT_EQ(m.positions.size(), 3u);
+  expect_vec(m.positions[0], vec3(1, 2, 3));
+  expect_vec(m.positions[1], vec3(2, 2, 3));
+  expect_vec(m.positions[2], vec3(1, 3, 3));
+  ASSERT_EQ(m.normals.size(), 3u);
+  expect_vec(m.normals[1], vec3(0, 0, 1));
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2}));
+  ASSERT_EQ(s.materials.size(), 1u);
+  EXPECT_EQ(s.materials[m.material].name, "grey");
+  EXPECT_EQ(s.materials[m.material].model, Reflection::Lambertian);
+  expect_vec(s.materials[m.material].base_color, vec3(0.5f, 0.6f, 0.7f));
+  EXPECT_FALSE(s.materials[m.material].emits());
+  ASSERT_EQ(s.lights.size(), 1u);
+  EXPECT_EQ(s.lights[0].name, "bulb");
+  EXPECT_EQ(s.lights[0].kind, pb::PunctualKind::Point);
+  expect_vec(s.lights[0].position, vec3(0, 2, 0));
+  expect_vec(s.lights[0].intensity, vec3(8, 4, 2));
+  ASSERT_EQ(s.cameras.size(), 1u);
+  const pb::Camera& c = s.cameras[0];
+  expect_vec(c.position, vec3(0, 0, 5));
+  expect_vec(c.forward, vec3(0, 0, -1));
+  expect_vec(c.up, vec3(0, 1, 0));
+  expect_vec(c.right, vec3(1, 0, 0));
+  EXPECT_NEAR(c.yfov, 0.7f, 1e-6f);
+  ASSERT_TRUE(c.aspect.has_value());
+  EXPECT_NEAR(*c.aspect, 1.5f, 1e-6f);
+  expect_vec(s.bounds.lo, vec3(1, 2, 3));
+  expect_vec(s.bounds.hi, vec3(2, 3, 3));
+  EXPECT_EQ(s.degenerate_triangles, 0u);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings.front();
+}
+
+TEST_F(LoaderTest, LoadsBinaryGlb) {
+  const Scene s = load_gltf(write("scene.glb", basic().glb()));
+  EXPECT_EQ(s.triangle_count(), 1u);
+  EXPECT_EQ(s.cameras.size(), 1u);
+  EXPECT_EQ(s.lights.size(), 1u);
+}
+
+TEST_F(LoaderTest, LoadsExternalBuffer) {
+  Gltf g = basic();
+  g.buffer_uri = "data.bin";
+  write("data.bin", g.bin);
+  EXPECT_EQ(load(g).triangle_count(), 1u);
+}
+
+TEST_F(LoaderTest, MaterialModelsFollowTheRules) {
+  Gltf g = basic();
+  const std::vector<std::string> bodies = {
+      "\"name\":\"mirror\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.9,0.8,0.7,1],"
+      "\"roughnessFactor\":0}",
+      "\"name\":\"rough\",\"pbrMetallicRoughness\":{\"metallicFactor\":0.7,\"roughnessFactor\":0."
+      "5}",
+      "\"name\":\"glass\",\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1}"
+      ","
+      "\"KHR_materials_ior\":{\"ior\":1.33}},\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,0."
+      "9,1]}",
+      "\"name\":\"glass15\",\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":"
+      "1}}",
+      "\"name\":\"lamp\",\"emissiveFactor\":[1,0.5,0],\"pbrMetallicRoughness\":{\"metallicFactor\":"
+      "0},"
+      "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":4}}",
+      "\"name\":\"plain\""};
+  for (const std::string& body : bodies) {
+    const int mat = g.material(body);
+    const int mesh = g.mesh("m" + std::to_string(mat), 0, 2, mat);
+    g.node("\"mesh\":" + std::to_string(mesh));
+  }
+  g.node("\"mesh\":" + std::to_string(g.mesh("nomat", 0, 2)));
+  const Scene s = load(g);
+  ASSERT_EQ(s.meshes.size(), 8u);
+  auto mat = [&](size_t mesh) { return s.materials[s.meshes[mesh].material]; };
+  EXPECT_EQ(mat(0).model, Reflection::Lambertian);
+  EXPECT_EQ(mat(1).model, Reflection::Mirror);
+  expect_vec(mat(1).base_color, vec3(0.9f, 0.8f, 0.7f));
+  EXPECT_EQ(mat(2).model, Reflection::Mirror);
+  EXPECT_TRUE(has_warning(s, "material 'rough': roughness 0.5 treated as a smooth mirror"));
+  EXPECT_FALSE(has_warning(s, "material 'mirror'"));
+  EXPECT_EQ(mat(3).model, Reflection::Dielectric);
+  EXPECT_NEAR(mat(3).ior, 1.33f, 1e-6f);
+  expect_vec(mat(3).base_color, vec3(1, 1, 0.9f));
+  EXPECT_EQ(mat(4).model, Reflection::Dielectric);
+  EXPECT_NEAR(mat(4).ior, 1.5f, 1e-6f);
+  EXPECT_EQ(mat(5).model, Reflection::Lambertian);
+  expect_vec(mat(5).emission, vec3(4, 2, 0));
+  EXPECT_TRUE(mat(5).emits());
+  EXPECT_EQ(mat(6).model, Reflection::Mirror);  // glTF default metallicFactor is 1
+  EXPECT_TRUE(has_warning(s, "material 'plain': roughness 1 treated as a smooth mirror"));
+  EXPECT_EQ(mat(7).name, "default");
+  EXPECT_EQ(mat(7).model, Reflection::Lambertian);
+  expect_vec(mat(7).base_color, vec3(0.8f));
+  EXPECT_TRUE(has_warning(s, "default"));
+}
+
+TEST_F(LoaderTest, TexturesAreIgnoredWithOneWarning) {
+  Gltf g = basic();
+  g.top =
+      "\"images\":[{\"uri\":\"data:image/png;base64,AAAAAAAA\"}],\"textures\":[{\"source\":0}],";
+  g.materials[0] =
+      "{\"pbrMetallicRoughness\":{\"metallicFactor\":0,\"baseColorTexture\":{\"index\":0}},"
+      "\"normalTexture\":{\"index\":0}}";
+  g.node("\"mesh\":" +
+         std::to_string(g.mesh("second", 0, 2, g.material("\"emissiveTexture\":{\"index\":0}"))));
+  const Scene s = load(g);
+  int count = 0;
+  for (const std::string& w : s.warnings) count += w == "textures are not read; factors are used";
+  EXPECT_EQ(count, 1);
+}
+
+TEST_F(LoaderTest, HierarchyComposesTrsAndMatrix) {
+  Gltf g = basic();
+  g.nodes[0] = "{\"mesh\":0}";
+  // parent: T(10,0,0) * R(90 deg about z) * S(2); child: matrix T(1,0,0) (column-major).
+  const double h = std::sqrt(0.5);
+  g.node("\"translation\":[10,0,0],\"rotation\":[0,0," + std::to_string(h) + "," +
+         std::to_string(h) + "],\"scale\":[2,2,2],\"children\":[4]");
+  g.node("\"matrix\":[1,0,0,0, 0,1,0,0, 0,0,1,0, 1,0,0,1],\"mesh\":0,\"children\":[5]");
+  g.node("\"camera\":0");
+  g.roots = std::vector<int>{1, 2, 3};
+  const Scene s = load(g);
+  ASSERT_EQ(s.meshes.size(), 1u);
+  const pb::Mesh& m = s.meshes[0];
+  // local (0,0,0) -> (1,0,0) -> (2,0,0) -> (0,2,0) -> (10,2,0); local (1,0,0) -> (10,4,0).
+  expect_vec(m.positions[0], vec3(10, 2, 0), 1e-4f);
+  expect_vec(m.positions[1], vec3(10, 4, 0), 1e-4f);
+  expect_vec(m.positions[2], vec3(8, 2, 0), 1e-4f);
+  expect_vec(m.normals[0], vec3(0, 0, 1));
+  ASSERT_EQ(s.cameras.size(), 2u);
+  const pb::Camera& c = s.cameras[1];  // node 5, under the rotated parent
+  expect_vec(c.position, vec3(10, 2, 0), 1e-4f);
+  expect_vec(c.forward, vec3(0, 0, -1));
+  expect_vec(c.up, vec3(-1, 0, 0));
+  expect_vec(c.right, vec3(0, 1, 0));
+}
+
+TEST_F(LoaderTest, NormalsUseTheInverseTranspose) {
+  Gltf g = basic();
+  // The plane x + y = 1 has normal (1,1,0)/sqrt2; scaling y by 2 makes it (1,0.5,0)/|.|.
+  const int pos = g.vec3s({1, 0, 0, 0, 1, 0, 1, 0, 1});
+  const float r = std::sqrt(0.5f);
+  const int nor = g.vec3s({r, r, 0, r, r, 0, r, r, 0});
+  g.meshes[0] =
+      "{\"name\":\"slant\",\"primitives\":[{\"attributes\":{\"POSITION\":" + std::to_string(pos) +
+      ",\"NORMAL\":" + std::to_string(nor) + "}}]}";
+  g.nodes[0] = "{\"mesh\":0,\"scale\":[1,2,1]}";
+  const Scene s = load(g);
+  expect_vec(s.meshes[0].positions[1], vec3(0, 2, 0));
+  expect_vec(s.meshes[0].normals[2], glm::normalize(vec3(1, 0.5f, 0)));
+}
+
+TEST_F(LoaderTest, NegativeDeterminantFlipsWinding) {
+  Gltf g = basic();
+  g.nodes[0] = "{\"mesh\":0,\"scale\":[-1,1,1]}";
+  const Scene s = load(g);
+  const pb::Mesh& m = s.meshes[0];
+  EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 2, 1}));
+  expect_vec(m.positions[1], vec3(-1, 0, 0));
+  expect_vec(face_normal(m, 0), vec3(0, 0, 1));  // the front side still faces +z
+  expect_vec(m.normals[0], vec3(0, 0, 1));
+}
+
+TEST_F(LoaderTest, NonIndexedAndInterleavedAndIndexTypes) {
+  Gltf g = basic();
+  // Interleaved POSITION + NORMAL, byteStride 24, two triangles, non-indexed.
+  const std::vector<float> data = {0, 0, 0, 0, 0, 1, 1, 0, 0, 0, 0, 1, 0, 1, 0, 0, 0, 1,
+                                   0, 0, 1, 0, 0, 1, 1, 0, 1, 0, 0, 1, 0, 1, 1, 0, 0, 1};
+  const int v = g.view(data, ",\"byteStride\":24");
+  const int pos = g.accessor(v, 5126, 6, "VEC3");
+  const int nor = g.accessor(v, 5126, 6, "VEC3", ",\"byteOffset\":12");
+  g.node("\"mesh\":" +
+         std::to_string(g.mesh("flat", pos, -1, 0, ",\"NORMAL\":" + std::to_string(nor))));
+  const int i8 = g.accessor(g.view(std::vector<uint8_t>{0, 1, 2}), 5121, 3, "SCALAR");
+  g.node("\"mesh\":" + std::to_string(g.mesh("u8", 0, i8, 0)));
+  const int i32 = g.accessor(g.view(std::vector<uint32_t>{2, 0, 1}), 5125, 3, "SCALAR");
+  g.node("\"mesh\":" + std::to_string(g.mesh("u32", 0, i32, 0)));
+  const Scene s = load(g);
+  ASSERT_EQ(s.meshes.size(), 4u);
+  EXPECT_EQ(s.meshes[1].indices, (std::vector<uint32_t>{0, 1, 2, 3, 4, 5}));
+  expect_vec(s.meshes[1].positions[4], vec3(1, 0, 1));
+  expect_vec(s.meshes[1].normals[4], vec3(0, 0, 1));
+  EXPECT_EQ(s.meshes[2].indices, (std::vector<uint32_t>{0, 1, 2}));
+  EXPECT_EQ(s.meshes[3].indices, (std::vector<uint32_t>{2, 0, 1}));
+}
+
+TEST_F(LoaderTest, SpotLightDirectionAndCones) {
+  Gltf g = basic();
+  g.lights[0] =
+      "{\"type\":\"spot\",\"intensity\":3,\"spot\":{\"innerConeAngle\":0.2,\"outerConeAngle\":0.5}"
+      "}";
+  const double h = std::sqrt(0.5);  // 90 degrees about x: local -z becomes world +y
+  g.nodes[2] = "{\"rotation\":[" + std::to_string(h) + ",0,0," + std::to_string(h) +
+               "],\"extensions\":{\"KHR_lights_punctual\":{\"light\":0}}}";
+  const Scene s = load(g);
+  ASSERT_EQ(s.lights.size(), 1u);
+  const pb::PunctualLight& l = s.lights[0];
+  EXPECT_EQ(l.kind, pb::PunctualKind::Spot);
+  EXPECT_EQ(l.name, "light 0");
+  expect_vec(l.direction, vec3(0, 1, 0));
+  expect_vec(l.intensity, vec3(3));
+  EXPECT_NEAR(l.cos_inner, std::cos(0.2f), 1e-6f);
+  EXPECT_NEAR(l.cos_outer, std::cos(0.5f), 1e-6f);
+}
+
+TEST_F(LoaderTest, EmissiveTrianglesAloneLightTheScene) {
+  Gltf g = basic();
+  g.materials[0] = "{\"emissiveFactor\":[1,1,1],\"pbrMetallicRoughness\":{\"metallicFactor\":0}}";
+  g.roots = std::vector<int>{0, 1};
+  const Scene s = load(g);
+  EXPECT_TRUE(s.lights.empty());
+  EXPECT_TRUE(s.materials[s.meshes[0].material].emits());
+}
+
+TEST_F(LoaderTest, DegenerateTrianglesAreSkippedAndCounted) {
+  Gltf g = basic();
+  const int pos = g.vec3s({0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0, 1e-20f, 1e-20f, 0});
+  // good, repeated index, collinear, area underflow
+  const int ind = g.indices({0, 1, 2, 0, 0, 1, 0, 1, 3, 0, 4, 1});
+  g.meshes[0] =
+      "{\"name\":\"tri\",\"primitives\":[{\"attributes\":{\"POSITION\":" + std::to_string(pos) +
+      "},\"indices\":" + std::to_string(ind) + "}]}";
+  const Scene s = load(g);
+  EXPECT_EQ(s.degenerate_triangles, 3u);
+  EXPECT_EQ(s.triangle_count(), 1u);
+  EXPECT_TRUE(has_warning(s, "3 degenerate triangles skipped"));
+}
+
+TEST_F(LoaderTest, OnlyDegenerateTrianglesMeansNoTriangles) {
+  Gltf g = basic();
+  const int ind = g.indices({0, 0, 1, 2, 2, 2});
+  g.meshes[0] = "{\"name\":\"tri\",\"primitives\":[{\"attributes\":{\"POSITION\":0},\"indices\":" +
+                std::to_string(ind) + "}]}";
+  expect_error(g, ": no triangles");
+}
+
+TEST_F(LoaderTest, MissingFile) {
+  expect_error((dir_ / "nope.gltf").string(), "cannot open (No such file or directory)");
+}
+
+TEST_F(LoaderTest, MalformedJson) {
+  expect_error(write("bad.gltf", "{ this is not json ]"), "malformed glTF: ");
+}
+
+TEST_F(LoaderTest, TruncatedJson) {
+  const std::string j = basic().json();
+  expect_error(write("cut.gltf", j.substr(0, j.size() / 2)), "malformed glTF: ");
+}
+
+TEST_F(LoaderTest, WrongLengthBaseColorIsMalformed) {
+  Gltf g = basic();
+  g.materials[0] = "{\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.5]}}";
+  expect_error(g, "malformed glTF: Array length of `baseColorFactor`");
+}
+
+TEST_F(LoaderTest, AccessorIndexOutOfRange) {
+  Gltf g = basic();
+  g.meshes[0] = "{\"name\":\"tri\",\"primitives\":[{\"attributes\":{\"POSITION\":99}}]}";
+  expect_error(g, "mesh 'tri' primitive 0 POSITION refers to accessor 99, which does not exist");
+}
+
+TEST_F(LoaderTest, BufferViewOutOfRange) {
+  Gltf g = basic();
+  g.accessors[0] = "{\"bufferView\":42,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}";
+  expect_error(g, "POSITION accessor 0 refers to bufferView 42, which does not exist");
+}
+
+TEST_F(LoaderTest, AccessorReadsPastTheBufferView) {
+  Gltf g = basic();
+  g.accessors[0] = "{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC3\"}";
+  expect_error(g, "mesh 'tri' primitive 0 POSITION accessor 0 reads past the end of bufferView 0");
+}
+
+TEST_F(LoaderTest, AccessorOffsetPastTheBufferView) {
+  Gltf g = basic();
+  g.accessors[0] =
+      "{\"bufferView\":0,\"byteOffset\":4,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\"}";
+  expect_error(g, "reads past the end of bufferView 0");
+}
+
+TEST_F(LoaderTest, BufferViewPastTheBufferEnd) {
+  Gltf g = basic();
+  g.views[0] = "{\"buffer\":0,\"byteOffset\":80,\"byteLength\":36}";
+  expect_error(g, "extends past the end of buffer 0");
+}
+
+TEST_F(LoaderTest, IndexValueOutOfRange) {
+  Gltf g = basic();
+  g.node("\"mesh\":" + std::to_string(g.mesh("bad", 0, g.indices({0, 1, 7}), 0)));
+  expect_error(g,
+               "mesh 'bad' primitive 0 indices accessor 3: index 2 has value 7, out of range for 3 "
+               "vertices");
+}
+
+TEST_F(LoaderTest, IndexCountNotMultipleOfThree) {
+  Gltf g = basic();
+  g.node("\"mesh\":" + std::to_string(g.mesh("bad", 0, g.indices({0, 1, 2, 0}), 0)));
+  expect_error(g, "has 4 indices, not a multiple of 3");
+}
+
+TEST_F(LoaderTest, WrongComponentTypeForPosition) {
+  Gltf g = basic();
+  const int a =
+      g.accessor(g.view(std::vector<uint16_t>{0, 0, 0, 1, 0, 0, 0, 1, 0}), 5123, 3, "VEC3");
+  g.node("\"mesh\":" + std::to_string(g.mesh("shorts", a)));
+  expect_error(g, "POSITION accessor 3 has componentType UNSIGNED_SHORT; expected FLOAT");
+}
+
+TEST_F(LoaderTest, WrongTypeForPosition) {
+  Gltf g = basic();
+  g.accessors[0] = "{\"bufferView\":0,\"componentType\":5126,\"count\":4,\"type\":\"VEC2\"}";
+  expect_error(g, "POSITION accessor 0 has type VEC2; expected VEC3");
+}
+
+TEST_F(LoaderTest, PointsModeIsRejected) {
+  Gltf g = basic();
+  g.mesh("dots", 0, -1, 0, "", ",\"mode\":0");
+  g.node("\"mesh\":1");
+  expect_error(g, "mesh 'dots' primitive 0 uses mode POINTS; only TRIANGLES is supported");
+}
+
+TEST_F(LoaderTest, LinesModeIsRejected) {
+  Gltf g = basic();
+  g.meshes[0] = "{\"name\":\"tri\",\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":1}]}";
+  expect_error(g, "mesh 'tri' primitive 0 uses mode LINES; only TRIANGLES is supported");
+}
+
+TEST_F(LoaderTest, SparseAccessorIsRejected) {
+  Gltf g = basic();
+  const int iv = g.view(std::vector<uint16_t>{1, 0});
+  const int vv = g.view(std::vector<float>{5, 5, 5});
+  g.accessors[0] =
+      "{\"bufferView\":0,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\"sparse\":{"
+      "\"count\":1,\"indices\":{\"bufferView\":" +
+      std::to_string(iv) +
+      ",\"componentType\":5123},\"values\":{\"bufferView\":" + std::to_string(vv) + "}}}";
+  expect_error(g, "POSITION accessor 0 is sparse; sparse accessors are not supported");
+}
+
+TEST_F(LoaderTest, NanCoordinate) {
+  Gltf g = basic();
+  const int pos = g.vec3s({0, 0, 0, std::numeric_limits<float>::quiet_NaN(), 0, 0, 0, 1, 0});
+  g.node("\"mesh\":" + std::to_string(g.mesh("nan", pos)));
+  expect_error(g, "mesh 'nan' has a non-finite vertex coordinate");
+}
+
+TEST_F(LoaderTest, InfCoordinate) {
+  Gltf g = basic();
+  const int pos = g.vec3s({0, 0, 0, 1, 0, 0, 0, std::numeric_limits<float>::infinity(), 0});
+  g.node("\"mesh\":" + std::to_string(g.mesh("inf", pos)));
+  expect_error(g, "mesh 'inf' has a non-finite vertex coordinate");
+}
+
+TEST_F(LoaderTest, NanNormal) {
+  Gltf g = basic();
+  const int nor = g.vec3s({0, 0, 1, 0, 0, std::numeric_limits<float>::quiet_NaN(), 0, 0, 1});
+  g.node("\"mesh\":" +
+         std::to_string(g.mesh("nn", 0, -1, 0, ",\"NORMAL\":" + std::to_string(nor))));
+  expect_error(g, "mesh 'nn' has a non-finite vertex coordinate");
+}
+
+TEST_F(LoaderTest, ZeroNormalsAreDroppedWithAWarning) {
+  Gltf g = basic();
+  const int nor = g.vec3s({0, 0, 1, 0, 0, 0, 0, 0, 1});
+  g.node("\"mesh\":" +
+         std::to_string(g.mesh("zn", 0, -1, 0, ",\"NORMAL\":" + std::to_string(nor))));
+  const Scene s = load(g);
+  ASSERT_EQ(s.meshes.size(), 2u);
+  EXPECT_FALSE(s.meshes[0].normals.empty());
+  EXPECT_TRUE(s.meshes[1].normals.empty());
+  EXPECT_TRUE(has_warning(s, "mesh 'zn': zero or non-finite normals"));
+}
+
+TEST_F(LoaderTest, AbsurdCoordinate) {
+  Gltf g = basic();
+  const int pos = g.vec3s({0, 0, 0, 1e12f, 0, 0, 0, 1, 0});
+  g.node("\"mesh\":" + std::to_string(g.mesh("huge", pos)));
+  expect_error(g, "mesh 'huge' has a vertex coordinate beyond the limit of 1e10");
+}
+
+TEST_F(LoaderTest, AbsurdCoordinateAfterTransform) {
+  Gltf g = basic();
+  g.nodes[0] = "{\"mesh\":0,\"scale\":[1e11,1e11,1e11]}";
+  expect_error(g, "mesh 'tri' has a vertex coordinate beyond the limit of 1e10");
+}
+
+TEST_F(LoaderTest, SingularTransform) {
+  Gltf g = basic();
+  g.nodes[0] = "{\"name\":\"flat\",\"mesh\":0,\"scale\":[1,1,0]}";
+  expect_error(g, "node 'flat' has a singular transform");
+}
+
+TEST_F(LoaderTest, NodeCycle) {
+  Gltf g = basic();
+  g.nodes[0] = "{\"name\":\"loop\",\"mesh\":0,\"children\":[0]}";
+  expect_error(g, "node 'loop' is reached twice");
+}
+
+TEST_F(LoaderTest, NoScenesUsesEveryRootNode) {
+  Gltf g = basic();
+  g.scenes = false;
+  g.node("\"translation\":[0,0,1],\"children\":[0]");  // node 0 is now a child, not a root
+  const Scene s = load(g);
+  ASSERT_EQ(s.meshes.size(), 1u);
+  expect_vec(s.meshes[0].positions[1], vec3(1, 0, 1));
+  EXPECT_EQ(s.cameras.size(), 1u);
+  EXPECT_EQ(s.lights.size(), 1u);
+}
+
+TEST_F(LoaderTest, ExcessiveDepth) {
+  Gltf g = basic();
+  const int first = int(g.nodes.size());
+  for (int i = 0; i < 1100; ++i) g.node("\"children\":[" + std::to_string(first + i + 1) + "]");
+  g.node("\"mesh\":0");
+  expect_error(g, "the node hierarchy is deeper than 1000 levels");
+}
+
+TEST_F(LoaderTest, MeshIndexOutOfRange) {
+  Gltf g = basic();
+  g.nodes[0] = "{\"name\":\"geometry\",\"mesh\":4}";
+  expect_error(g, "node 'geometry' refers to mesh 4, which does not exist (the file has 1 mesh)");
+  g.mesh("second", 0);
+  expect_error(g, "(the file has 2 meshes)");
+}
+
+TEST_F(LoaderTest, MaterialIndexOutOfRange) {
+  Gltf g = basic();
+  g.node("\"mesh\":" + std::to_string(g.mesh("odd", 0, 2, 5)));
+  expect_error(g, "mesh 'odd' primitive 0 refers to material 5, which does not exist");
+}
+
+TEST_F(LoaderTest, NoCamera) {
+  Gltf g = basic();
+  g.roots = std::vector<int>{0, 2};
+  expect_error(g, ": no perspective camera");
+}
+
+TEST_F(LoaderTest, OrthographicCameraIsSkipped) {
+  Gltf g = basic();
+  g.cameras.push_back(
+      "{\"name\":\"ortho\",\"type\":\"orthographic\",\"orthographic\":"
+      "{\"xmag\":1,\"ymag\":1,\"znear\":0.1,\"zfar\":10}}");
+  g.node("\"camera\":1");
+  const Scene s = load(g);
+  EXPECT_EQ(s.cameras.size(), 1u);
+  EXPECT_TRUE(has_warning(s, "camera 'ortho' is orthographic and is skipped"));
+  g.roots = std::vector<int>{0, 2, 3};
+  expect_error(g, ": no perspective camera");
+}
+
+TEST_F(LoaderTest, InvalidYfov) {
+  Gltf g = basic();
+  g.cameras[0] = "{\"type\":\"perspective\",\"perspective\":{\"yfov\":3.5,\"znear\":0.1}}";
+  expect_error(g, "camera 0: yfov 3.5 must be in (0, pi)");
+}
+
+TEST_F(LoaderTest, NoLight) {
+  Gltf g = basic();
+  g.roots = std::vector<int>{0, 1};
+  expect_error(g, ": no light: the scene has no punctual light and no emissive triangles");
+}
+
+TEST_F(LoaderTest, ZeroIntensityLightIsNoLight) {
+  Gltf g = basic();
+  g.lights[0] = "{\"type\":\"point\",\"intensity\":0}";
+  expect_error(g, ": no light: the scene has no punctual light and no emissive triangles");
+}
+
+TEST_F(LoaderTest, DirectionalLight) {
+  Gltf g = basic();
+  g.lights[0] = "{\"name\":\"sun\",\"type\":\"directional\"}";
+  expect_error(g, "light 'sun' is directional; only point and spot lights are supported");
+}
+
+TEST_F(LoaderTest, NegativeIntensity) {
+  Gltf g = basic();
+  g.lights[0] = "{\"name\":\"dark\",\"type\":\"point\",\"intensity\":-1}";
+  expect_error(g, "light 'dark': intensity and color must be finite and >= 0");
+}
+
+TEST_F(LoaderTest, LightIndexOutOfRange) {
+  Gltf g = basic();
+  g.nodes[2] = "{\"name\":\"lamp\",\"extensions\":{\"KHR_lights_punctual\":{\"light\":3}}}";
+  expect_error(g, "node 'lamp' refers to light 3, which does not exist");
+}
+
+TEST_F(LoaderTest, SpotConeAnglesInvalid) {
+  Gltf g = basic();
+  g.lights[0] = "{\"type\":\"spot\",\"spot\":{\"innerConeAngle\":0.6,\"outerConeAngle\":0.5}}";
+  expect_error(g, "spot cone angles inner 0.6, outer 0.5 must satisfy 0 <= inner < outer <= pi/2");
+  g.lights[0] = "{\"type\":\"spot\",\"spot\":{\"outerConeAngle\":2}}";
+  expect_error(g, "must satisfy 0 <= inner < outer <= pi/2");
+}
+
+TEST_F(LoaderTest, IorBelowOne) {
+  Gltf g = basic();
+  g.materials[0] =
+      "{\"name\":\"odd\",\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
+      "\"KHR_materials_ior\":{\"ior\":0.9}}}";
+  expect_error(g, "material 'odd': ior 0.9 must be finite and >= 1");
+}
+
+TEST_F(LoaderTest, BaseColorAboveOne) {
+  Gltf g = basic();
+  g.materials[0] =
+      "{\"name\":\"hot\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[1.2,0.5,0.5,1]}}";
+  expect_error(g, "material 'hot': baseColorFactor (1.2, 0.5, 0.5) is outside [0, 1]");
+}
+
+TEST_F(LoaderTest, NegativeEmission) {
+  Gltf g = basic();
+  g.materials[0] =
+      "{\"name\":\"sink\",\"emissiveFactor\":[1,1,1],"
+      "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":-2}}}";
+  expect_error(
+      g, "material 'sink': emission (emissiveFactor x emissiveStrength) must be finite and >= 0");
+}
+
+TEST_F(LoaderTest, UnsupportedRequiredExtension) {
+  Gltf g = basic();
+  g.top =
+      "\"extensionsUsed\":[\"KHR_draco_mesh_compression\"],"
+      "\"extensionsRequired\":[\"KHR_draco_mesh_compression\"],";
+  expect_error(g, "requires extension 'KHR_draco_mesh_compression', which is not supported");
+}
+
+TEST_F(LoaderTest, GlbBadMagic) {
+  std::vector<unsigned char> b = basic().glb();
+  b[0] = 'x';
+  expect_error(write("bad.glb", b), "malformed glTF: bad GLB magic");
+}
+
+TEST_F(LoaderTest, GlbTruncatedChunk) {
+  std::vector<unsigned char> b = basic().glb();
+  b.resize(b.size() - 8);
+  expect_error(write("cut.glb", b), "malformed glTF: truncated GLB");
+  // Header length adjusted to the cut: the BIN chunk itself now overruns the file.
+  const uint32_t n = uint32_t(b.size());
+  std::memcpy(b.data() + 8, &n, 4);
+  expect_error(write("cut2.glb", b), "malformed glTF: the GLB BIN chunk");
+  expect_error(write("tiny.glb", std::vector<unsigned char>{'g', 'l', 'T', 'F', 2}),
+               "truncated GLB header");
+}
+
+TEST_F(LoaderTest, ExternalBufferMissing) {
+  Gltf g = basic();
+  g.buffer_uri = "missing.bin";
+  expect_error(g, "malformed glTF: File not found : missing.bin");
+}
+
+TEST_F(LoaderTest, ExternalBufferWrongSize) {
+  Gltf g = basic();
+  g.buffer_uri = "short.bin";
+  write("short.bin", std::vector<unsigned char>(g.bin.begin(), g.bin.end() - 4));
+  expect_error(g, "malformed glTF: File size mismatch");
+}
+
+TEST_F(LoaderTest, SmokeLoadsShippedScenes) {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(PHOTONBOUND_SCENES, ec))
+    if (e.path().extension() == ".gltf" || e.path().extension() == ".glb")
+      files.push_back(e.path());
+  if (files.empty()) GTEST_SKIP() << "no scenes in " << PHOTONBOUND_SCENES;
+  for (const fs::path& f : files) {
+    SCOPED_TRACE(f.string());
+    const Scene s = load_gltf(f.string());
+    EXPECT_GT(s.triangle_count(), 0u);
+    EXPECT_FALSE(s.cameras.empty());
+    bool lit = !s.lights.empty();
+    for (const pb::Mesh& m : s.meshes) lit = lit || s.materials[m.material].emits();
+    EXPECT_TRUE(lit);
+    EXPECT_FALSE(s.bounds.empty());
+  }
+}
+
+}  // namespace
