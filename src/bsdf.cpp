@@ -90,7 +90,11 @@ int specular_branches(const Material& m, const Surface& s, const vec3& wo, Trans
   if (f >= 1.0f) return 1;
   vec3 wt;
   if (!refract(wo, ns, eta, wt) || glm::dot(wt, ng) >= 0.0f) {
-    if (!refract(wo, ng, eta, wt)) return 1;
+    if (!refract(wo, ng, eta, wt)) {
+      // No transmission about either normal: all of the energy is reflected.
+      out[0].weight = vec3(1.0f);
+      return 1;
+    }
   }
   const float scale = mode == Transport::Radiance ? 1.0f / (eta * eta) : 1.0f;
   out[1] = {wt, m.base_color * ((1.0f - f) * scale)};

@@ -36,9 +36,12 @@ void accumulate_pass(PointState& s, const PassGather& g, const EstimatorParams& 
     shrink = (s.n + params.alpha * m) / (s.n + m);
     s.n += params.alpha * m;
   }
-  s.tau = (s.tau + g.phi) * shrink;
-  s.tau_lap = (s.tau_lap + g.phi_lap_r2 / r2_pass) * shrink;  // w_lap carries 1 / R_j^2
+  // At the radius floor the shrink actually applied is smaller; tau must follow R^2 exactly or
+  // tau / (pi R^2 i M_e) stops being the mean of the per-pass estimates.
   s.r2 = std::max(r2_pass * shrink, params.min_r2);
+  const double applied = s.r2 / r2_pass;
+  s.tau = (s.tau + g.phi) * applied;
+  s.tau_lap = (s.tau_lap + g.phi_lap_r2 / r2_pass) * applied;  // w_lap carries 1 / R_j^2
 }
 
 dvec3 photon_radiance(const PointState& s, uint64_t passes, double photons_per_pass) {

@@ -1,0 +1,75 @@
+// Prints the README's evidence for the error bounds: coverage against the exact answers of the
+// analytic scenes, and renders to halving target errors (specified vs actual error).
+// Run: build/tests/bounds_study  (about a few minutes on 2 cores)
+#include "analytic.h"
+#include "render_fixture.h"
+
+#include <cstdio>
+
+namespace {
+
+using namespace pb;
+
+void coverage_table() {
+  std::printf("### Coverage against the exact answer (64x64, --direct photons, 4 seeds pooled)\n\n");
+  std::printf("| scene | passes | confidence | mean actual error | mean bound | bound / actual | coverage |\n");
+  std::printf("|---|---|---|---|---|---|---|\n");
+  for (const char* name : {"plane", "box"}) {
+    std::vector<analytic::CoverageRow> pooled;
+    for (uint64_t seed = 1; seed <= 4; ++seed) {
+      RenderOptions o = test::quick_options(analytic::by_name(name).file, 64, 256);
+      o.direct = DirectMode::Photons;
+      o.seed = seed;
+      const auto rows = analytic::coverage_run(name, o, {16, 64, 256}, {0.5, 0.9});
+      if (pooled.empty()) {
+        pooled = rows;
+        continue;
+      }
+      for (size_t k = 0; k < rows.size(); ++k) {
+        auto& a = pooled[k].accuracy;
+        const auto& b = rows[k].accuracy;
+        const double n = double(a.samples), m = double(b.samples);
+        a.mean_abs_error = (a.mean_abs_error * n + b.mean_abs_error * m) / (n + m);
+        a.mean_bound = (a.mean_bound * n + b.mean_bound * m) / (n + m);
+        a.coverage = (a.coverage * n + b.coverage * m) / (n + m);
+        a.samples += b.samples;
+      }
+    }
+    for (const auto& r : pooled)
+      std::printf("| %s | %llu | %.0f%% | %.5f | %.5f | %.2f | %.3f |\n", r.scene.c_str(),
+                  (unsigned long long)r.passes, 100.0 * r.confidence, r.accuracy.mean_abs_error,
+                  r.accuracy.mean_bound, r.accuracy.mean_bound / r.accuracy.mean_abs_error,
+                  r.accuracy.coverage);
+  }
+  std::printf("\n");
+}
+
+void termination_table() {
+  std::printf("### Render to a target error: plane under a point light (32x32, --direct photons)\n\n");
+  std::printf("| confidence | target (specified) | actual mean error | specified / actual | passes | seconds | stop |\n");
+  std::printf("|---|---|---|---|---|---|---|\n");
+  for (double confidence : {0.5, 0.9}) {
+    for (double target : {0.02, 0.01, 0.005}) {
+      RenderOptions o = test::quick_options("plane_point.gltf", 32, 100000);
+      o.passes.reset();
+      o.direct = DirectMode::Photons;
+      o.confidence = confidence;
+      o.target_error = target;
+      const analytic::TerminationRow r = analytic::termination_run("plane", o);
+      std::printf("| %.0f%% | %.4f | %.5f | %.2f | %llu | %.1f | %s |\n", 100.0 * confidence, target,
+                  r.actual, target / r.actual, (unsigned long long)r.passes, r.seconds,
+                  r.stop_reason.c_str());
+      std::fflush(stdout);
+    }
+  }
+  std::printf("\n");
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string which = argc > 1 ? argv[1] : "all";
+  if (which == "all" || which == "coverage") coverage_table();
+  if (which == "all" || which == "termination") termination_table();
+  return 0;
+}
