@@ -68,6 +68,62 @@ PointEstimate estimate(const PointState& s, uint64_t passes, double photons_per_
   return e;
 }
 
+namespace {
+
+// CDF and density of Student's t (normal beyond 1e7 degrees of freedom, like the quantile).
+struct StudentT {
+  double nu;
+  double cdf(double x) const {
+    if (nu > 1e7) return boost::math::cdf(boost::math::normal_distribution<double>(), x);
+    return boost::math::cdf(boost::math::students_t_distribution<double>(nu), x);
+  }
+  double pdf(double x) const {
+    if (nu > 1e7) return boost::math::pdf(boost::math::normal_distribution<double>(), x);
+    return boost::math::pdf(boost::math::students_t_distribution<double>(nu), x);
+  }
+};
+
+}  // namespace
+
+BoundQuantile::BoundQuantile(double nu, double confidence)
+    : t_two_(student_t_quantile(nu, 0.5 + 0.5 * confidence)) {
+  const StudentT t{nu};
+  const double t_one = student_t_quantile(nu, confidence);
+  for (int k = 0; k < kTable; ++k) {
+    const double x = double(k) / double(kTable - k);  // u / (1 - u) with u = k / kTable
+    // Solve P(|x + T| <= q) = F(q - x) - F(-q - x) = confidence for q. The root lies between
+    // the one- and two-sided bounds; Newton steps from the upper end, kept inside the bracket,
+    // with a bisection step whenever Newton would leave it.
+    double lo = x + t_one, hi = x + t_two_, q = hi;
+    for (int it = 0; it < 50; ++it) {
+      const double g = t.cdf(q - x) - t.cdf(-q - x) - confidence;
+      if (g > 0.0) hi = q;
+      else lo = q;
+      const double slope = t.pdf(q - x) + t.pdf(-q - x);
+      double next = slope > 0.0 ? q - g / slope : 0.5 * (lo + hi);
+      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      if (std::fabs(next - q) <= 1e-12 * q || hi - lo <= 1e-12 * hi) {
+        q = next;
+        break;
+      }
+      q = next;
+    }
+    table_[k] = q - x;
+  }
+  table_[kTable] = t_one;  // x -> infinity: the far tail vanishes, one-sided quantile
+}
+
+double BoundQuantile::operator()(double bias, double sd) const {
+  const double b = std::fabs(bias);
+  if (!(sd > 0.0)) return b;
+  const double x = b / sd;
+  if (!std::isfinite(x)) return b + sd * table_[kTable];
+  const double pos = x / (1.0 + x) * kTable;
+  const int k = std::min(int(pos), kTable - 1);
+  const double f = pos - k;
+  return b + sd * (table_[k] * (1.0 - f) + table_[k + 1] * f);
+}
+
 double student_t_quantile(double nu, double p) {
   // Beyond 1e7 degrees of freedom the t and normal quantiles agree to ~1e-8 and Boost's t
   // evaluation loses accuracy; use the normal there.

@@ -49,8 +49,8 @@ FilmSummary develop(const EyePassResult& eye, const std::vector<PointState>& sta
   });
 
   // No bound exists before two passes (nu = i - 1 >= 1).
-  const double t = passes >= 2 ? student_t_quantile(double(passes - 1), 0.5 + 0.5 * s.confidence)
-                               : std::numeric_limits<double>::infinity();
+  const BoundQuantile quantile(double(std::max<uint64_t>(passes, 2) - 1), s.confidence);
+  const double t = quantile.two_sided_t();
   FilmSummary sum;
   double mean_radiance = 0.0;
   for (const PixelResult& r : results) mean_radiance += (r.radiance.x + r.radiance.y + r.radiance.z);
@@ -74,8 +74,9 @@ FilmSummary develop(const EyePassResult& eye, const std::vector<PointState>& sta
     dvec3 noise(0.0), bound(std::numeric_limits<double>::infinity());
     if (known_pixel) {
       // Pixels without points see only background or exact emission: bound 0.
-      noise = r.has_points ? t * glm::sqrt(r.variance) : dvec3(0.0);
-      bound = noise + glm::abs(r.bias);
+      const dvec3 sd = glm::sqrt(r.variance);
+      noise = r.has_points ? t * sd : dvec3(0.0);
+      for (int c = 0; c < 3; ++c) bound[c] = r.has_points ? quantile(r.bias[c], sd[c]) : 0.0;
       dvec3 metric = bound;
       if (s.metric == ErrorMetric::Relative)
         metric = bound / glm::max(r.radiance, dvec3(std::max(sum.relative_floor, 1e-300)));

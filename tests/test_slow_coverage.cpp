@@ -131,6 +131,9 @@ TEST(SlowCoverage, SyntheticDensityBoundsCoverNominalConfidence) {
         accumulate_pass(s, g, params, uint64_t(pass));
       }
       if (next_check < 3 && pass == checks[next_check]) {
+        // The bound the renderer reports (film.cpp): the quantile of |B + noise|.
+        const BoundQuantile quantiles[2] = {BoundQuantile(double(pass - 1), confidences[0]),
+                                            BoundQuantile(double(pass - 1), confidences[1])};
         for (size_t q = 0; q < points.size(); ++q) {
           const PointEstimate e = estimate(states[q], uint64_t(pass), kMe);
           ++total[next_check];
@@ -143,11 +146,11 @@ TEST(SlowCoverage, SyntheticDensityBoundsCoverNominalConfidence) {
           const int reg = region(points[q][0], points[q][1]);
           ++reg_n[next_check][reg];
           for (int ci = 0; ci < 2; ++ci) {
-            const double beta = 1.0 - confidences[ci];
-            const double t = student_t_quantile(double(pass - 1), 1.0 - beta / 2.0);
-            const double bound = t * std::sqrt(e.variance.x) + std::fabs(e.bias.x);
+            const BoundQuantile& quantile = quantiles[ci];
+            const double sd = std::sqrt(e.variance.x);
+            const double bound = quantile(e.bias.x, sd);
             sum_bound[next_check][ci] += bound;
-            if (err <= bound - std::fabs(e.bias.x)) ++noise_only[next_check][ci];
+            if (err <= quantile.two_sided_t() * sd) ++noise_only[next_check][ci];
             if (err <= bound) {
               ++covered[next_check][ci];
               ++reg_cov[next_check][reg][ci];

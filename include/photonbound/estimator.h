@@ -57,7 +57,27 @@ PointEstimate estimate(const PointState& state, uint64_t passes, double photons_
 // mean of the photon parts of X_j (ESTIMATOR.md section 3, key identity).
 dvec3 photon_radiance(const PointState& state, uint64_t passes, double photons_per_pass);
 
-// Two-sided Student-t quantile t_{nu, p} (Boost.Math), ESTIMATOR.md section 6. nu >= 1.
+// Student-t quantile t_{nu, p} (Boost.Math), ESTIMATOR.md section 6. nu >= 1.
 double student_t_quantile(double nu, double p);
+
+// Error bound half-width for an estimate whose error is its estimated bias B plus noise of
+// standard deviation s with nu degrees of freedom: the smallest q with
+// P(|B + s T_nu| <= q) = confidence. This is where photonbound departs from ESTIMATOR.md
+// section 4, which adds the two-sided noise half-width to |B|: that sum covers the noise on the
+// side away from B too, and is conservative by up to the difference between the two- and
+// one-sided quantiles (README "Error bounds"). q lies between |B| + s t_{nu,conf} and
+// |B| + s t_{nu,(1+conf)/2}; it equals the latter when B = 0.
+class BoundQuantile {
+ public:
+  BoundQuantile(double nu, double confidence);
+  double operator()(double bias, double sd) const;
+  double two_sided_t() const { return t_two_; }  // t_{nu, (1+conf)/2}: the noise half-width factor
+
+ private:
+  // (q/s - x) tabulated over u = x / (1 + x), x = |B| / s, u in [0, 1].
+  static constexpr int kTable = 256;
+  double table_[kTable + 1];
+  double t_two_;
+};
 
 }  // namespace pb
