@@ -4,7 +4,6 @@
 #include <cmath>
 #include <functional>
 #include <map>
-#include <sstream>
 
 namespace pb {
 
@@ -230,13 +229,14 @@ options:
 )";
 }
 
+std::string number_text(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
 std::vector<std::pair<std::string, std::string>> describe(const RenderOptions& o) {
-  auto num = [](double v) {
-    std::ostringstream s;
-    s.precision(17);
-    s << v;
-    return s.str();
-  };
+  const auto num = number_text;
   std::vector<std::pair<std::string, std::string>> d = {
       {"scene", o.scene},
       {"passes", o.passes ? std::to_string(*o.passes) : "none"},

@@ -1,20 +1,8 @@
 // Renderer::image: the EXR layout (README "Output") and its metadata.
 #include "photonbound/renderer.h"
 
-#include <sstream>
 
 namespace pb {
-
-namespace {
-
-std::string num(double v) {
-  std::ostringstream s;
-  s.precision(17);
-  s << v;
-  return s.str();
-}
-
-}  // namespace
 
 ExrImage Renderer::image(const RenderReport& report) const {
   FilmImage film;
@@ -50,10 +38,10 @@ ExrImage Renderer::image(const RenderReport& report) const {
       {"command_line", options_.command_line},
       {"passes_done", std::to_string(report.passes)},
       {"photons_emitted", std::to_string(report.photons)},
-      {"seconds", num(report.seconds)},
+      {"seconds", number_text(report.seconds)},
       {"stop_reason", report.stop_reason},
-      {"initial_radius", num(report.initial_radius)},
-      {"mean_error_bound", num(summary.mean_bound)},
+      {"initial_radius", number_text(report.initial_radius)},
+      {"mean_error_bound", number_text(summary.mean_bound)},
       {"unknown_pixels", std::to_string(summary.unknown_pixels)},
       {"measurement_points", std::to_string(eye_.points.size())},
   });

@@ -49,7 +49,8 @@ void termination_table() {
   std::printf("| confidence | target (specified) | actual mean error | specified / actual | passes | seconds | stop |\n");
   std::printf("|---|---|---|---|---|---|---|\n");
   for (double confidence : {0.5, 0.9}) {
-    for (double target : {0.02, 0.01, 0.005}) {
+    for (double target : confidence < 0.7 ? std::vector<double>{0.016, 0.008, 0.004}
+                                          : std::vector<double>{0.04, 0.02, 0.01}) {
       RenderOptions o = test::quick_options("plane_point.gltf", 32, 100000);
       o.passes.reset();
       o.direct = DirectMode::Photons;
@@ -65,11 +66,40 @@ void termination_table() {
   std::printf("\n");
 }
 
+// Optional stopping: how often a render stops with its actual mean error above the target.
+void stopping_table() {
+  const int kSeeds = 20;
+  std::printf("### Early stops over %d seeds (plane, 32x32, --direct photons)\n\n", kSeeds);
+  std::printf("| confidence | target | runs with actual > target | mean specified / actual | mean passes |\n");
+  std::printf("|---|---|---|---|---|\n");
+  for (const auto& [confidence, target] : {std::pair{0.5, 0.008}, std::pair{0.9, 0.02}}) {
+    int above = 0;
+    double ratio = 0.0, passes = 0.0;
+    for (int seed = 1; seed <= kSeeds; ++seed) {
+      RenderOptions o = test::quick_options("plane_point.gltf", 32, 1);
+      o.passes = 100000;
+      o.direct = DirectMode::Photons;
+      o.confidence = confidence;
+      o.target_error = target;
+      o.seed = uint64_t(seed) * 7919u;
+      const analytic::TerminationRow r = analytic::termination_run("plane", o);
+      above += r.actual > target;
+      ratio += target / r.actual / kSeeds;
+      passes += double(r.passes) / kSeeds;
+    }
+    std::printf("| %.0f%% | %.3f | %d / %d | %.2f | %.0f |\n", 100.0 * confidence, target, above,
+                kSeeds, ratio, passes);
+    std::fflush(stdout);
+  }
+  std::printf("\n");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   const std::string which = argc > 1 ? argv[1] : "all";
   if (which == "all" || which == "coverage") coverage_table();
   if (which == "all" || which == "termination") termination_table();
+  if (which == "all" || which == "stopping") stopping_table();
   return 0;
 }

@@ -73,6 +73,9 @@ void validate(const RenderOptions& options);
 // The --help text.
 std::string usage_text();
 
+// Shortest text that reads back as the same double (metadata, messages).
+std::string number_text(double v);
+
 // "name=value" pairs of every option, for the EXR metadata and the progress header.
 std::vector<std::pair<std::string, std::string>> describe(const RenderOptions& options);
 
