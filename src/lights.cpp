@@ -28,6 +28,52 @@ vec3 punctual_power(const PunctualLight& l) {
 
 }  // namespace
 
+bool sample_spherical_triangle(const vec3& v0, const vec3& v1, const vec3& v2, const vec3& p,
+                               float u0, float u1, vec3& dir, float& solid_angle) {
+  // Arvo 1995, "Stratified sampling of spherical triangles", in the form of pbrt-v4's
+  // SampleSphericalTriangle, in double: the arcs and angles lose float precision quickly.
+  using glm::dvec3;
+  const dvec3 a = glm::normalize(dvec3(v0) - dvec3(p));
+  const dvec3 b = glm::normalize(dvec3(v1) - dvec3(p));
+  const dvec3 c = glm::normalize(dvec3(v2) - dvec3(p));
+  dvec3 n_ab = glm::cross(a, b), n_bc = glm::cross(b, c), n_ca = glm::cross(c, a);
+  const double l_ab = glm::length(n_ab), l_bc = glm::length(n_bc), l_ca = glm::length(n_ca);
+  if (!(l_ab > 1e-12 && l_bc > 1e-12 && l_ca > 1e-12)) return false;
+  n_ab /= l_ab;
+  n_bc /= l_bc;
+  n_ca /= l_ca;
+  auto angle = [](const dvec3& x, const dvec3& y) {
+    return std::acos(std::clamp(glm::dot(x, y), -1.0, 1.0));
+  };
+  const double alpha = angle(n_ab, -n_ca), beta = angle(n_bc, -n_ab), gamma = angle(n_ca, -n_bc);
+  const double area = alpha + beta + gamma - kPiD;  // spherical excess = solid angle
+  // Below this the excess is dominated by rounding; above 2 pi - eps the receiver is almost in
+  // the triangle's plane. Both fall back to area sampling.
+  if (!(area > 3e-4 && area < 6.22)) return false;
+
+  // Choose the sub-triangle area A' uniformly, then the point on arc b-c' for it.
+  const double ap_pi = kPiD + double(u0) * area;  // A' + pi
+  const double cos_alpha = std::cos(alpha), sin_alpha = std::sin(alpha);
+  const double sin_phi = std::sin(ap_pi) * cos_alpha - std::cos(ap_pi) * sin_alpha;
+  const double cos_phi = std::cos(ap_pi) * cos_alpha + std::sin(ap_pi) * sin_alpha;
+  const double k1 = cos_phi + cos_alpha;
+  const double k2 = sin_phi - sin_alpha * glm::dot(a, b);
+  double cos_bp = (k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha) / ((k2 * sin_phi + k1 * cos_phi) * sin_alpha);
+  cos_bp = std::clamp(cos_bp, -1.0, 1.0);
+  const double sin_bp = std::sqrt(std::max(0.0, 1.0 - cos_bp * cos_bp));
+  const dvec3 c_perp = c - glm::dot(c, a) * a;
+  if (!(glm::length(c_perp) > 0.0)) return false;
+  const dvec3 cp = cos_bp * a + sin_bp * glm::normalize(c_perp);
+  const double cos_theta = 1.0 - double(u1) * (1.0 - glm::dot(cp, b));
+  const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
+  const dvec3 cp_perp = cp - glm::dot(cp, b) * b;
+  const double l = glm::length(cp_perp);
+  const dvec3 w = l > 0.0 ? cos_theta * b + sin_theta * (cp_perp / l) : b;
+  dir = vec3(glm::normalize(w));
+  solid_angle = float(area);
+  return std::isfinite(dir.x) && std::isfinite(dir.y) && std::isfinite(dir.z);
+}
+
 Lights::Lights(const Scene& scene) : punctual_(scene.lights) {
   for (const Mesh& mesh : scene.meshes) {
     const Material& mat = scene.materials[mesh.material];
@@ -112,9 +158,54 @@ EmittedPhoton Lights::sample_photon(Rng& rng) const {
   return ph;
 }
 
+float Lights::local_weight(size_t k, const vec3& receiver) const {
+  if (k < punctual_.size()) {
+    const PunctualLight& l = punctual_[k];
+    const vec3 d = l.position - receiver;
+    const float dist2 = glm::dot(d, d);
+    if (!(dist2 > 0.0f)) return 0.0f;
+    return average(spot_falloff(l, -d / std::sqrt(dist2))) / dist2;
+  }
+  const Triangle& t = triangles_[k - punctual_.size()];
+  const vec3 a = t.p0 - receiver, b = a + t.e1, c = a + t.e2;
+  if (glm::dot(a, t.normal) >= 0.0f) return 0.0f;  // receiver behind the one-sided emitter
+  // Solid angle (Van Oosterom & Strackee 1983): tan(omega / 2) = |a.(b x c)| / denominator.
+  const float la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
+  const float num = std::fabs(glm::dot(a, glm::cross(b, c)));
+  const float den = la * lb * lc + glm::dot(a, b) * lc + glm::dot(a, c) * lb + glm::dot(b, c) * la;
+  const float omega = 2.0f * std::atan2(num, den);
+  return average(t.radiance) * std::max(omega, 0.0f);
+}
+
 bool Lights::sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) const {
-  const size_t k = pick(rng.next_float());
-  const float p_pick = probability_[k];
+  size_t k = 0;
+  float p_pick = 0.0f;
+  const float u0 = rng.next_float();
+  if (emitter_count() <= kLocalSelectionMax) {
+    // Few emitters: choose in proportion to radiance x solid angle (or intensity / d^2) seen
+    // from this receiver, so that an emitter close to the receiver is chosen as often as it
+    // matters. With power-proportional choice its rare picks carry huge weights, and the
+    // per-pass samples become heavy-tailed, which breaks the t-interval of the error bound.
+    float weights[kLocalSelectionMax];
+    float sum = 0.0f;
+    for (size_t j = 0; j < emitter_count(); ++j) sum += (weights[j] = local_weight(j, receiver));
+    if (!(sum > 0.0f) || !std::isfinite(sum)) return false;
+    float target = u0 * sum;
+    k = emitter_count() - 1;
+    for (size_t j = 0; j < emitter_count(); ++j) {
+      if (target < weights[j]) {
+        k = j;
+        break;
+      }
+      target -= weights[j];
+    }
+    while (weights[k] == 0.0f && k > 0) --k;  // rounding at the end of the list
+    p_pick = weights[k] / sum;
+    if (!(p_pick > 0.0f)) return false;
+  } else {
+    k = pick(u0);
+    p_pick = probability_[k];
+  }
   const float u1 = rng.next_float(), u2 = rng.next_float();
   if (k < punctual_.size()) {
     const PunctualLight& l = punctual_[k];
@@ -127,6 +218,22 @@ bool Lights::sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) co
     return max_component(out.li) > 0.0f;
   }
   const Triangle& t = triangles_[k - punctual_.size()];
+  const vec3 p1 = t.p0 + t.e1, p2 = t.p0 + t.e2;
+  // A receiver on the emitter's back side or in its plane sees no light from it.
+  if (glm::dot(receiver - t.p0, t.normal) <= 0.0f) return false;
+  vec3 dir;
+  float solid_angle = 0.0f;
+  if (sample_spherical_triangle(t.p0, p1, p2, receiver, u1, u2, dir, solid_angle)) {
+    // Uniform in solid angle: each sample carries Le times the solid angle, bounded even when
+    // the emitter nearly touches the receiver (area sampling is heavy-tailed there).
+    const float dist = glm::dot(t.p0 - receiver, t.normal) / glm::dot(dir, t.normal);
+    if (!(dist > 0.0f) || !std::isfinite(dist)) return false;
+    out.wi = dir;
+    out.distance = dist;
+    out.li = t.radiance * (solid_angle / p_pick);
+    return true;
+  }
+  // Tiny or degenerate solid angle: uniform area sampling (pbrt-v4 does the same).
   const float s = std::sqrt(u1);
   const vec3 y = t.p0 + (1.0f - s) * t.e1 + (u2 * s) * t.e2;
   const vec3 d = y - receiver;

@@ -38,6 +38,14 @@ TEST(SlowBounds, CoverageOnClosedEmittingBox) {
   expect_coverage("box", o);
 }
 
+// The default mode: one next-event sample per point and pass (emitters chosen by solid angle at
+// the receiver) plus photons after their first bounce.
+TEST(SlowBounds, CoverageOnClosedEmittingBoxWithNextEvent) {
+  RenderOptions o = test::quick_options("closed_box.gltf", 64, 256);
+  o.photons_per_pass = 25000;
+  expect_coverage("box", o);
+}
+
 // Three targets halving in turn: the actual mean error at the stop is below the target in every
 // run, and at 50% confidence the target is at most 1.5x the actual error (HJJ10 report 1.3-1.4).
 void expect_termination(double confidence, std::initializer_list<double> targets, double max_ratio) {

@@ -22,6 +22,12 @@ struct DirectSample {
   vec3 li{0.0f};       // incident radiance times geometry over pdf, without the receiver's cosine
 };
 
+// Direction from p uniform in the solid angle the triangle (v0, v1, v2) subtends, from two
+// uniform numbers. False when the solid angle is too small or too close to 2 pi to sample
+// reliably (the caller then samples by area).
+bool sample_spherical_triangle(const vec3& v0, const vec3& v1, const vec3& v2, const vec3& p,
+                               float u0, float u1, vec3& dir, float& solid_angle);
+
 class Lights {
  public:
   explicit Lights(const Scene& scene);
@@ -43,6 +49,9 @@ class Lights {
   };
   // Emitter k < punctual_.size() is a punctual light, the rest are triangles.
   size_t pick(float u) const;
+  // Next-event choice weight of emitter k at a receiver (used for small emitter sets).
+  float local_weight(size_t k, const vec3& receiver) const;
+  static constexpr size_t kLocalSelectionMax = 32;
   vec3 spot_falloff(const PunctualLight& light, const vec3& dir) const;
 
   std::vector<PunctualLight> punctual_;
