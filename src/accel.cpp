@@ -44,9 +44,9 @@ Accel::Accel(const Scene& scene) : impl_(std::make_unique<Impl>()) {
     auto* v = static_cast<float*>(rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_VERTEX, 0,
                                                           RTC_FORMAT_FLOAT3, sizeof(float) * 3,
                                                           mesh.positions.size()));
-    auto* idx = static_cast<uint32_t*>(rtcSetNewGeometryBuffer(
-        geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3, sizeof(uint32_t) * 3,
-        mesh.indices.size() / 3));
+    auto* idx = static_cast<uint32_t*>(
+        rtcSetNewGeometryBuffer(geom, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
+                                sizeof(uint32_t) * 3, mesh.indices.size() / 3));
     check(impl_->device, "geometry allocation");
     for (size_t i = 0; i < mesh.positions.size(); ++i) {
       v[3 * i + 0] = mesh.positions[i].x;

@@ -73,7 +73,8 @@ CompareResult compare_images(const ExrImage& a, const ExrImage& ref, const std::
     r.coverage = double(covered) / double(r.bounded);
     r.mean_bound = bound_sum / double(r.bounded);
     r.mean_bounded_error = bounded_err / double(r.bounded);
-    r.bound_over_error = r.mean_bounded_error > 0.0 ? r.mean_bound / r.mean_bounded_error : INFINITY;
+    r.bound_over_error =
+        r.mean_bounded_error > 0.0 ? r.mean_bound / r.mean_bounded_error : INFINITY;
     r.bias_dominated = double(bias_pixels) / double(bounded_pixels);
   }
   return r;

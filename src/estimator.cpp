@@ -94,15 +94,19 @@ BoundQuantile::BoundQuantile(double nu, double confidence)
     // Solve P(|x + T| <= q) = F(q - x) - F(-q - x) = confidence for q. The root lies between
     // the one- and two-sided bounds; Newton steps from the upper end, kept inside the bracket,
     // with a bisection step whenever Newton would leave it.
-    double lo = x + t_one, hi = x + t_two_, q = hi;
+    // Warm start from the previous node: q - x changes slowly with x.
+    double lo = x + t_one, hi = x + t_two_;
+    double q = k == 0 ? hi : std::clamp(x + table_[k - 1], lo, hi);
     for (int it = 0; it < 50; ++it) {
       const double g = t.cdf(q - x) - t.cdf(-q - x) - confidence;
-      if (g > 0.0) hi = q;
-      else lo = q;
+      if (g > 0.0)
+        hi = q;
+      else
+        lo = q;
       const double slope = t.pdf(q - x) + t.pdf(-q - x);
       double next = slope > 0.0 ? q - g / slope : 0.5 * (lo + hi);
       if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-      if (std::fabs(next - q) <= 1e-12 * q || hi - lo <= 1e-12 * hi) {
+      if (std::fabs(next - q) <= 1e-10 * q || hi - lo <= 1e-10 * hi) {
         q = next;
         break;
       }

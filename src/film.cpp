@@ -53,7 +53,8 @@ FilmSummary develop(const EyePassResult& eye, const std::vector<PointState>& sta
   const double t = quantile.two_sided_t();
   FilmSummary sum;
   double mean_radiance = 0.0;
-  for (const PixelResult& r : results) mean_radiance += (r.radiance.x + r.radiance.y + r.radiance.z);
+  for (const PixelResult& r : results)
+    mean_radiance += (r.radiance.x + r.radiance.y + r.radiance.z);
   mean_radiance /= 3.0 * double(std::max<size_t>(pixels, 1));
   sum.relative_floor = kRelativeFloor * mean_radiance;
 

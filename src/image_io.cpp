@@ -2,12 +2,12 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <unistd.h>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
 namespace pb {
 
@@ -17,7 +17,8 @@ std::string temporary_name(const std::string& path) {
   const std::filesystem::path p(path);
   // Keep the extension: OpenImageIO picks the writer from it.
   const std::string ext = p.extension().string().empty() ? ".exr" : p.extension().string();
-  const std::string name = "." + p.stem().string() + ".tmp" + std::to_string(::getpid()) + ext;
+  std::string name = ".";  // appended piecewise: GCC 12 misreports operator+ chains (-Wrestrict)
+  name.append(p.stem().string()).append(".tmp").append(std::to_string(::getpid())).append(ext);
   return (p.parent_path() / name).string();
 }
 
@@ -33,7 +34,8 @@ void write_atomic(const std::string& path, const OIIO::ImageSpec& spec, const vo
                   OIIO::TypeDesc type) {
   const std::string tmp = temporary_name(path);
   auto out = OIIO::ImageOutput::create(tmp);
-  if (!out) throw ImageError(path + ": cannot create an image writer: " + one_line(OIIO::geterror()));
+  if (!out)
+    throw ImageError(path + ": cannot create an image writer: " + one_line(OIIO::geterror()));
   bool ok = out->open(tmp, spec) && out->write_image(type, data);
   ok = out->close() && ok;
   if (!ok) {
@@ -67,7 +69,8 @@ void check_writable(const std::string& path) {
 }
 
 void write_exr(const std::string& path, const ExrImage& image) {
-  OIIO::ImageSpec spec(image.width, image.height, int(image.channels.size()), OIIO::TypeDesc::FLOAT);
+  OIIO::ImageSpec spec(image.width, image.height, int(image.channels.size()),
+                       OIIO::TypeDesc::FLOAT);
   spec.channelnames = image.channels;
   spec.alpha_channel = -1;
   spec.attribute("compression", "zip");
@@ -75,7 +78,8 @@ void write_exr(const std::string& path, const ExrImage& image) {
   write_atomic(path, spec, image.pixels.data(), OIIO::TypeDesc::FLOAT);
 }
 
-void write_png(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb) {
+void write_png(const std::string& path, int width, int height,
+               const std::vector<unsigned char>& rgb) {
   OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
   write_atomic(path, spec, rgb.data(), OIIO::TypeDesc::UINT8);
 }

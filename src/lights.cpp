@@ -9,7 +9,8 @@ namespace pb {
 
 namespace {
 
-// KHR_lights_punctual recommended spot attenuation: a linear ramp in cos between the cones, squared.
+// KHR_lights_punctual recommended spot attenuation: a linear ramp in cos between the cones,
+// squared.
 float spot_attenuation(const PunctualLight& l, float cos_angle) {
   if (l.kind == PunctualKind::Point) return 1.0f;
   const float span = std::max(l.cos_inner - l.cos_outer, 1e-4f);
@@ -25,6 +26,10 @@ vec3 punctual_power(const PunctualLight& l) {
   const float span = std::max(l.cos_inner - l.cos_outer, 0.0f);
   return 2.0f * kPi * l.intensity * (span / 3.0f + (1.0f - l.cos_inner));
 }
+
+// Receivers closer to a triangle's centroid than this many times its longest edge from vertex 0
+// (squared) sample it by solid angle.
+constexpr float kNearFactor2 = 4.0f * 4.0f;
 
 }  // namespace
 
@@ -58,7 +63,8 @@ bool sample_spherical_triangle(const vec3& v0, const vec3& v1, const vec3& v2, c
   const double cos_phi = std::cos(ap_pi) * cos_alpha + std::sin(ap_pi) * sin_alpha;
   const double k1 = cos_phi + cos_alpha;
   const double k2 = sin_phi - sin_alpha * glm::dot(a, b);
-  double cos_bp = (k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha) / ((k2 * sin_phi + k1 * cos_phi) * sin_alpha);
+  double cos_bp = (k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha) /
+                  ((k2 * sin_phi + k1 * cos_phi) * sin_alpha);
   cos_bp = std::clamp(cos_bp, -1.0, 1.0);
   const double sin_bp = std::sqrt(std::max(0.0, 1.0 - cos_bp * cos_bp));
   const dvec3 c_perp = c - glm::dot(c, a) * a;
@@ -223,7 +229,12 @@ bool Lights::sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) co
   if (glm::dot(receiver - t.p0, t.normal) <= 0.0f) return false;
   vec3 dir;
   float solid_angle = 0.0f;
-  if (sample_spherical_triangle(t.p0, p1, p2, receiver, u1, u2, dir, solid_angle)) {
+  // Solid-angle sampling only pays near the emitter: from farther than a few times its size,
+  // area sampling is already close to uniform in solid angle, and much cheaper.
+  const vec3 to_centroid = t.p0 + (t.e1 + t.e2) * (1.0f / 3.0f) - receiver;
+  const float size2 = std::max(glm::dot(t.e1, t.e1), glm::dot(t.e2, t.e2));
+  const bool near = glm::dot(to_centroid, to_centroid) < kNearFactor2 * size2;
+  if (near && sample_spherical_triangle(t.p0, p1, p2, receiver, u1, u2, dir, solid_angle)) {
     // Uniform in solid angle: each sample carries Le times the solid angle, bounded even when
     // the emitter nearly touches the receiver (area sampling is heavy-tailed there).
     const float dist = glm::dot(t.p0 - receiver, t.normal) / glm::dot(dir, t.normal);

@@ -7,13 +7,13 @@
 #include "photonbound/parallel.h"
 #include "photonbound/renderer.h"
 
+#include <unistd.h>
 #include <algorithm>
 #include <atomic>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <iostream>
-#include <unistd.h>
 
 namespace {
 
@@ -50,8 +50,8 @@ int render(const pb::RenderOptions& options) {
 }
 
 int compare(const pb::CompareOptions& o) {
-  const pb::CompareResult r = pb::compare_images(pb::read_exr(o.render), pb::read_exr(o.reference),
-                                                 o.render, o.reference);
+  const pb::CompareResult r =
+      pb::compare_images(pb::read_exr(o.render), pb::read_exr(o.reference), o.render, o.reference);
   std::cout << (o.json ? pb::to_json(r) : pb::to_text(r));
   return 0;
 }

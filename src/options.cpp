@@ -18,8 +18,7 @@ uint64_t parse_uint(const std::string& flag, const std::string& text, uint64_t l
   if (text.empty() || ec == std::errc::result_out_of_range)
     fail(flag + ": '" + text + "' is not a whole number in [" + std::to_string(lo) + ", " +
          std::to_string(hi) + "]");
-  if (ec != std::errc() || ptr != end)
-    fail(flag + ": '" + text + "' is not a whole number");
+  if (ec != std::errc() || ptr != end) fail(flag + ": '" + text + "' is not a whole number");
   if (v < lo || v > hi)
     fail(flag + ": " + text + " is out of range [" + std::to_string(lo) + ", " +
          std::to_string(hi) + "]");
@@ -53,17 +52,24 @@ const std::map<std::string, Setter>& value_flags() {
        [](RenderOptions& o, const std::string& v) {
          o.passes = parse_uint("--passes", v, 1, 1000000000000ULL);
        }},
-      {"--time", [](RenderOptions& o, const std::string& v) { o.time_seconds = parse_real("--time", v); }},
+      {"--time",
+       [](RenderOptions& o, const std::string& v) { o.time_seconds = parse_real("--time", v); }},
       {"--target-error",
-       [](RenderOptions& o, const std::string& v) { o.target_error = parse_real("--target-error", v); }},
+       [](RenderOptions& o, const std::string& v) {
+         o.target_error = parse_real("--target-error", v);
+       }},
       {"--photons-per-pass",
        [](RenderOptions& o, const std::string& v) {
          o.photons_per_pass = parse_uint("--photons-per-pass", v, 1, 1000000000ULL);
        }},
-      {"--alpha", [](RenderOptions& o, const std::string& v) { o.alpha = parse_real("--alpha", v); }},
-      {"--radius", [](RenderOptions& o, const std::string& v) { o.radius = parse_real("--radius", v); }},
+      {"--alpha",
+       [](RenderOptions& o, const std::string& v) { o.alpha = parse_real("--alpha", v); }},
+      {"--radius",
+       [](RenderOptions& o, const std::string& v) { o.radius = parse_real("--radius", v); }},
       {"--max-depth",
-       [](RenderOptions& o, const std::string& v) { o.max_depth = int(parse_uint("--max-depth", v, 0, 32)); }},
+       [](RenderOptions& o, const std::string& v) {
+         o.max_depth = int(parse_uint("--max-depth", v, 0, 32));
+       }},
       {"--resolution", [](RenderOptions& o, const std::string& v) { parse_resolution(v, o); }},
       {"--camera",
        [](RenderOptions& o, const std::string& v) {
@@ -71,26 +77,34 @@ const std::map<std::string, Setter>& value_flags() {
          o.camera = v;
        }},
       {"--threads",
-       [](RenderOptions& o, const std::string& v) { o.threads = int(parse_uint("--threads", v, 0, 1024)); }},
-      {"--seed",
-       [](RenderOptions& o, const std::string& v) { o.seed = parse_uint("--seed", v, 0, UINT64_MAX); }},
+       [](RenderOptions& o, const std::string& v) {
+         o.threads = int(parse_uint("--threads", v, 0, 1024));
+       }},
+      {"--seed", [](RenderOptions& o,
+                    const std::string& v) { o.seed = parse_uint("--seed", v, 0, UINT64_MAX); }},
       {"--direct",
        [](RenderOptions& o, const std::string& v) {
-         if (v == "nee") o.direct = DirectMode::NextEvent;
-         else if (v == "photons") o.direct = DirectMode::Photons;
-         else fail("--direct: '" + v + "' is not one of nee, photons");
+         if (v == "nee")
+           o.direct = DirectMode::NextEvent;
+         else if (v == "photons")
+           o.direct = DirectMode::Photons;
+         else
+           fail("--direct: '" + v + "' is not one of nee, photons");
        }},
-      {"--confidence",
-       [](RenderOptions& o, const std::string& v) { o.confidence = parse_real("--confidence", v); }},
+      {"--confidence", [](RenderOptions& o,
+                          const std::string& v) { o.confidence = parse_real("--confidence", v); }},
       {"--min-passes",
        [](RenderOptions& o, const std::string& v) {
          o.min_passes = parse_uint("--min-passes", v, 2, 1000000000000ULL);
        }},
       {"--error-metric",
        [](RenderOptions& o, const std::string& v) {
-         if (v == "absolute") o.metric = ErrorMetric::Absolute;
-         else if (v == "relative") o.metric = ErrorMetric::Relative;
-         else fail("--error-metric: '" + v + "' is not one of absolute, relative");
+         if (v == "absolute")
+           o.metric = ErrorMetric::Absolute;
+         else if (v == "relative")
+           o.metric = ErrorMetric::Relative;
+         else
+           fail("--error-metric: '" + v + "' is not one of absolute, relative");
        }},
   };
   return flags;
@@ -127,8 +141,10 @@ PreviewOptions parse_preview(int argc, const char* const* argv, int first) {
     if (arg == "-o" || arg == "--exposure") {
       if (k + 1 >= argc) fail(arg + ": missing value");
       const std::string v = argv[++k];
-      if (arg == "-o") o.output = v;
-      else o.exposure = parse_real("--exposure", v);
+      if (arg == "-o")
+        o.output = v;
+      else
+        o.exposure = parse_real("--exposure", v);
     } else if (!arg.empty() && arg[0] == '-') {
       fail("unknown option '" + arg + "' (see photonbound --help)");
     } else if (o.input.empty()) {
@@ -137,7 +153,8 @@ PreviewOptions parse_preview(int argc, const char* const* argv, int first) {
       fail("unexpected argument '" + arg + "'");
     }
   }
-  if (o.input.empty() || o.output.empty()) fail("preview: usage: photonbound preview IN.exr -o OUT.png");
+  if (o.input.empty() || o.output.empty())
+    fail("preview: usage: photonbound preview IN.exr -o OUT.png");
   if (std::fabs(o.exposure) > 64.0) fail("--exposure: must be in [-64, 64] stops");
   return o;
 }
@@ -147,11 +164,15 @@ CompareOptions parse_compare(int argc, const char* const* argv, int first) {
   std::vector<std::string> files;
   for (int k = first; k < argc; ++k) {
     const std::string arg = argv[k];
-    if (arg == "--json") o.json = true;
-    else if (!arg.empty() && arg[0] == '-') fail("unknown option '" + arg + "' (see photonbound --help)");
-    else files.push_back(arg);
+    if (arg == "--json")
+      o.json = true;
+    else if (!arg.empty() && arg[0] == '-')
+      fail("unknown option '" + arg + "' (see photonbound --help)");
+    else
+      files.push_back(arg);
   }
-  if (files.size() != 2) fail("compare: usage: photonbound compare RENDER.exr REFERENCE.exr [--json]");
+  if (files.size() != 2)
+    fail("compare: usage: photonbound compare RENDER.exr REFERENCE.exr [--json]");
   o.render = files[0];
   o.reference = files[1];
   return o;
@@ -166,8 +187,7 @@ void validate(const RenderOptions& o) {
     fail("render: no stop condition: give --passes, --time or --target-error");
   if (o.time_seconds && !(*o.time_seconds > 0.0 && *o.time_seconds <= 1e9))
     fail("--time: must be in (0, 1e9] seconds");
-  if (o.target_error && !(*o.target_error > 0.0))
-    fail("--target-error: must be greater than 0");
+  if (o.target_error && !(*o.target_error > 0.0)) fail("--target-error: must be greater than 0");
   if (!(o.alpha > 0.0 && o.alpha <= 1.0)) fail("--alpha: must be in (0, 1]");
   if (o.radius && !(*o.radius > 0.0 && *o.radius < 1e30)) fail("--radius: must be in (0, 1e30)");
   if (!(o.confidence > 0.0 && o.confidence < 1.0)) fail("--confidence: must be in (0, 1)");

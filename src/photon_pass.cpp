@@ -16,8 +16,8 @@ constexpr size_t kChunk = 2048;
 PhotonTracer::PhotonTracer(const World& world, bool deposit_first_hit)
     : world_(world), deposit_first_hit_(deposit_first_hit) {}
 
-void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index,
-                         std::vector<PhotonHit>& out, uint64_t& rays) const {
+void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, std::vector<PhotonHit>& out,
+                         uint64_t& rays) const {
   Rng rng(seed, pass, index, Stream::Photon);
   const EmittedPhoton e = world_.lights().sample_photon(rng);
   vec3 origin = e.origin, dir = e.dir, flux = e.flux, origin_normal = e.normal;

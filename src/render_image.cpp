@@ -1,7 +1,6 @@
 // Renderer::image: the EXR layout (README "Output") and its metadata.
 #include "photonbound/renderer.h"
 
-
 namespace pb {
 
 ExrImage Renderer::image(const RenderReport& report) const {
@@ -13,8 +12,11 @@ ExrImage Renderer::image(const RenderReport& report) const {
   out.height = film.height;
   // Each RGB quantity becomes three channels "<Name>.R/G/B"; radiance is plain R, G, B.
   const std::vector<std::pair<std::string, const std::vector<float>*>> rgb = {
-      {"", &film.radiance}, {"ErrorBound.", &film.bound}, {"Bias.", &film.bias},
-      {"Noise.", &film.noise}, {"Variance.", &film.variance}};
+      {"", &film.radiance},
+      {"ErrorBound.", &film.bound},
+      {"Bias.", &film.bias},
+      {"Noise.", &film.noise},
+      {"Variance.", &film.variance}};
   for (const auto& [prefix, data] : rgb)
     for (const char* c : {"R", "G", "B"}) out.channels.push_back(prefix + c);
   out.channels.push_back("Photons");
@@ -33,18 +35,19 @@ ExrImage Renderer::image(const RenderReport& report) const {
   }
 
   out.metadata = describe(options_);
-  out.metadata.insert(out.metadata.end(), {
-      {"version", PHOTONBOUND_VERSION},
-      {"command_line", options_.command_line},
-      {"passes_done", std::to_string(report.passes)},
-      {"photons_emitted", std::to_string(report.photons)},
-      {"seconds", number_text(report.seconds)},
-      {"stop_reason", report.stop_reason},
-      {"initial_radius", number_text(report.initial_radius)},
-      {"mean_error_bound", number_text(summary.mean_bound)},
-      {"unknown_pixels", std::to_string(summary.unknown_pixels)},
-      {"measurement_points", std::to_string(eye_.points.size())},
-  });
+  out.metadata.insert(out.metadata.end(),
+                      {
+                          {"version", PHOTONBOUND_VERSION},
+                          {"command_line", options_.command_line},
+                          {"passes_done", std::to_string(report.passes)},
+                          {"photons_emitted", std::to_string(report.photons)},
+                          {"seconds", number_text(report.seconds)},
+                          {"stop_reason", report.stop_reason},
+                          {"initial_radius", number_text(report.initial_radius)},
+                          {"mean_error_bound", number_text(summary.mean_bound)},
+                          {"unknown_pixels", std::to_string(summary.unknown_pixels)},
+                          {"measurement_points", std::to_string(eye_.points.size())},
+                      });
   return out;
 }
 

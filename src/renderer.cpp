@@ -27,10 +27,14 @@ constexpr double kMinRadiusFraction = 1e-6;
 
 std::string format_count(double v) {
   char buf[32];
-  if (v >= 1e9) std::snprintf(buf, sizeof buf, "%.2fG", v / 1e9);
-  else if (v >= 1e6) std::snprintf(buf, sizeof buf, "%.2fM", v / 1e6);
-  else if (v >= 1e3) std::snprintf(buf, sizeof buf, "%.1fk", v / 1e3);
-  else std::snprintf(buf, sizeof buf, "%.0f", v);
+  if (v >= 1e9)
+    std::snprintf(buf, sizeof buf, "%.2fG", v / 1e9);
+  else if (v >= 1e6)
+    std::snprintf(buf, sizeof buf, "%.2fM", v / 1e6);
+  else if (v >= 1e3)
+    std::snprintf(buf, sizeof buf, "%.1fk", v / 1e3);
+  else
+    std::snprintf(buf, sizeof buf, "%.0f", v);
   return buf;
 }
 
@@ -44,7 +48,9 @@ PinholeCamera choose_camera(const Scene& scene, const RenderOptions& o) {
       break;
     }
   }
-  if (!cam) throw UsageError("--camera: " + scene.source + " has no perspective camera named '" + o.camera + "'");
+  if (!cam)
+    throw UsageError("--camera: " + scene.source + " has no perspective camera named '" + o.camera +
+                     "'");
   int w = 512, h = 512;
   if (o.width && o.height) {
     w = *o.width;
@@ -151,8 +157,10 @@ RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress
     }
 
     if (options_.passes && pass >= *options_.passes) report.stop_reason = "passes";
-    if (options_.time_seconds && report.seconds >= *options_.time_seconds) report.stop_reason = "time";
-    if (check && report.summary.mean_bound <= *options_.target_error) report.stop_reason = "target-error";
+    if (options_.time_seconds && report.seconds >= *options_.time_seconds)
+      report.stop_reason = "time";
+    if (check && report.summary.mean_bound <= *options_.target_error)
+      report.stop_reason = "target-error";
     if (check && options_.alpha >= 1.0 && options_.metric == ErrorMetric::Absolute &&
         report.summary.mean_abs_bias >= *options_.target_error)
       report.stop_reason = "unreachable: alpha = 1 keeps the bias above the target";
@@ -179,7 +187,8 @@ RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress
       if (options_.target_error && early_pass > 0 && pass > early_pass &&
           s.mean_bound < early_bound && s.mean_bound > *options_.target_error) {
         const double k = std::log(early_bound / s.mean_bound) / std::log(double(pass) / early_pass);
-        const double needed = double(pass) * std::pow(s.mean_bound / *options_.target_error, 1.0 / k);
+        const double needed =
+            double(pass) * std::pow(s.mean_bound / *options_.target_error, 1.0 / k);
         left = std::min(left, (needed - double(pass)) * per_pass);
       }
       if (std::isfinite(left)) line << " | ~" << std::max(0.0, left) << " s left";

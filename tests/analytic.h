@@ -36,9 +36,9 @@ inline Case by_name(const std::string& name) {
 // Actual error and coverage of a render against the exact answer, over pixel-channels with a
 // known, nonzero bound (each of these scenes has one measurement point per pixel).
 struct Accuracy {
-  double mean_abs_error = 0.0;   // mean over pixels and channels of |L - L_exact|
-  double mean_bound = 0.0;       // mean over the same of the bound
-  double coverage = 0.0;         // fraction with |L - L_exact| <= bound
+  double mean_abs_error = 0.0;  // mean over pixels and channels of |L - L_exact|
+  double mean_bound = 0.0;      // mean over the same of the bound
+  double coverage = 0.0;        // fraction with |L - L_exact| <= bound
   size_t samples = 0;
 };
 
@@ -106,8 +106,8 @@ struct TerminationRow {
   double confidence = 0.0;
   uint64_t passes = 0;
   double seconds = 0.0;
-  double mean_bound = 0.0;   // the renderer's own image mean bound at the stop
-  double actual = 0.0;       // mean over pixels and channels of |L - L_exact|
+  double mean_bound = 0.0;  // the renderer's own image mean bound at the stop
+  double actual = 0.0;      // mean over pixels and channels of |L - L_exact|
   std::string stop_reason;
 };
 

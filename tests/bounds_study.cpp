@@ -12,11 +12,12 @@ using namespace pb;
 
 void coverage_table() {
   std::printf("### Coverage against the exact answer (64x64, 4 seeds pooled)\n\n");
-  std::printf("| scene | direct | passes | confidence | mean actual error | mean bound | bound / actual | coverage |\n");
+  std::printf(
+      "| scene | direct | passes | confidence | mean actual error | mean bound | bound / actual | "
+      "coverage |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
-  const std::pair<const char*, DirectMode> cases[] = {{"plane", DirectMode::Photons},
-                                                       {"box", DirectMode::Photons},
-                                                       {"box", DirectMode::NextEvent}};
+  const std::pair<const char*, DirectMode> cases[] = {
+      {"plane", DirectMode::Photons}, {"box", DirectMode::Photons}, {"box", DirectMode::NextEvent}};
   for (const auto& [name, mode] : cases) {
     std::vector<analytic::CoverageRow> pooled;
     for (uint64_t seed = 1; seed <= 4; ++seed) {
@@ -40,17 +41,19 @@ void coverage_table() {
     }
     for (const auto& r : pooled)
       std::printf("| %s | %s | %llu | %.0f%% | %.5f | %.5f | %.2f | %.3f |\n", r.scene.c_str(),
-                  mode == DirectMode::Photons ? "photons" : "nee",
-                  (unsigned long long)r.passes, 100.0 * r.confidence, r.accuracy.mean_abs_error,
-                  r.accuracy.mean_bound, r.accuracy.mean_bound / r.accuracy.mean_abs_error,
-                  r.accuracy.coverage);
+                  mode == DirectMode::Photons ? "photons" : "nee", (unsigned long long)r.passes,
+                  100.0 * r.confidence, r.accuracy.mean_abs_error, r.accuracy.mean_bound,
+                  r.accuracy.mean_bound / r.accuracy.mean_abs_error, r.accuracy.coverage);
   }
   std::printf("\n");
 }
 
 void termination_table() {
-  std::printf("### Render to a target error: plane under a point light (32x32, --direct photons)\n\n");
-  std::printf("| confidence | target (specified) | actual mean error | specified / actual | passes | seconds | stop |\n");
+  std::printf(
+      "### Render to a target error: plane under a point light (32x32, --direct photons)\n\n");
+  std::printf(
+      "| confidence | target (specified) | actual mean error | specified / actual | passes | "
+      "seconds | stop |\n");
   std::printf("|---|---|---|---|---|---|---|\n");
   for (double confidence : {0.5, 0.9}) {
     for (double target : confidence < 0.7 ? std::vector<double>{0.016, 0.008, 0.004}
@@ -61,8 +64,8 @@ void termination_table() {
       o.confidence = confidence;
       o.target_error = target;
       const analytic::TerminationRow r = analytic::termination_run("plane", o);
-      std::printf("| %.0f%% | %.4f | %.5f | %.2f | %llu | %.1f | %s |\n", 100.0 * confidence, target,
-                  r.actual, target / r.actual, (unsigned long long)r.passes, r.seconds,
+      std::printf("| %.0f%% | %.4f | %.5f | %.2f | %llu | %.1f | %s |\n", 100.0 * confidence,
+                  target, r.actual, target / r.actual, (unsigned long long)r.passes, r.seconds,
                   r.stop_reason.c_str());
       std::fflush(stdout);
     }
@@ -74,7 +77,9 @@ void termination_table() {
 void stopping_table() {
   const int kSeeds = 20;
   std::printf("### Early stops over %d seeds (plane, 32x32, --direct photons)\n\n", kSeeds);
-  std::printf("| confidence | target | runs with actual > target | mean specified / actual | mean passes |\n");
+  std::printf(
+      "| confidence | target | runs with actual > target | mean specified / actual | mean passes "
+      "|\n");
   std::printf("|---|---|---|---|---|\n");
   for (const auto& [confidence, target] : {std::pair{0.5, 0.008}, std::pair{0.9, 0.02}}) {
     int above = 0;

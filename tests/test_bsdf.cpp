@@ -258,8 +258,8 @@ TEST(Samplers, CosineHemisphereMoments) {
   // normal, 4 standard errors. Includes the poles and near-pole normals where orthonormal bases
   // are fragile.
   const std::vector<vec3> normals = {
-      vec3(0, 0, 1),         vec3(0, 0, -1),          unit(1e-7f, 0, -1),   unit(0, 1e-4f, -1),
-      unit(1e-4f, 1e-4f, 1), unit(0.3f, -0.5f, 0.8f), unit(1, 0, 0),        unit(-0.2f, 0.9f, -0.1f)};
+      vec3(0, 0, 1),         vec3(0, 0, -1),          unit(1e-7f, 0, -1), unit(0, 1e-4f, -1),
+      unit(1e-4f, 1e-4f, 1), unit(0.3f, -0.5f, 0.8f), unit(1, 0, 0),      unit(-0.2f, 0.9f, -0.1f)};
   for (size_t ni = 0; ni < normals.size(); ++ni) {
     const vec3 n = normals[ni];
     vec3 t, b;
@@ -538,8 +538,7 @@ TEST(SpecularBranches, WhiteDielectricConservesPhotonEnergyWithShadingNormals) {
       worst = std::min(worst, sum);
     }
   }
-  EXPECT_EQ(bad, 0) << "of " << tested << " random configurations lose energy; worst sum "
-                    << worst;
+  EXPECT_EQ(bad, 0) << "of " << tested << " random configurations lose energy; worst sum " << worst;
 }
 
 TEST(SpecularBranches, TiltedShadingNormalKeepsDirectionsOnCorrectSide) {

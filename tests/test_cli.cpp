@@ -42,8 +42,9 @@ std::string scene(const std::string& name) { return std::string(PHOTONBOUND_SCEN
 class Cli : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ = fs::temp_directory_path() /
-           ("pb_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    dir_ =
+        fs::temp_directory_path() /
+        ("pb_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
     fs::remove_all(dir_);
     fs::create_directories(dir_);
   }
@@ -66,24 +67,51 @@ TEST_F(Cli, HelpAndVersion) {
 
 TEST_F(Cli, RendersAndWritesOnlyTheImage) {
   const Outcome r = run("render " + quote(scene("cornell.gltf")) + " -o " + quote(out()) +
-                    " --passes 2 --resolution 16x16 --photons-per-pass 2000 --quiet");
+                        " --passes 2 --resolution 16x16 --photons-per-pass 2000 --quiet");
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_TRUE(fs::exists(out()));
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
 }
 
 TEST_F(Cli, BadOptionValuesExitWithUsageError) {
-  const std::string base = "render " + quote(scene("cornell.gltf")) + " -o " + quote(out()) + " --passes 1 ";
+  const std::string base =
+      "render " + quote(scene("cornell.gltf")) + " -o " + quote(out()) + " --passes 1 ";
   const char* bad[] = {
-      "--alpha 0",        "--alpha 1.5",        "--alpha nan",       "--alpha abc",
-      "--alpha ''",       "--alpha -0.5",       "--alpha inf",       "--passes 0",
-      "--passes -3",      "--passes 2.5",       "--passes 99999999999999999999999",
-      "--time 0",         "--time -1",          "--time nan",        "--photons-per-pass 0",
-      "--radius 0",       "--radius -1",        "--max-depth 33",    "--resolution 0x10",
-      "--resolution 10",  "--resolution axb",   "--resolution 10x",  "--threads -1",
-      "--seed -1",        "--direct foo",       "--confidence 0",    "--confidence 1",
-      "--min-passes 1",   "--error-metric foo", "--target-error 0",  "--target-error -1",
-      "--camera ''",      "--bogus",            "--alpha",           "extra.gltf",
+      "--alpha 0",
+      "--alpha 1.5",
+      "--alpha nan",
+      "--alpha abc",
+      "--alpha ''",
+      "--alpha -0.5",
+      "--alpha inf",
+      "--passes 0",
+      "--passes -3",
+      "--passes 2.5",
+      "--passes 99999999999999999999999",
+      "--time 0",
+      "--time -1",
+      "--time nan",
+      "--photons-per-pass 0",
+      "--radius 0",
+      "--radius -1",
+      "--max-depth 33",
+      "--resolution 0x10",
+      "--resolution 10",
+      "--resolution axb",
+      "--resolution 10x",
+      "--threads -1",
+      "--seed -1",
+      "--direct foo",
+      "--confidence 0",
+      "--confidence 1",
+      "--min-passes 1",
+      "--error-metric foo",
+      "--target-error 0",
+      "--target-error -1",
+      "--camera ''",
+      "--bogus",
+      "--alpha",
+      "extra.gltf",
   };
   for (const char* b : bad) {
     const Outcome r = run(base + b);
@@ -121,7 +149,7 @@ TEST_F(Cli, BadSceneFilesFailWithTheirNameAndNoOutput) {
 
 TEST_F(Cli, UnknownCameraIsAUsageError) {
   const Outcome r = run("render " + quote(scene("cornell.gltf")) + " -o " + quote(out()) +
-                    " --passes 1 --camera nosuchcamera");
+                        " --passes 1 --camera nosuchcamera");
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("nosuchcamera"), std::string::npos);
   EXPECT_TRUE(folder_empty());

@@ -268,7 +268,7 @@ struct Recorded {
   double r2;        // R_j^2 (state.r2 before the pass)
   double n_before;  // state.n before the pass
   PassGather g;
-  dvec3 x;          // X_j = D_j + phi_j / (pi R_j^2 M_e)
+  dvec3 x;  // X_j = D_j + phi_j / (pi R_j^2 M_e)
 };
 
 // Synthetic gathers whose per-pass estimates look like a real point's: X_j ~ L + b R_j^2 + noise,
@@ -511,8 +511,8 @@ TEST(Estimator, StudentTQuantilesMatchTable) {
   struct Row {
     double nu, t;
   };
-  for (const Row& r : {Row{1, 6.3138}, Row{2, 2.9200}, Row{4, 2.1318}, Row{10, 1.8125},
-                       Row{100, 1.6602}}) {
+  for (const Row& r :
+       {Row{1, 6.3138}, Row{2, 2.9200}, Row{4, 2.1318}, Row{10, 1.8125}, Row{100, 1.6602}}) {
     EXPECT_NEAR(student_t_quantile(r.nu, 0.95), r.t, 5e-5) << "nu=" << r.nu;
   }
   for (double nu : {1e6, 1e7, 1e8, 1e12}) {

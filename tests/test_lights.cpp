@@ -30,7 +30,7 @@ TEST(SphericalTriangle, DirectionsHitTheTriangleUniformlyInSolidAngle) {
   const vec3 tris[][4] = {
       {vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0), vec3(0.2f, 0.3f, 0.5f)},
       {vec3(-1, 0, -1), vec3(1, 0, -1), vec3(0, 0, 1), vec3(0.1f, 0.05f, 0.0f)},  // close
-      {vec3(0, 0, 0), vec3(3, 0, 0), vec3(0, 0.2f, 0), vec3(1.5f, 0.05f, 2.0f)},   // thin
+      {vec3(0, 0, 0), vec3(3, 0, 0), vec3(0, 0.2f, 0), vec3(1.5f, 0.05f, 2.0f)},  // thin
   };
   for (const auto& tri : tris) {
     const vec3 p = tri[3];
@@ -70,8 +70,8 @@ TEST(SphericalTriangle, RefusesDegenerateAndTinySolidAngles) {
   vec3 d;
   float omega;
   // Receiver in the triangle's plane, and a triangle seen edge-on from far away.
-  EXPECT_FALSE(sample_spherical_triangle(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0),
-                                         vec3(2, 2, 0), 0.5f, 0.5f, d, omega));
+  EXPECT_FALSE(sample_spherical_triangle(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0), vec3(2, 2, 0),
+                                         0.5f, 0.5f, d, omega));
   EXPECT_FALSE(sample_spherical_triangle(vec3(0, 0, 0), vec3(1e-3f, 0, 0), vec3(0, 1e-3f, 0),
                                          vec3(0, 0, 100), 0.5f, 0.5f, d, omega));
 }

@@ -1,4 +1,5 @@
 // Whole-renderer properties on small renders: determinism, exact direct light, scene variants.
+#include "analytic.h"
 #include "render_fixture.h"
 
 #include "photonbound/parallel.h"
@@ -54,9 +55,7 @@ TEST(Render, PointLightDirectIsExact) {
   r.step();
   ASSERT_EQ(r.eye().points.size(), 16u * 16u);
   for (size_t k = 0; k < r.eye().points.size(); ++k) {
-    const vec3 p = r.eye().points[k].position;
-    const double d = std::sqrt(double(p.x) * p.x + double(p.y - 1.0f) * (p.y - 1.0f) + double(p.z) * p.z);
-    const double exact = 0.5 / kPiD * 10.0 * (1.0 / d) / (d * d);
+    const double exact = analytic::plane_point(r.eye().points[k].position);
     const PointEstimate e = estimate(r.states()[k], r.passes(), double(o.photons_per_pass));
     // float geometry: a few ulps of relative error
     EXPECT_NEAR(e.radiance.x, exact, 1e-5 * exact);
@@ -114,6 +113,48 @@ TEST(Render, ImageHasEveryChannelAndMetadata) {
   bool has_passes = false;
   for (const auto& [k, v] : img.metadata) has_passes |= (k == "passes_done" && v == "3");
   EXPECT_TRUE(has_passes);
+}
+
+// --error-metric relative: the image mean of bound / max(L, floor), floor = 1% of the image's
+// mean radiance, recomputed here from the pixels the film writes.
+TEST(Render, RelativeMetricIsTheMeanOfBoundOverRadiance) {
+  RenderOptions o = test::quick_options("cornell.gltf", 24, 4);
+  o.photons_per_pass = 20000;
+  o.metric = ErrorMetric::Relative;
+  const Scene scene = load_gltf(o.scene);
+  Renderer r(scene, o);
+  for (int k = 0; k < 4; ++k) r.step();
+  FilmImage img;
+  const FilmSummary s = develop(r.eye(), r.states(), r.passes(), r.film_settings(), &img);
+  double mean_l = 0.0;
+  for (float v : img.radiance) mean_l += v;
+  mean_l /= double(img.radiance.size());
+  double sum = 0.0;
+  size_t n = 0;
+  for (size_t i = 0; i < img.bound.size(); ++i) {
+    if (!std::isfinite(img.bound[i])) continue;
+    sum += img.bound[i] / std::max(double(img.radiance[i]), kRelativeFloor * mean_l);
+    ++n;
+  }
+  ASSERT_GT(n, 0u);
+  EXPECT_NEAR(s.mean_bound, sum / double(n), 1e-4 * s.mean_bound);
+  EXPECT_NEAR(s.relative_floor, kRelativeFloor * mean_l, 1e-5 * s.relative_floor);
+}
+
+// alpha = 1 never shrinks the radius, so a target below the bias cannot be reached: the render
+// must say so instead of running on.
+TEST(Render, UnreachableTargetIsDetected) {
+  RenderOptions o = test::quick_options("plane_point.gltf", 16, 1);
+  o.passes = 5000;
+  o.direct = DirectMode::Photons;
+  o.alpha = 1.0;
+  o.radius = 0.5;  // a large radius over a curved radiance field: a large bias
+  o.target_error = 1e-4;
+  const Scene scene = load_gltf(o.scene);
+  Renderer r(scene, o);
+  const RenderReport report = r.run(nullptr, nullptr);
+  EXPECT_EQ(report.stop_reason.rfind("unreachable", 0), 0u) << report.stop_reason;
+  EXPECT_LT(report.passes, 100u);
 }
 
 }  // namespace

@@ -48,7 +48,8 @@ TEST(SlowBounds, CoverageOnClosedEmittingBoxWithNextEvent) {
 
 // Three targets halving in turn: the actual mean error at the stop is below the target in every
 // run, and at 50% confidence the target is at most 1.5x the actual error (HJJ10 report 1.3-1.4).
-void expect_termination(double confidence, std::initializer_list<double> targets, double max_ratio) {
+void expect_termination(double confidence, std::initializer_list<double> targets,
+                        double max_ratio) {
   for (double target : targets) {
     RenderOptions o = test::quick_options("plane_point.gltf", 32, 1);
     o.passes = 20000;  // a safety net only: the target must stop it first

@@ -47,7 +47,8 @@ double closed_box_error(DirectMode mode, uint64_t passes, uint64_t photons_per_p
     return near_face == 1;
   };
   while (r.passes() < passes) r.step();
-  return test::mean_relative_error(r, r.passes(), [](const vec3&) { return 2.0; }, interior);
+  return test::mean_relative_error(
+      r, r.passes(), [](const vec3&) { return 2.0; }, interior);
 }
 
 TEST(SlowConvergence, ClosedEmittingBoxWithPhotonsOnly) {

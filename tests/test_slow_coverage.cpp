@@ -28,8 +28,8 @@ constexpr double kSigma = 0.1;
 double density(double x, double y) {
   const double uni = (x >= 0.0 && x <= 1.0 && y >= 0.0 && y <= 1.0) ? 0.5 : 0.0;
   const double dx = x - 0.5, dy = y - 0.5;
-  const double g = std::exp(-(dx * dx + dy * dy) / (2.0 * kSigma * kSigma)) /
-                   (2.0 * kPi_ * kSigma * kSigma);
+  const double g =
+      std::exp(-(dx * dx + dy * dy) / (2.0 * kSigma * kSigma)) / (2.0 * kPi_ * kSigma * kSigma);
   return uni + 0.5 * g;
 }
 
@@ -115,7 +115,8 @@ TEST(SlowCoverage, SyntheticDensityBoundsCoverNominalConfidence) {
         const int cx = int(px * PassPhotons::kCells), cy = int(py * PassPhotons::kCells);
         for (int yy = cy - 1; yy <= cy + 1; ++yy) {
           for (int xx = cx - 1; xx <= cx + 1; ++xx) {
-            if (xx < 0 || yy < 0 || xx >= PassPhotons::kCells || yy >= PassPhotons::kCells) continue;
+            if (xx < 0 || yy < 0 || xx >= PassPhotons::kCells || yy >= PassPhotons::kCells)
+              continue;
             const int c = yy * PassPhotons::kCells + xx;
             for (uint32_t k = pp.start[c]; k < pp.start[c + 1]; ++k) {
               const double dx = pp.photons[k].x - px, dy = pp.photons[k].y - py;
@@ -172,11 +173,13 @@ TEST(SlowCoverage, SyntheticDensityBoundsCoverNominalConfidence) {
     const long n = total[k] - unknown[k];
     for (int ci = 0; ci < 2; ++ci) {
       const double cov = double(covered[k][ci]) / double(n);
-      std::printf("passes %3d confidence %.2f: coverage %.4f (%ld / %ld), mean bound %.5g, "
-                  "mean |error| %.5g, bound/error %.3f\n",
-                  checks[k], confidences[ci], cov, covered[k][ci], n, sum_bound[k][ci] / n,
-                  sum_err[k] / n, sum_bound[k][ci] / sum_err[k]);
-      std::printf("    noise-only interval (no |B|): %.4f\n", double(noise_only[k][ci]) / double(n));
+      std::printf(
+          "passes %3d confidence %.2f: coverage %.4f (%ld / %ld), mean bound %.5g, "
+          "mean |error| %.5g, bound/error %.3f\n",
+          checks[k], confidences[ci], cov, covered[k][ci], n, sum_bound[k][ci] / n, sum_err[k] / n,
+          sum_bound[k][ci] / sum_err[k]);
+      std::printf("    noise-only interval (no |B|): %.4f\n",
+                  double(noise_only[k][ci]) / double(n));
       std::printf("    by region (bump / flank / flat):");
       for (int r = 0; r < 3; ++r)
         std::printf(" %.4f (n=%ld)", double(reg_cov[k][r][ci]) / double(std::max(1L, reg_n[k][r])),

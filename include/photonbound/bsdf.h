@@ -27,7 +27,8 @@ vec3 sample_cosine_hemisphere(const vec3& n, float u1, float u2);
 // Uniform direction on the unit sphere; pdf = 1 / (4 pi).
 vec3 sample_uniform_sphere(float u1, float u2);
 
-// Uniform direction in the cone of directions within acos(cos_max) of axis; pdf = 1/(2 pi (1-cos_max)).
+// Uniform direction in the cone of directions within acos(cos_max) of axis; pdf = 1/(2 pi
+// (1-cos_max)).
 vec3 sample_uniform_cone(const vec3& axis, float cos_max, float u1, float u2);
 
 // Veach's correction for shading normals in adjoint (photon) transport, thesis eq. 5.19:

@@ -15,13 +15,14 @@ struct CompareResult {
   double rmse = 0.0;
   // Over pixel-channels with a finite, positive bound (not exact, not unknown):
   uint64_t bounded = 0;
-  double coverage = 0.0;         // fraction with |L - L_ref| <= ErrorBound
+  double coverage = 0.0;  // fraction with |L - L_ref| <= ErrorBound
   double mean_bound = 0.0;
   double mean_bounded_error = 0.0;
   double bound_over_error = 0.0;  // mean_bound / mean_bounded_error
   uint64_t exact = 0;             // pixel-channels with bound 0 (background, exact emission)
   uint64_t unknown = 0;           // pixel-channels with an infinite bound
-  double bias_dominated = 0.0;    // fraction of bounded pixels whose |bias| exceeds the noise half-width
+  double bias_dominated =
+      0.0;  // fraction of bounded pixels whose |bias| exceeds the noise half-width
 };
 
 // Throws ImageError when the sizes differ or a needed channel is missing.

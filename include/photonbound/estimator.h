@@ -34,9 +34,9 @@ struct PointState {
 };
 
 struct EstimatorParams {
-  double alpha = 0.7;               // PPM radius reduction, in (0, 1]
-  double photons_per_pass = 1.0;    // M_e
-  double min_r2 = 0.0;              // floor on R^2 (ESTIMATOR.md section 8)
+  double alpha = 0.7;             // PPM radius reduction, in (0, 1]
+  double photons_per_pass = 1.0;  // M_e
+  double min_r2 = 0.0;            // floor on R^2 (ESTIMATOR.md section 8)
 };
 
 // Folds pass number `pass` (1-based) into the state. state.r2 must be the radius the pass used.

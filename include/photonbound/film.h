@@ -14,22 +14,22 @@ namespace pb {
 // Planar float images, RGB channels interleaved per pixel (3 floats), scalars one per pixel.
 struct FilmImage {
   int width = 0, height = 0;
-  std::vector<float> radiance;     // L_pix
-  std::vector<float> bound;        // Eb_pix at the chosen confidence; +inf where unknown
-  std::vector<float> bias;         // B_pix, signed
-  std::vector<float> noise;        // noise half-width t sqrt(Var_pix)
-  std::vector<float> variance;     // Var_pix: variance of the mean
-  std::vector<float> photons;      // photons gathered by the pixel's points
-  std::vector<float> radius;       // current radius of the pixel's first point (0 if none)
+  std::vector<float> radiance;  // L_pix
+  std::vector<float> bound;     // Eb_pix at the chosen confidence; +inf where unknown
+  std::vector<float> bias;      // B_pix, signed
+  std::vector<float> noise;     // noise half-width t sqrt(Var_pix)
+  std::vector<float> variance;  // Var_pix: variance of the mean
+  std::vector<float> photons;   // photons gathered by the pixel's points
+  std::vector<float> radius;    // current radius of the pixel's first point (0 if none)
 };
 
 struct FilmSummary {
-  double mean_bound = INFINITY;    // over known pixels and RGB channels, in the chosen metric
-  double mean_noise = 0.0;         // mean noise half-width (absolute)
-  double mean_abs_bias = 0.0;      // mean |B| (absolute)
-  double below_target = 0.0;       // fraction of known pixels whose every channel meets the target
-  uint64_t unknown_pixels = 0;     // pixels with a point that never received a photon
-  double relative_floor = 0.0;     // denominator floor of the relative metric
+  double mean_bound = INFINITY;  // over known pixels and RGB channels, in the chosen metric
+  double mean_noise = 0.0;       // mean noise half-width (absolute)
+  double mean_abs_bias = 0.0;    // mean |B| (absolute)
+  double below_target = 0.0;     // fraction of known pixels whose every channel meets the target
+  uint64_t unknown_pixels = 0;   // pixels with a point that never received a photon
+  double relative_floor = 0.0;   // denominator floor of the relative metric
 };
 
 struct FilmSettings {

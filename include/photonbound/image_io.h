@@ -29,7 +29,8 @@ void write_exr(const std::string& path, const ExrImage& image);
 ExrImage read_exr(const std::string& path);
 
 // Writes an 8-bit RGB PNG (rgb: 3 bytes per pixel, row-major), atomically like write_exr.
-void write_png(const std::string& path, int width, int height, const std::vector<unsigned char>& rgb);
+void write_png(const std::string& path, int width, int height,
+               const std::vector<unsigned char>& rgb);
 
 // Fails early (ImageError) when `path` cannot be created, before any rendering starts.
 void check_writable(const std::string& path);

@@ -12,8 +12,8 @@ namespace pb {
 struct EmittedPhoton {
   vec3 origin{0.0f};
   vec3 dir{0.0f};
-  vec3 flux{0.0f};        // power carried, already divided by every sampling probability
-  vec3 normal{0.0f};      // surface normal at the origin (area lights), 0 for punctual lights
+  vec3 flux{0.0f};    // power carried, already divided by every sampling probability
+  vec3 normal{0.0f};  // surface normal at the origin (area lights), 0 for punctual lights
 };
 
 struct DirectSample {
@@ -51,7 +51,7 @@ class Lights {
   size_t pick(float u) const;
   // Next-event choice weight of emitter k at a receiver (used for small emitter sets).
   float local_weight(size_t k, const vec3& receiver) const;
-  static constexpr size_t kLocalSelectionMax = 32;
+  static constexpr size_t kLocalSelectionMax = 16;
   vec3 spot_falloff(const PunctualLight& light, const vec3& dir) const;
 
   std::vector<PunctualLight> punctual_;

@@ -36,12 +36,12 @@ struct RenderOptions {
   std::string camera;                  // --camera NAME; empty = first perspective camera
   int threads = 0;                     // --threads, 0 (all) .. 1024
   uint64_t seed = 1;                   // --seed, 0 .. 2^64-1
-  DirectMode direct = DirectMode::NextEvent;        // --direct nee|photons
-  double confidence = 0.9;                          // --confidence, (0, 1): 1 - beta
-  uint64_t min_passes = 16;                         // --min-passes, 2 .. 1e12
-  ErrorMetric metric = ErrorMetric::Absolute;       // --error-metric absolute|relative
-  ProgressMode progress = ProgressMode::Auto;       // --progress / --quiet
-  std::string command_line;                         // as typed, for the metadata
+  DirectMode direct = DirectMode::NextEvent;   // --direct nee|photons
+  double confidence = 0.9;                     // --confidence, (0, 1): 1 - beta
+  uint64_t min_passes = 16;                    // --min-passes, 2 .. 1e12
+  ErrorMetric metric = ErrorMetric::Absolute;  // --error-metric absolute|relative
+  ProgressMode progress = ProgressMode::Auto;  // --progress / --quiet
+  std::string command_line;                    // as typed, for the metadata
 };
 
 // photonbound preview IN.exr -o OUT.png [--exposure STOPS]

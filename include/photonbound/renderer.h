@@ -52,7 +52,6 @@ class Renderer {
   FilmSettings film_settings() const;
 
  private:
-
   double default_radius() const;
 
   const RenderOptions options_;

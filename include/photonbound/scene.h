@@ -28,11 +28,11 @@ struct Material {
 };
 
 struct Mesh {
-  std::string name;                // glTF mesh name (or "mesh <index>") for messages
-  std::vector<vec3> positions;     // world space
-  std::vector<vec3> normals;       // world space, unit length; empty when the file has none
-  std::vector<uint32_t> indices;   // three per triangle, degenerate triangles already removed
-  uint32_t material = 0;           // index into Scene::materials
+  std::string name;               // glTF mesh name (or "mesh <index>") for messages
+  std::vector<vec3> positions;    // world space
+  std::vector<vec3> normals;      // world space, unit length; empty when the file has none
+  std::vector<uint32_t> indices;  // three per triangle, degenerate triangles already removed
+  uint32_t material = 0;          // index into Scene::materials
 };
 
 enum class PunctualKind : uint8_t { Point, Spot };
@@ -64,8 +64,8 @@ struct Scene {
   std::vector<Mesh> meshes;
   std::vector<Material> materials;
   std::vector<PunctualLight> lights;
-  std::vector<Camera> cameras;  // every perspective camera, in node order
-  Bounds bounds;                // of all triangle vertices
+  std::vector<Camera> cameras;        // every perspective camera, in node order
+  Bounds bounds;                      // of all triangle vertices
   uint64_t degenerate_triangles = 0;  // skipped at load time
   std::vector<std::string> warnings;  // each once, for the user
 
