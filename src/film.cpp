@@ -67,7 +67,7 @@ FilmSummary develop(const EyePassResult& eye, const std::vector<PointState>& sta
     image->radius.assign(pixels, 0.0f);
   }
 
-  double bound_sum = 0.0, noise_sum = 0.0, bias_sum = 0.0;
+  double bound_sum = 0.0, noise_sum = 0.0, bias_sum = 0.0, bias_metric_sum = 0.0;
   uint64_t known = 0, below = 0;
   for (size_t p = 0; p < pixels; ++p) {
     const PixelResult& r = results[p];
@@ -78,10 +78,14 @@ FilmSummary develop(const EyePassResult& eye, const std::vector<PointState>& sta
       const dvec3 sd = glm::sqrt(r.variance);
       noise = r.has_points ? t * sd : dvec3(0.0);
       for (int c = 0; c < 3; ++c) bound[c] = r.has_points ? quantile(r.bias[c], sd[c]) : 0.0;
-      dvec3 metric = bound;
-      if (s.metric == ErrorMetric::Relative)
-        metric = bound / glm::max(r.radiance, dvec3(std::max(sum.relative_floor, 1e-300)));
+      dvec3 metric = bound, bias_metric = glm::abs(r.bias);
+      if (s.metric == ErrorMetric::Relative) {
+        const dvec3 denominator = glm::max(r.radiance, dvec3(std::max(sum.relative_floor, 1e-300)));
+        metric /= denominator;
+        bias_metric /= denominator;
+      }
       bound_sum += metric.x + metric.y + metric.z;
+      bias_metric_sum += bias_metric.x + bias_metric.y + bias_metric.z;
       noise_sum += noise.x + noise.y + noise.z;
       bias_sum += std::fabs(r.bias.x) + std::fabs(r.bias.y) + std::fabs(r.bias.z);
       ++known;
@@ -105,6 +109,7 @@ FilmSummary develop(const EyePassResult& eye, const std::vector<PointState>& sta
     sum.mean_bound = bound_sum / (3.0 * double(known));
     sum.mean_noise = noise_sum / (3.0 * double(known));
     sum.mean_abs_bias = bias_sum / (3.0 * double(known));
+    sum.mean_bias_metric = bias_metric_sum / (3.0 * double(known));
     sum.below_target = double(below) / double(known);
   }
   return sum;

@@ -67,7 +67,9 @@ Renderer::Renderer(const Scene& scene, const RenderOptions& options)
       world_(scene),
       camera_(choose_camera(scene, options)),
       tracer_(world_, options.direct == DirectMode::Photons) {
+  const auto t0 = Clock::now();
   eye_ = run_eye_pass(world_, camera_, options_.max_depth);
+  timings_.eye = seconds_since(t0);
   params_.alpha = options_.alpha;
   params_.photons_per_pass = double(options_.photons_per_pass);
   const double r_min = kMinRadiusFraction * world_.scene_size();
@@ -88,6 +90,13 @@ double Renderer::default_radius() const {
   return r > 0.0 && std::isfinite(r) ? r : 0.01 * world_.scene_size();
 }
 
+bool Renderer::radii_fixed() const {
+  if (options_.alpha >= 1.0) return true;
+  for (const PointState& s : states_)
+    if (s.r2 > params_.min_r2) return false;
+  return !states_.empty();
+}
+
 FilmSettings Renderer::film_settings() const {
   FilmSettings s;
   s.photons_per_pass = double(options_.photons_per_pass);
@@ -99,17 +108,22 @@ FilmSettings Renderer::film_settings() const {
 
 void Renderer::step() {
   const uint64_t pass = ++passes_;
+  auto t = Clock::now();
   const PhotonPassStats stats = tracer_.run(options_.seed, pass, options_.photons_per_pass, hits_);
   rays_ += stats.rays;
   photons_ += stats.paths;
+  timings_.trace += seconds_since(t);
 
   const size_t n = states_.size();
   if (n == 0) return;
+  t = Clock::now();
   hit_positions_.resize(hits_.size());
   for (size_t k = 0; k < hits_.size(); ++k) hit_positions_[k] = hits_[k].position;
   for (size_t k = 0; k < n; ++k) radii_[k] = float(std::sqrt(states_[k].r2));
   grid_.build(hit_positions_, radii_);
+  timings_.grid += seconds_since(t);
 
+  t = Clock::now();
   const bool nee = options_.direct == DirectMode::NextEvent;
   parallel_for(n, 256, [&](size_t begin, size_t end) {
     for (size_t k = begin; k < end; ++k) {
@@ -122,6 +136,7 @@ void Renderer::step() {
       accumulate_pass(states_[k], g, params_, pass);
     }
   });
+  timings_.gather += seconds_since(t);
 }
 
 RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress) {
@@ -161,9 +176,10 @@ RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress
       report.stop_reason = "time";
     if (check && report.summary.mean_bound <= *options_.target_error)
       report.stop_reason = "target-error";
-    if (check && options_.alpha >= 1.0 && options_.metric == ErrorMetric::Absolute &&
-        report.summary.mean_abs_bias >= *options_.target_error)
-      report.stop_reason = "unreachable: alpha = 1 keeps the bias above the target";
+    // A target below the bias cannot be reached once the radii can no longer shrink (alpha = 1,
+    // or every radius at its floor): more passes only shrink the noise.
+    if (check && report.summary.mean_bias_metric >= *options_.target_error && radii_fixed())
+      report.stop_reason = "unreachable: the radius cannot shrink and the bias is above the target";
     if (stop && stop->load()) report.stop_reason = "interrupted";
 
     if (want_progress || (progress && !report.stop_reason.empty())) {

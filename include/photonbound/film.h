@@ -27,9 +27,11 @@ struct FilmSummary {
   double mean_bound = INFINITY;  // over known pixels and RGB channels, in the chosen metric
   double mean_noise = 0.0;       // mean noise half-width (absolute)
   double mean_abs_bias = 0.0;    // mean |B| (absolute)
-  double below_target = 0.0;     // fraction of known pixels whose every channel meets the target
-  uint64_t unknown_pixels = 0;   // pixels with a point that never received a photon
-  double relative_floor = 0.0;   // denominator floor of the relative metric
+  double mean_bias_metric =
+      0.0;  // mean |B| in the chosen metric: the part of the bound the noise cannot shrink
+  double below_target = 0.0;    // fraction of known pixels whose every channel meets the target
+  uint64_t unknown_pixels = 0;  // pixels with a point that never received a photon
+  double relative_floor = 0.0;  // denominator floor of the relative metric
 };
 
 struct FilmSettings {

@@ -32,6 +32,14 @@ struct RenderReport {
 // Picks the camera (by node or camera name when given) and the image size.
 PinholeCamera choose_camera(const Scene& scene, const RenderOptions& options);
 
+// Wall-clock seconds spent in each phase, accumulated over all passes (for the benchmark).
+struct PhaseTimings {
+  double eye = 0.0;     // eye pass (once)
+  double trace = 0.0;   // photon tracing
+  double grid = 0.0;    // hash grid builds
+  double gather = 0.0;  // gathers, next-event samples and estimator updates
+};
+
 class Renderer {
  public:
   Renderer(const Scene& scene, const RenderOptions& options);
@@ -50,9 +58,12 @@ class Renderer {
   const EyePassResult& eye() const { return eye_; }
   const std::vector<PointState>& states() const { return states_; }
   FilmSettings film_settings() const;
+  const PhaseTimings& timings() const { return timings_; }
+  const World& world() const { return world_; }
 
  private:
   double default_radius() const;
+  bool radii_fixed() const;
 
   const RenderOptions options_;
   World world_;
@@ -68,6 +79,7 @@ class Renderer {
   uint64_t passes_ = 0;
   uint64_t photons_ = 0;  // emitted so far
   uint64_t rays_ = 0;     // photon-pass rays so far
+  PhaseTimings timings_;
 };
 
 }  // namespace pb
