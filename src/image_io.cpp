@@ -2,6 +2,7 @@
 
 #include <OpenImageIO/imageio.h>
 
+#include <fcntl.h>
 #include <unistd.h>
 #include <cerrno>
 #include <cstdio>
@@ -43,11 +44,24 @@ void write_atomic(const std::string& path, const OIIO::ImageSpec& spec, const vo
     std::remove(tmp.c_str());
     throw ImageError(path + ": cannot write: " + err);
   }
+  // Flush the image to disk before the rename makes it the file of record (checkpoints must
+  // survive a crash), then make the rename itself durable.
+  if (const int fd = ::open(tmp.c_str(), O_RDONLY | O_CLOEXEC); fd >= 0) {
+    ::fsync(fd);
+    ::close(fd);
+  }
   std::error_code ec;
   std::filesystem::rename(tmp, path, ec);
   if (ec) {
     std::remove(tmp.c_str());
     throw ImageError(path + ": cannot rename the finished image into place: " + ec.message());
+  }
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  if (const int dfd =
+          ::open(parent.empty() ? "." : parent.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+      dfd >= 0) {
+    ::fsync(dfd);
+    ::close(dfd);
   }
 }
 

@@ -1,5 +1,6 @@
 // photonbound command-line entry point. The only catch-all: maps failures to exit codes
 // (0 done, 1 runtime failure or bad input file, 2 bad usage).
+#include "photonbound/checkpoint.h"
 #include "photonbound/compare.h"
 #include "photonbound/gltf_loader.h"
 #include "photonbound/image_io.h"
@@ -24,29 +25,85 @@ extern "C" void on_signal(int sig) {
   if (g_stop.exchange(true)) _exit(128 + sig);
 }
 
-int render(const pb::RenderOptions& options) {
+// Renders `options`; with `saved`, continues that render (already checked to match).
+int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
+  // Installed first: a Ctrl-C while the scene loads still ends with an image and a state.
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
   pb::check_writable(options.output);  // fail before hours of rendering, not after
+  const bool keep_state = options.checkpoint_every || !options.state_path.empty();
+  const std::string state_path = pb::state_path_for(options);
   const pb::Scene scene = pb::load_gltf(options.scene);
   for (const std::string& w : scene.warnings)
     std::cerr << "photonbound: warning: " << options.scene << ": " << w << "\n";
+  const uint64_t scene_hash = pb::hash_file(options.scene);
+  if (saved) {
+    const std::vector<std::string> diff = pb::differences(*saved, options, scene_hash);
+    if (!diff.empty()) {
+      std::string msg = options.resume_from + ": cannot continue this render: ";
+      for (size_t k = 0; k < diff.size(); ++k) msg += (k ? "; " : "") + diff[k];
+      throw pb::StateError(msg);
+    }
+  }
 
   pb::ThreadLimit threads(options.threads);
   pb::Renderer renderer(scene, options);
-  std::signal(SIGINT, on_signal);
-  std::signal(SIGTERM, on_signal);
+  if (saved) renderer.restore(*saved);
+
+  // A checkpoint is the image and the state, each written atomically; the state goes last, so
+  // a state file never refers to passes the image does not show.
+  auto write_outputs = [&](const pb::RenderReport& report, bool with_state) {
+    pb::write_exr(options.output, renderer.image(report));
+    if (with_state) {
+      pb::SavedRender s = renderer.snapshot();
+      s.scene_hash = scene_hash;
+      pb::save_state(state_path, s);
+    }
+  };
+  pb::CheckpointPolicy checkpoint;
+  if (options.checkpoint_every) {
+    checkpoint.every = *options.checkpoint_every;
+    checkpoint.write = [&](const pb::RenderReport& r) { write_outputs(r, true); };
+  }
 
   const bool show = options.progress == pb::ProgressMode::Always ||
                     (options.progress == pb::ProgressMode::Auto && isatty(STDERR_FILENO));
   if (show)
     std::cerr << "photonbound: " << renderer.eye().points.size() << " measurement points, "
-              << threads.threads() << " threads\n";
-  const pb::RenderReport report = renderer.run(&g_stop, show ? &std::cerr : nullptr);
-  pb::write_exr(options.output, renderer.image(report));
+              << threads.threads() << " threads" << (saved ? ", resumed" : "") << "\n";
+  const pb::RenderReport report = renderer.run(&g_stop, show ? &std::cerr : nullptr, checkpoint);
+  // Ctrl-C keeps the work: the state is written then too.
+  write_outputs(report, keep_state || report.stop_reason == "interrupted");
   if (show || report.stop_reason != "passes")
     std::cerr << "photonbound: stopped (" << report.stop_reason << ") after " << report.passes
               << " passes, " << report.seconds << " s; mean bound " << report.summary.mean_bound
               << "; wrote " << options.output << "\n";
   return 0;
+}
+
+int render(const pb::RenderOptions& options) {
+  if (options.resume_from.empty()) return render(options, nullptr);
+  const pb::SavedRender saved = pb::load_state(options.resume_from);
+  return render(options, &saved);
+}
+
+int resume(const pb::ResumeOptions& r) {
+  const pb::SavedRender saved = pb::load_state(r.state);
+  pb::RenderOptions o = saved.options;
+  const pb::RenderOptions& n = r.overrides;
+  o.output = n.output;
+  if (r.new_stop) {
+    o.passes = n.passes;
+    o.time_seconds = n.time_seconds;
+    o.target_error = n.target_error;
+  }
+  o.checkpoint_every = n.checkpoint_every;
+  o.state_path = n.state_path;
+  o.threads = n.threads;
+  o.progress = n.progress;
+  o.resume_from = r.state;
+  o.command_line = n.command_line;
+  return render(o, &saved);
 }
 
 int compare(const pb::CompareOptions& o) {
@@ -91,6 +148,8 @@ int main(int argc, char** argv) {
         return 0;
       case pb::Command::Kind::Render:
         return render(cmd.render);
+      case pb::Command::Kind::Resume:
+        return resume(cmd.resume);
       case pb::Command::Kind::Compare:
         return compare(cmd.compare);
       case pb::Command::Kind::Preview:

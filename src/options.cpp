@@ -1,5 +1,6 @@
 #include "photonbound/options.h"
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <functional>
@@ -97,6 +98,20 @@ const std::map<std::string, Setter>& value_flags() {
        [](RenderOptions& o, const std::string& v) {
          o.min_passes = parse_uint("--min-passes", v, 2, 1000000000000ULL);
        }},
+      {"--checkpoint-every",
+       [](RenderOptions& o, const std::string& v) {
+         o.checkpoint_every = parse_real("--checkpoint-every", v);
+       }},
+      {"--state",
+       [](RenderOptions& o, const std::string& v) {
+         if (v.empty()) fail("--state: the path is empty");
+         o.state_path = v;
+       }},
+      {"--resume",
+       [](RenderOptions& o, const std::string& v) {
+         if (v.empty()) fail("--resume: the path is empty");
+         o.resume_from = v;
+       }},
       {"--error-metric",
        [](RenderOptions& o, const std::string& v) {
          if (v == "absolute")
@@ -110,11 +125,12 @@ const std::map<std::string, Setter>& value_flags() {
   return flags;
 }
 
-RenderOptions parse_render(int argc, const char* const* argv, int first) {
-  RenderOptions o;
-  for (int k = 0; k < argc; ++k) o.command_line += (k ? " " : "") + std::string(argv[k]);
+// Fills `o` from the flags; `given` collects the flags seen.
+void parse_flags(int argc, const char* const* argv, int first, RenderOptions& o,
+                 std::vector<std::string>& positional, std::vector<std::string>& given) {
   for (int k = first; k < argc; ++k) {
     const std::string arg = argv[k];
+    if (!arg.empty() && arg[0] == '-') given.push_back(arg);
     if (arg == "--progress") {
       o.progress = ProgressMode::Always;
     } else if (arg == "--quiet") {
@@ -124,14 +140,51 @@ RenderOptions parse_render(int argc, const char* const* argv, int first) {
       it->second(o, argv[++k]);
     } else if (!arg.empty() && arg[0] == '-') {
       fail("unknown option '" + arg + "' (see photonbound --help)");
-    } else if (o.scene.empty()) {
-      o.scene = arg;
     } else {
-      fail("unexpected argument '" + arg + "': only one scene file is rendered");
+      positional.push_back(arg);
     }
   }
+}
+
+std::string join_command_line(int argc, const char* const* argv) {
+  std::string s;
+  for (int k = 0; k < argc; ++k) s += (k ? " " : "") + std::string(argv[k]);
+  return s;
+}
+
+RenderOptions parse_render(int argc, const char* const* argv, int first) {
+  RenderOptions o;
+  o.command_line = join_command_line(argc, argv);
+  std::vector<std::string> positional, given;
+  parse_flags(argc, argv, first, o, positional, given);
+  if (positional.size() > 1)
+    fail("unexpected argument '" + positional[1] + "': only one scene file is rendered");
+  if (!positional.empty()) o.scene = positional[0];
   validate(o);
   return o;
+}
+
+ResumeOptions parse_resume(int argc, const char* const* argv, int first) {
+  ResumeOptions r;
+  std::vector<std::string> positional, given;
+  parse_flags(argc, argv, first, r.overrides, positional, given);
+  static const std::vector<std::string> allowed = {
+      "-o",      "--passes",  "--time",     "--target-error", "--checkpoint-every",
+      "--state", "--threads", "--progress", "--quiet"};
+  for (const std::string& g : given)
+    if (std::find(allowed.begin(), allowed.end(), g) == allowed.end())
+      fail("resume: " + g + " cannot be given when resuming: the state file fixes it");
+  if (positional.size() != 1)
+    fail("resume: usage: photonbound resume STATE -o OUT.exr [stop conditions]");
+  r.state = positional[0];
+  if (r.overrides.output.empty()) fail("resume: no output file given (-o OUT.exr)");
+  r.new_stop = r.overrides.passes || r.overrides.time_seconds || r.overrides.target_error;
+  r.overrides.command_line = join_command_line(argc, argv);
+  RenderOptions check = r.overrides;  // range checks of the flags given
+  check.scene = r.state;
+  if (!r.new_stop) check.passes = 1;
+  validate(check);
+  return r;
 }
 
 PreviewOptions parse_preview(int argc, const char* const* argv, int first) {
@@ -193,6 +246,16 @@ void validate(const RenderOptions& o) {
   if (!(o.confidence > 0.0 && o.confidence < 1.0)) fail("--confidence: must be in (0, 1)");
   if (o.photons_per_pass < 1) fail("--photons-per-pass: must be at least 1");
   if (o.min_passes < 2) fail("--min-passes: must be at least 2");
+  if (o.checkpoint_every && !(*o.checkpoint_every > 0.0 && *o.checkpoint_every <= 1e9))
+    fail("--checkpoint-every: must be in (0, 1e9] seconds");
+}
+
+std::string state_path_for(const RenderOptions& o) {
+  if (!o.state_path.empty()) return o.state_path;
+  const size_t slash = o.output.find_last_of('/');
+  const size_t dot = o.output.find_last_of('.');
+  const bool has_ext = dot != std::string::npos && (slash == std::string::npos || dot > slash);
+  return (has_ext ? o.output.substr(0, dot) : o.output) + ".pbstate";
 }
 
 Command parse_command_line(int argc, const char* const* argv) {
@@ -206,6 +269,9 @@ Command parse_command_line(int argc, const char* const* argv) {
   } else if (cmd == "render") {
     c.kind = Command::Kind::Render;
     c.render = parse_render(argc, argv, 2);
+  } else if (cmd == "resume") {
+    c.kind = Command::Kind::Resume;
+    c.resume = parse_resume(argc, argv, 2);
   } else if (cmd == "compare") {
     c.kind = Command::Kind::Compare;
     c.compare = parse_compare(argc, argv, 2);
@@ -223,6 +289,7 @@ std::string usage_text() {
 
 usage:
   photonbound render SCENE.gltf|.glb -o OUT.exr [options]
+  photonbound resume STATE -o OUT.exr [--passes N] [--time S] [--target-error E] [checkpoints]
   photonbound compare RENDER.exr REFERENCE.exr [--json]
   photonbound preview IN.exr -o OUT.png [--exposure STOPS]
   photonbound --help | --version
@@ -246,6 +313,12 @@ options:
   --min-passes N         passes before any bound or stop test (>= 2; default 16)
   --error-metric absolute|relative   what --target-error measures (default absolute)
   --progress | --quiet   force the progress line on or off (default: on when stderr is a terminal)
+
+checkpoints:
+  --checkpoint-every S   write the EXR and a state file every S seconds (0 .. 1e9]
+  --state FILE           state file (default: OUT with the extension .pbstate); written at
+                         checkpoints, on Ctrl-C, and at the end when checkpoints are on
+  --resume STATE         continue the render saved in STATE (its scene and options must match)
 )";
 }
 

@@ -75,6 +75,7 @@ Renderer::Renderer(const Scene& scene, const RenderOptions& options)
   const double r_min = kMinRadiusFraction * world_.scene_size();
   params_.min_r2 = r_min * r_min;
   const double r0 = std::max(options_.radius ? *options_.radius : default_radius(), r_min);
+  initial_radius_ = r0;
   PointState initial;
   initial.r2 = r0 * r0;
   states_.assign(eye_.points.size(), initial);
@@ -107,11 +108,11 @@ FilmSettings Renderer::film_settings() const {
 }
 
 void Renderer::step() {
-  const uint64_t pass = ++passes_;
+  const uint64_t pass = ++loop_.passes;
   auto t = Clock::now();
   const PhotonPassStats stats = tracer_.run(options_.seed, pass, options_.photons_per_pass, hits_);
-  rays_ += stats.rays;
-  photons_ += stats.paths;
+  loop_.rays += stats.rays;
+  loop_.photons += stats.paths;
   timings_.trace += seconds_since(t);
 
   const size_t n = states_.size();
@@ -139,41 +140,74 @@ void Renderer::step() {
   timings_.gather += seconds_since(t);
 }
 
-RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress) {
+std::string Renderer::progress_line(const RenderReport& report, double run_seconds) const {
+  const FilmSummary& s = report.summary;
+  const uint64_t pass = report.passes;
+  std::ostringstream line;
+  line.precision(4);
+  line << "pass " << pass << " | " << format_count(double(report.photons)) << " photons";
+  if (pass >= 2) {
+    line << " | bound " << s.mean_bound;
+    if (options_.target_error) line << " | " << int(100.0 * s.below_target) << "% below target";
+    line << " | " << s.unknown_pixels << " unknown";
+  }
+  line << " | " << report.seconds << " s";
+  // Time left: the smallest of what the stop conditions imply; the target's from the observed
+  // power-law decay of the mean bound since an earlier check.
+  const double per_pass = report.seconds / double(pass);
+  double left = INFINITY;
+  if (options_.passes) left = std::min(left, double(*options_.passes - pass) * per_pass);
+  if (options_.time_seconds) left = std::min(left, *options_.time_seconds - run_seconds);
+  const uint64_t early = loop_.early_pass;
+  if (options_.target_error && early > 0 && pass > early && s.mean_bound < loop_.early_bound &&
+      s.mean_bound > *options_.target_error) {
+    const double k = std::log(loop_.early_bound / s.mean_bound) / std::log(double(pass) / early);
+    const double needed = double(pass) * std::pow(s.mean_bound / *options_.target_error, 1.0 / k);
+    left = std::min(left, (needed - double(pass)) * per_pass);
+  }
+  if (std::isfinite(left)) line << " | ~" << std::max(0.0, left) << " s left";
+  return line.str();
+}
+
+RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress,
+                           const CheckpointPolicy& checkpoint) {
   RenderReport report;
-  report.initial_radius = states_.empty() ? 0.0 : std::sqrt(states_[0].r2);
+  report.initial_radius = initial_radius_;
   const FilmSettings settings = film_settings();
   const auto t0 = Clock::now();
-  double last_print = -1.0;
-  uint64_t next_check = options_.min_passes;
-  // (pass, mean bound) at an earlier check, for the time-left estimate.
-  uint64_t early_pass = 0;
-  double early_bound = 0.0;
+  const double seconds_before = loop_.seconds;
+  double last_print = -1.0, last_checkpoint = 0.0;
+  if (loop_.next_check == 0) loop_.next_check = options_.min_passes;
+  auto fill = [&] {
+    report.passes = loop_.passes;
+    report.photons = loop_.photons;
+    report.rays = loop_.rays;
+    report.seconds = loop_.seconds = seconds_before + seconds_since(t0);
+  };
+  // A resumed render that already did its passes does not run another one.
+  if (options_.passes && loop_.passes >= *options_.passes) report.stop_reason = "passes";
 
-  for (;;) {
+  while (report.stop_reason.empty()) {
     step();
-    const uint64_t pass = passes_;
-    report.passes = pass;
-    report.photons = photons_;
-    report.rays = rays_;
-    report.seconds = seconds_since(t0);
+    fill();
+    const uint64_t pass = loop_.passes;
+    const double run_seconds = seconds_since(t0);
 
-    const bool check = options_.target_error && pass >= next_check;
-    const bool want_progress = progress && report.seconds - last_print >= 0.5;
+    const bool check = options_.target_error && pass >= loop_.next_check;
+    const bool want_progress = progress && run_seconds - last_print >= 0.5;
     if (check || want_progress) report.summary = develop(eye_, states_, pass, settings, nullptr);
     if (check) {
       // Sparse schedule (ESTIMATOR.md section 7): checks about 10% apart in pass count, so the
       // criterion is not retried after every pass (optional stopping).
-      next_check = pass + std::max<uint64_t>(1, pass / 10);
-      if (early_pass == 0 || pass >= 2 * early_pass) {
-        early_pass = pass;
-        early_bound = report.summary.mean_bound;
+      loop_.next_check = pass + std::max<uint64_t>(1, pass / 10);
+      if (loop_.early_pass == 0 || pass >= 2 * loop_.early_pass) {
+        loop_.early_pass = pass;
+        loop_.early_bound = report.summary.mean_bound;
       }
     }
 
     if (options_.passes && pass >= *options_.passes) report.stop_reason = "passes";
-    if (options_.time_seconds && report.seconds >= *options_.time_seconds)
-      report.stop_reason = "time";
+    if (options_.time_seconds && run_seconds >= *options_.time_seconds) report.stop_reason = "time";
     if (check && report.summary.mean_bound <= *options_.target_error)
       report.stop_reason = "target-error";
     // A target below the bias cannot be reached once the radii can no longer shrink (alpha = 1,
@@ -183,37 +217,38 @@ RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress
     if (stop && stop->load()) report.stop_reason = "interrupted";
 
     if (want_progress || (progress && !report.stop_reason.empty())) {
-      last_print = report.seconds;
-      const FilmSummary& s = report.summary;
-      std::ostringstream line;
-      line.precision(4);
-      line << "pass " << pass << " | " << format_count(double(report.photons)) << " photons";
-      if (pass >= 2) {
-        line << " | bound " << s.mean_bound;
-        if (options_.target_error) line << " | " << int(100.0 * s.below_target) << "% below target";
-        line << " | " << s.unknown_pixels << " unknown";
-      }
-      line << " | " << report.seconds << " s";
-      // Time left: the smallest of what the stop conditions imply; the target's from the
-      // observed power-law decay of the mean bound since an earlier check.
-      const double per_pass = report.seconds / double(pass);
-      double left = INFINITY;
-      if (options_.passes) left = std::min(left, double(*options_.passes - pass) * per_pass);
-      if (options_.time_seconds) left = std::min(left, *options_.time_seconds - report.seconds);
-      if (options_.target_error && early_pass > 0 && pass > early_pass &&
-          s.mean_bound < early_bound && s.mean_bound > *options_.target_error) {
-        const double k = std::log(early_bound / s.mean_bound) / std::log(double(pass) / early_pass);
-        const double needed =
-            double(pass) * std::pow(s.mean_bound / *options_.target_error, 1.0 / k);
-        left = std::min(left, (needed - double(pass)) * per_pass);
-      }
-      if (std::isfinite(left)) line << " | ~" << std::max(0.0, left) << " s left";
-      *progress << line.str() << std::endl;
+      last_print = run_seconds;
+      *progress << progress_line(report, run_seconds) << std::endl;
     }
-    if (!report.stop_reason.empty()) break;
+    if (report.stop_reason.empty() && checkpoint.every > 0.0 &&
+        run_seconds - last_checkpoint >= checkpoint.every) {
+      last_checkpoint = run_seconds;
+      report.summary = develop(eye_, states_, pass, settings, nullptr);
+      checkpoint.write(report);
+    }
   }
+  fill();
   report.summary = develop(eye_, states_, report.passes, settings, nullptr);
   return report;
+}
+
+void Renderer::restore(const SavedRender& saved) {
+  if (saved.states.size() != states_.size())
+    throw StateError("the state holds " + std::to_string(saved.states.size()) +
+                     " measurement points but this scene and camera give " +
+                     std::to_string(states_.size()));
+  states_ = saved.states;
+  loop_ = saved.loop;
+  initial_radius_ = saved.initial_radius;
+}
+
+SavedRender Renderer::snapshot() const {
+  SavedRender s;
+  s.options = options_;
+  s.initial_radius = initial_radius_;
+  s.loop = loop_;
+  s.states = states_;
+  return s;
 }
 
 }  // namespace pb

@@ -167,4 +167,43 @@ TEST_F(Cli, UnwritableOutputFailsBeforeRendering) {
   EXPECT_TRUE(folder_empty());
 }
 
+TEST_F(Cli, ResumeRefusesWhatWouldChangeTheImage) {
+  const std::string base = "render " + quote(scene("cornell.gltf")) +
+                           " --resolution 16x16 --photons-per-pass 2000 --quiet --passes 2";
+  const std::string state = (dir_ / "s.pbstate").string();
+  ASSERT_EQ(run(base + " -o " + quote(out()) + " --state " + quote(state)).code, 0);
+  ASSERT_TRUE(fs::exists(state));
+  // Same render continued: fine. Another alpha: refused, naming it.
+  const std::string more = (dir_ / "more.exr").string();
+  EXPECT_EQ(run(base + " -o " + quote(more) + " --resume " + quote(state) + " --passes 4").code, 0);
+  Outcome r = run(base + " -o " + quote(more) + " --resume " + quote(state) + " --alpha 0.5");
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("alpha: 0.7 in the state, 0.5 now"), std::string::npos) << r.err;
+  expect_one_line(r);
+  // `resume` takes everything that shapes the image from the state.
+  r = run("resume " + quote(state) + " -o " + quote(more) + " --alpha 0.5");
+  EXPECT_EQ(r.code, 2);
+  EXPECT_NE(r.err.find("--alpha"), std::string::npos) << r.err;
+  EXPECT_EQ(run("resume " + quote(state) + " -o " + quote(more) + " --passes 5 --quiet").code, 0);
+  r = run("resume " + quote((dir_ / "nothing.pbstate").string()) + " -o " + quote(more));
+  EXPECT_EQ(r.code, 1);
+  expect_one_line(r);
+}
+
+TEST_F(Cli, ResumeRefusesAChangedSceneFile) {
+  const std::string copy = (dir_ / "box.gltf").string();
+  fs::copy_file(scene("cornell.gltf"), copy);
+  const std::string state = (dir_ / "c.pbstate").string();
+  ASSERT_EQ(
+      run("render " + quote(copy) + " -o " + quote(out()) +
+          " --resolution 16x16 --photons-per-pass 2000 --quiet --passes 2 --state " + quote(state))
+          .code,
+      0);
+  std::ofstream(copy, std::ios::app) << "\n";  // same scene, other bytes: refuse to guess
+  const Outcome r = run("resume " + quote(state) + " -o " + quote((dir_ / "r.exr").string()));
+  EXPECT_EQ(r.code, 1);
+  EXPECT_NE(r.err.find("scene"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "r.exr"));
+}
+
 }  // namespace

@@ -42,7 +42,15 @@ struct RenderOptions {
   ErrorMetric metric = ErrorMetric::Absolute;  // --error-metric absolute|relative
   ProgressMode progress = ProgressMode::Auto;  // --progress / --quiet
   std::string command_line;                    // as typed, for the metadata
+  // Checkpoints (README "Checkpoints"): none of these changes the image.
+  std::optional<double> checkpoint_every;  // --checkpoint-every, (0, 1e9] seconds
+  std::string state_path;                  // --state FILE; default OUT with .pbstate
+  std::string resume_from;                 // --resume STATE: continue that render
 };
+
+// The state file a render writes: --state, or the output path with its extension replaced by
+// ".pbstate".
+std::string state_path_for(const RenderOptions& options);
 
 // photonbound preview IN.exr -o OUT.png [--exposure STOPS]
 struct PreviewOptions {
@@ -56,9 +64,20 @@ struct CompareOptions {
   bool json = false;
 };
 
+// photonbound resume STATE -o OUT.exr [--passes N] [--time S] [--target-error E]
+//   [--checkpoint-every S] [--state FILE] [--threads T] [--progress | --quiet]
+// Every other option comes from the state. New stop conditions replace the saved ones; without
+// any, the saved ones apply (passes and target count the whole render, time this run).
+struct ResumeOptions {
+  std::string state;
+  RenderOptions overrides;  // output, stop conditions, checkpoints, threads, progress
+  bool new_stop = false;    // at least one stop condition was given
+};
+
 struct Command {
-  enum class Kind { Help, Version, Render, Preview, Compare } kind = Kind::Help;
+  enum class Kind { Help, Version, Render, Resume, Preview, Compare } kind = Kind::Help;
   RenderOptions render;
+  ResumeOptions resume;
   PreviewOptions preview;
   CompareOptions compare;
 };

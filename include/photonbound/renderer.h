@@ -2,6 +2,7 @@
 // pass, until a stop condition (passes, time, target error, interruption) is met.
 #pragma once
 
+#include "photonbound/checkpoint.h"
 #include "photonbound/estimator.h"
 #include "photonbound/eye_pass.h"
 #include "photonbound/film.h"
@@ -12,6 +13,7 @@
 #include "photonbound/world.h"
 
 #include <atomic>
+#include <functional>
 #include <memory>
 #include <ostream>
 #include <string>
@@ -40,17 +42,29 @@ struct PhaseTimings {
   double gather = 0.0;  // gathers, next-event samples and estimator updates
 };
 
+// Called between passes every `every` seconds of the run (0 = never), to write checkpoints.
+struct CheckpointPolicy {
+  double every = 0.0;
+  std::function<void(const RenderReport&)> write;
+};
+
 class Renderer {
  public:
   Renderer(const Scene& scene, const RenderOptions& options);
 
   // Runs to a stop condition. `stop` is polled after every pass (Ctrl-C); progress lines go to
   // `progress` when it is not null.
-  RenderReport run(const std::atomic<bool>* stop, std::ostream* progress);
+  RenderReport run(const std::atomic<bool>* stop, std::ostream* progress,
+                   const CheckpointPolicy& checkpoint = {});
 
   // Runs one more pass (pass number passes() + 1).
   void step();
-  uint64_t passes() const { return passes_; }
+  uint64_t passes() const { return loop_.passes; }
+
+  // Everything a state file holds (scene hash aside), and the way back. restore() throws
+  // StateError when the state does not fit this scene and camera.
+  SavedRender snapshot() const;
+  void restore(const SavedRender& saved);
 
   // Radiance, bound channels and metadata, ready for write_exr.
   ExrImage image(const RenderReport& report) const;
@@ -63,6 +77,7 @@ class Renderer {
 
  private:
   double default_radius() const;
+  std::string progress_line(const RenderReport& report, double run_seconds) const;
   bool radii_fixed() const;
 
   const RenderOptions options_;
@@ -76,9 +91,8 @@ class Renderer {
   std::vector<PhotonHit> hits_;
   std::vector<vec3> hit_positions_;
   std::vector<float> radii_;
-  uint64_t passes_ = 0;
-  uint64_t photons_ = 0;  // emitted so far
-  uint64_t rays_ = 0;     // photon-pass rays so far
+  LoopState loop_;  // passes, photons, rays, seconds and check schedule so far
+  double initial_radius_ = 0.0;
   PhaseTimings timings_;
 };
 

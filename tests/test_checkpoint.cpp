@@ -1,0 +1,267 @@
+// Checkpoints, resume and interruption (README "Checkpoints").
+#include "render_fixture.h"
+
+#include "photonbound/checkpoint.h"
+#include "photonbound/image_io.h"
+
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+extern char** environ;
+
+namespace pb {
+namespace {
+
+namespace fs = std::filesystem;
+
+class Checkpoints : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ =
+        fs::temp_directory_path() /
+        ("pb_ck_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+  std::string path(const std::string& name) const { return (dir_ / name).string(); }
+  fs::path dir_;
+};
+
+RenderOptions small_options() {
+  RenderOptions o = test::quick_options("cornell.gltf", 32, 8);
+  o.photons_per_pass = 10000;
+  return o;
+}
+
+SavedRender saved_after(const RenderOptions& o, uint64_t passes) {
+  const Scene scene = load_gltf(o.scene);
+  Renderer r(scene, o);
+  while (r.passes() < passes) r.step();
+  SavedRender s = r.snapshot();
+  s.scene_hash = hash_file(o.scene);
+  return s;
+}
+
+// Continuing from a state file gives the image of an uninterrupted render, bit for bit.
+TEST_F(Checkpoints, ResumeIsBitIdentical) {
+  const RenderOptions o = small_options();
+  const Scene scene = load_gltf(o.scene);
+  Renderer straight(scene, o);
+  const RenderReport full = straight.run(nullptr, nullptr);
+
+  save_state(path("half.pbstate"), saved_after(o, 3));
+  const SavedRender loaded = load_state(path("half.pbstate"));
+  Renderer resumed(scene, o);
+  resumed.restore(loaded);
+  EXPECT_EQ(resumed.passes(), 3u);
+  const RenderReport rest = resumed.run(nullptr, nullptr);
+  EXPECT_EQ(rest.passes, full.passes);
+  EXPECT_EQ(rest.photons, full.photons);
+  ASSERT_EQ(resumed.states().size(), straight.states().size());
+  EXPECT_EQ(std::memcmp(resumed.states().data(), straight.states().data(),
+                        straight.states().size() * sizeof(PointState)),
+            0);
+  const ExrImage a = straight.image(full), b = resumed.image(rest);
+  EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(float)), 0);
+}
+
+TEST_F(Checkpoints, StateRoundTripsExactly) {
+  const SavedRender s = saved_after(small_options(), 2);
+  save_state(path("s.pbstate"), s);
+  const SavedRender t = load_state(path("s.pbstate"));
+  EXPECT_EQ(t.loop.passes, 2u);
+  EXPECT_EQ(t.scene_hash, s.scene_hash);
+  EXPECT_EQ(t.options.seed, s.options.seed);
+  EXPECT_EQ(t.options.width, s.options.width);
+  ASSERT_EQ(t.states.size(), s.states.size());
+  EXPECT_EQ(std::memcmp(t.states.data(), s.states.data(), s.states.size() * sizeof(PointState)), 0);
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const StateError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST_F(Checkpoints, BadStateFilesAreRefusedWithTheirReason) {
+  save_state(path("good.pbstate"), saved_after(small_options(), 1));
+  std::ifstream in(path("good.pbstate"), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto write = [&](const std::string& name, const std::string& content) {
+    std::ofstream(path(name), std::ios::binary) << content;
+    return path(name);
+  };
+  const std::string truncated = write("truncated.pbstate", bytes.substr(0, bytes.size() / 2));
+  EXPECT_NE(error_of([&] { load_state(truncated); }).find("truncated"), std::string::npos);
+  const std::string stub = write("stub.pbstate", bytes.substr(0, 20));
+  EXPECT_NE(error_of([&] { load_state(stub); }).find("truncated"), std::string::npos);
+
+  std::string flipped = bytes;
+  flipped[bytes.size() / 2] ^= 0x10;
+  const std::string corrupted = write("corrupted.pbstate", flipped);
+  EXPECT_NE(error_of([&] { load_state(corrupted); }).find("checksum"), std::string::npos);
+
+  std::string other_version = bytes;
+  other_version[8] = char(kStateVersion + 1);
+  const std::string version = write("version.pbstate", other_version);
+  EXPECT_NE(error_of([&] { load_state(version); }).find("version"), std::string::npos);
+
+  const std::string text = write("text.pbstate", "hello, I am not a state file at all\n");
+  EXPECT_NE(error_of([&] { load_state(text); }).find("not a photonbound state"), std::string::npos);
+  EXPECT_NE(error_of([&] { load_state(path("missing.pbstate")); }).find("cannot open"),
+            std::string::npos);
+  // Every message names the file.
+  EXPECT_NE(error_of([&] { load_state(corrupted); }).find("corrupted.pbstate"), std::string::npos);
+}
+
+TEST_F(Checkpoints, MismatchedSceneAndOptionsAreNamed) {
+  const RenderOptions o = small_options();
+  const SavedRender s = saved_after(o, 1);
+  EXPECT_TRUE(differences(s, o, s.scene_hash).empty());
+  RenderOptions changed = o;
+  changed.alpha = 0.5;
+  changed.seed = 9;
+  const auto d = differences(s, changed, s.scene_hash);
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_EQ(d[0], "alpha: 0.7 in the state, 0.5 now");
+  EXPECT_EQ(d[1], "seed: 1 in the state, 9 now");
+  const auto scene = differences(s, o, s.scene_hash + 1);
+  ASSERT_EQ(scene.size(), 1u);
+  EXPECT_NE(scene[0].find("scene"), std::string::npos);
+  // Options that do not change the image may differ.
+  RenderOptions harmless = o;
+  harmless.threads = 1;
+  harmless.passes = 1000;
+  harmless.confidence = 0.5;
+  EXPECT_TRUE(differences(s, harmless, s.scene_hash).empty());
+  // A state whose points do not fit the camera is refused by restore.
+  RenderOptions other = o;
+  other.width = 16;
+  other.height = 16;
+  const Scene sc = load_gltf(o.scene);
+  Renderer r(sc, other);
+  EXPECT_THROW(r.restore(s), StateError);
+}
+
+// ---- The executable under signals -------------------------------------------------------
+
+pid_t spawn(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  pid_t pid = -1;
+  posix_spawn(&pid, PHOTONBOUND_EXE, &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  return pid;
+}
+
+// Waits (at most 60 s) for a file to appear; false if it never does.
+bool wait_for(const std::string& file) {
+  for (int k = 0; k < 600; ++k) {
+    if (fs::exists(file)) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return false;
+}
+
+std::string meta(const ExrImage& img, const std::string& key) {
+  for (const auto& [k, v] : img.metadata)
+    if (k == key) return v;
+  return "";
+}
+
+std::vector<std::string> long_render(const std::string& out, double every) {
+  std::vector<std::string> a = {"photonbound",
+                                "render",
+                                test::scene_path("cornell.gltf"),
+                                "-o",
+                                out,
+                                "--passes",
+                                "1000000",
+                                "--resolution",
+                                "48x48",
+                                "--photons-per-pass",
+                                "20000",
+                                "--quiet"};
+  if (every > 0.0) {
+    a.push_back("--checkpoint-every");
+    a.push_back(std::to_string(every));
+  }
+  return a;
+}
+
+// kill -9 at arbitrary moments never leaves a half-written image or state: each is renamed
+// into place complete, and the state never claims passes the image lacks.
+TEST_F(Checkpoints, KillNineLeavesLoadableFiles) {
+  const std::string out = path("k.exr"), state = path("k.pbstate");
+  for (int trial = 0; trial < 5; ++trial) {
+    const pid_t pid = spawn(long_render(out, 0.02));
+    ASSERT_GT(pid, 0);
+    ASSERT_TRUE(wait_for(state));
+    // A different moment in each trial: 0 to 400 ms after the first checkpoint.
+    std::this_thread::sleep_for(std::chrono::milliseconds(37 + 91 * trial));
+    kill(pid, SIGKILL);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    const SavedRender s = load_state(state);
+    const ExrImage img = read_exr(out);
+    EXPECT_GE(std::stoull(meta(img, "passes_done")), s.loop.passes) << "trial " << trial;
+    EXPECT_GT(s.loop.passes, 0u);
+  }
+}
+
+TEST_F(Checkpoints, CtrlCWritesImageAndStateAndExitsZero) {
+  const std::string out = path("i.exr"), state = path("i.pbstate");
+  const pid_t pid = spawn(long_render(out, 0.0));
+  ASSERT_GT(pid, 0);
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  const ExrImage img = read_exr(out);
+  EXPECT_EQ(meta(img, "stop_reason"), "interrupted");
+  const SavedRender s = load_state(state);
+  EXPECT_EQ(std::to_string(s.loop.passes), meta(img, "passes_done"));
+}
+
+TEST_F(Checkpoints, SecondSignalLeavesAtOnceAndKeepsTheLastFiles) {
+  const std::string out = path("d.exr"), state = path("d.pbstate");
+  const pid_t pid = spawn(long_render(out, 0.05));
+  ASSERT_GT(pid, 0);
+  ASSERT_TRUE(wait_for(state));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  kill(pid, SIGTERM);
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  // Either the second signal arrived during the last pass (exit 128 + SIGTERM) or the first
+  // already finished the pass and its files (exit 0); in both cases the files on disk load.
+  EXPECT_TRUE(WEXITSTATUS(status) == 128 + SIGTERM || WEXITSTATUS(status) == 0)
+      << WEXITSTATUS(status);
+  EXPECT_NO_THROW(load_state(state));
+  EXPECT_NO_THROW(read_exr(out));
+}
+
+}  // namespace
+}  // namespace pb
