@@ -14,6 +14,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
 #include <iostream>
 
 namespace {
@@ -46,9 +47,26 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
     }
   }
 
+  pb::ExrImage reference;
+  if (!options.reference_path.empty()) reference = pb::read_exr(options.reference_path);
+  std::ofstream log_file;
+  if (!options.log_path.empty()) {
+    log_file.open(options.log_path, std::ios::trunc);
+    if (!log_file) throw std::runtime_error(options.log_path + ": cannot write the log");
+  }
+
   pb::ThreadLimit threads(options.threads);
   pb::Renderer renderer(scene, options);
   if (saved) renderer.restore(*saved);
+  if (!options.reference_path.empty() &&
+      (reference.width != renderer.eye().width || reference.height != renderer.eye().height))
+    throw pb::ImageError(options.reference_path + " is " + std::to_string(reference.width) + "x" +
+                         std::to_string(reference.height) + " but the render is " +
+                         std::to_string(renderer.eye().width) + "x" +
+                         std::to_string(renderer.eye().height));
+  pb::PassLog log;
+  if (log_file.is_open()) log.out = &log_file;
+  if (!options.reference_path.empty()) log.reference = &reference;
 
   // A checkpoint is the image and the state, each written atomically; the state goes last, so
   // a state file never refers to passes the image does not show.
@@ -71,7 +89,7 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   if (show)
     std::cerr << "photonbound: " << renderer.eye().points.size() << " measurement points, "
               << threads.threads() << " threads" << (saved ? ", resumed" : "") << "\n";
-  const pb::RenderReport report = renderer.run(&g_stop, show ? &std::cerr : nullptr, checkpoint);
+  const pb::RenderReport report = renderer.run(&g_stop, show ? &std::cerr : nullptr, checkpoint, log);
   // Ctrl-C keeps the work: the state is written then too.
   write_outputs(report, keep_state || report.stop_reason == "interrupted");
   if (show || report.stop_reason != "passes")
@@ -101,6 +119,8 @@ int resume(const pb::ResumeOptions& r) {
   o.state_path = n.state_path;
   o.threads = n.threads;
   o.progress = n.progress;
+  o.log_path = n.log_path;
+  o.reference_path = n.reference_path;
   o.resume_from = r.state;
   o.command_line = n.command_line;
   return render(o, &saved);

@@ -112,6 +112,16 @@ const std::map<std::string, Setter>& value_flags() {
          if (v.empty()) fail("--resume: the path is empty");
          o.resume_from = v;
        }},
+      {"--log",
+       [](RenderOptions& o, const std::string& v) {
+         if (v.empty()) fail("--log: the path is empty");
+         o.log_path = v;
+       }},
+      {"--reference",
+       [](RenderOptions& o, const std::string& v) {
+         if (v.empty()) fail("--reference: the path is empty");
+         o.reference_path = v;
+       }},
       {"--error-metric",
        [](RenderOptions& o, const std::string& v) {
          if (v == "absolute")
@@ -170,7 +180,7 @@ ResumeOptions parse_resume(int argc, const char* const* argv, int first) {
   parse_flags(argc, argv, first, r.overrides, positional, given);
   static const std::vector<std::string> allowed = {
       "-o",      "--passes",  "--time",     "--target-error", "--checkpoint-every",
-      "--state", "--threads", "--progress", "--quiet"};
+      "--state", "--threads", "--progress", "--quiet",   "--log", "--reference"};
   for (const std::string& g : given)
     if (std::find(allowed.begin(), allowed.end(), g) == allowed.end())
       fail("resume: " + g + " cannot be given when resuming: the state file fixes it");
@@ -246,6 +256,8 @@ void validate(const RenderOptions& o) {
   if (!(o.confidence > 0.0 && o.confidence < 1.0)) fail("--confidence: must be in (0, 1)");
   if (o.photons_per_pass < 1) fail("--photons-per-pass: must be at least 1");
   if (o.min_passes < 2) fail("--min-passes: must be at least 2");
+  if (!o.reference_path.empty() && o.log_path.empty())
+    fail("--reference: only used by --log (give --log FILE.jsonl too)");
   if (o.checkpoint_every && !(*o.checkpoint_every > 0.0 && *o.checkpoint_every <= 1e9))
     fail("--checkpoint-every: must be in (0, 1e9] seconds");
 }
@@ -319,6 +331,12 @@ checkpoints:
   --state FILE           state file (default: OUT with the extension .pbstate); written at
                          checkpoints, on Ctrl-C, and at the end when checkpoints are on
   --resume STATE         continue the render saved in STATE (its scene and options must match)
+
+measuring:
+  --log FILE.jsonl       one JSON line per logged pass: pass, seconds, photons, mean bound,
+                         mean noise, mean |bias|, fraction below target, unknown pixels
+                         (sparse: logging stays within 3% of the run time; last pass always)
+  --reference REF.exr    with --log: also the actual mean error, RMSE and coverage
 )";
 }
 

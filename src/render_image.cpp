@@ -3,10 +3,7 @@
 
 namespace pb {
 
-ExrImage Renderer::image(const RenderReport& report) const {
-  FilmImage film;
-  const FilmSummary summary = develop(eye_, states_, report.passes, film_settings(), &film);
-
+ExrImage pack_channels(const FilmImage& film) {
   ExrImage out;
   out.width = film.width;
   out.height = film.height;
@@ -33,7 +30,13 @@ ExrImage Renderer::image(const RenderReport& report) const {
     dst[c++] = film.photons[p];
     dst[c++] = film.radius[p];
   }
+  return out;
+}
 
+ExrImage Renderer::image(const RenderReport& report) const {
+  FilmImage film;
+  const FilmSummary summary = develop(eye_, states_, report.passes, film_settings(), &film);
+  ExrImage out = pack_channels(film);
   out.metadata = describe(options_);
   out.metadata.insert(out.metadata.end(),
                       {

@@ -1,5 +1,6 @@
 #include "photonbound/renderer.h"
 
+#include "photonbound/compare.h"
 #include "photonbound/gather.h"
 #include "photonbound/parallel.h"
 
@@ -169,14 +170,34 @@ std::string Renderer::progress_line(const RenderReport& report, double run_secon
   return line.str();
 }
 
+void Renderer::write_log_line(const RenderReport& report, const PassLog& log) const {
+  const FilmSummary& s = report.summary;
+  std::ostringstream line;
+  line.precision(9);
+  auto finite = [](double v) { return std::isfinite(v) ? v : -1.0; };  // JSON has no inf
+  line << "{\"pass\": " << report.passes << ", \"seconds\": " << report.seconds
+       << ", \"photons\": " << report.photons << ", \"mean_bound\": " << finite(s.mean_bound)
+       << ", \"mean_noise\": " << s.mean_noise << ", \"mean_abs_bias\": " << s.mean_abs_bias
+       << ", \"below_target\": " << s.below_target << ", \"unknown_pixels\": " << s.unknown_pixels;
+  if (log.reference) {
+    FilmImage film;
+    develop(eye_, states_, report.passes, film_settings(), &film);
+    const CompareResult c = compare_images(pack_channels(film), *log.reference, "render", "reference");
+    line << ", \"mae\": " << c.mean_abs_error << ", \"rmse\": " << c.rmse
+         << ", \"coverage\": " << c.coverage;
+  }
+  line << "}\n";
+  *log.out << line.str() << std::flush;
+}
+
 RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress,
-                           const CheckpointPolicy& checkpoint) {
+                           const CheckpointPolicy& checkpoint, const PassLog& log) {
   RenderReport report;
   report.initial_radius = initial_radius_;
   const FilmSettings settings = film_settings();
   const auto t0 = Clock::now();
   const double seconds_before = loop_.seconds;
-  double last_print = -1.0, last_checkpoint = 0.0;
+  double last_print = -1.0, last_checkpoint = 0.0, log_seconds = 0.0;
   if (loop_.next_check == 0) loop_.next_check = options_.min_passes;
   auto fill = [&] {
     report.passes = loop_.passes;
@@ -195,7 +216,9 @@ RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress
 
     const bool check = options_.target_error && pass >= loop_.next_check;
     const bool want_progress = progress && run_seconds - last_print >= 0.5;
-    if (check || want_progress) report.summary = develop(eye_, states_, pass, settings, nullptr);
+    const bool want_log = log.out && log_seconds <= log.max_overhead * run_seconds;
+    const bool developed = check || want_progress || want_log;
+    if (developed) report.summary = develop(eye_, states_, pass, settings, nullptr);
     if (check) {
       // Sparse schedule (ESTIMATOR.md section 7): checks about 10% apart in pass count, so the
       // criterion is not retried after every pass (optional stopping).
@@ -216,6 +239,12 @@ RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress
       report.stop_reason = "unreachable: the radius cannot shrink and the bias is above the target";
     if (stop && stop->load()) report.stop_reason = "interrupted";
 
+    if (log.out && (want_log || !report.stop_reason.empty())) {
+      const auto t_log = Clock::now();
+      if (!developed) report.summary = develop(eye_, states_, pass, settings, nullptr);
+      write_log_line(report, log);
+      log_seconds += seconds_since(t_log);
+    }
     if (want_progress || (progress && !report.stop_reason.empty())) {
       last_print = run_seconds;
       *progress << progress_line(report, run_seconds) << std::endl;

@@ -46,6 +46,9 @@ struct RenderOptions {
   std::optional<double> checkpoint_every;  // --checkpoint-every, (0, 1e9] seconds
   std::string state_path;                  // --state FILE; default OUT with .pbstate
   std::string resume_from;                 // --resume STATE: continue that render
+  // Per-pass log (README "Measuring the trade"): none of these changes the image.
+  std::string log_path;        // --log FILE.jsonl
+  std::string reference_path;  // --reference REF.exr: adds actual error and coverage to the log
 };
 
 // The state file a render writes: --state, or the output path with its extension replaced by

@@ -42,6 +42,18 @@ struct PhaseTimings {
   double gather = 0.0;  // gathers, next-event samples and estimator updates
 };
 
+// The EXR channel layout of README "Output" (no metadata).
+ExrImage pack_channels(const FilmImage& film);
+
+// Optional per-pass log (--log): one JSON object per logged pass. Passes are logged while the
+// time spent logging stays within `max_overhead` of the run's time, so the log never slows the
+// pass loop by more than that; the last pass is always logged.
+struct PassLog {
+  std::ostream* out = nullptr;
+  const ExrImage* reference = nullptr;  // adds the actual error and coverage when given
+  double max_overhead = 0.03;
+};
+
 // Called between passes every `every` seconds of the run (0 = never), to write checkpoints.
 struct CheckpointPolicy {
   double every = 0.0;
@@ -55,7 +67,7 @@ class Renderer {
   // Runs to a stop condition. `stop` is polled after every pass (Ctrl-C); progress lines go to
   // `progress` when it is not null.
   RenderReport run(const std::atomic<bool>* stop, std::ostream* progress,
-                   const CheckpointPolicy& checkpoint = {});
+                   const CheckpointPolicy& checkpoint = {}, const PassLog& log = {});
 
   // Runs one more pass (pass number passes() + 1).
   void step();
@@ -78,6 +90,7 @@ class Renderer {
  private:
   double default_radius() const;
   std::string progress_line(const RenderReport& report, double run_seconds) const;
+  void write_log_line(const RenderReport& report, const PassLog& log) const;
   bool radii_fixed() const;
 
   const RenderOptions options_;
