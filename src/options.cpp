@@ -317,7 +317,7 @@ options:
   --radius R             initial search radius in scene units (> 0; default 4 pixel footprints)
   --max-depth D          specular bounces of camera paths (0 .. 32; default 8)
   --resolution WxH       image size (1 .. 16384 each; default 512 wide, camera aspect)
-  --camera NAME          camera node or camera name (default: the first perspective camera)
+  --camera NAME          glTF camera name, "camera N" when unnamed (default: the first one)
   --threads T            worker threads (0 = all; default 0)
   --seed S               random seed (0 .. 2^64-1; default 1)
   --direct nee|photons   direct light by next-event estimation (default) or from photons
