@@ -37,12 +37,6 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   const pb::Scene scene = pb::load_gltf(options.scene);
   for (const std::string& w : scene.warnings)
     std::cerr << "photonbound: warning: " << options.scene << ": " << w << "\n";
-  // ESTIMATOR.md section 8: with error estimation the accumulated Laplacian converges only for
-  // alpha > 2/3, so the bias part of the bound is unreliable below it.
-  if (options.alpha <= 2.0 / 3.0)
-    std::cerr << "photonbound: warning: --alpha " << options.alpha
-              << " is at or below 2/3: the Laplacian (bias) estimate does not converge and the "
-                 "error bounds are unreliable\n";
   const uint64_t scene_hash = pb::hash_file(options.scene);
   if (saved) {
     const std::vector<std::string> diff = pb::differences(*saved, options, scene_hash);
@@ -61,6 +55,12 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
     if (!log_file) throw std::runtime_error(options.log_path + ": cannot write the log");
   }
 
+  // ESTIMATOR.md section 8: with error estimation the accumulated Laplacian converges only for
+  // alpha > 2/3, so the bias part of the bound is unreliable below it.
+  if (options.alpha <= 2.0 / 3.0)
+    std::cerr << "photonbound: warning: --alpha " << options.alpha
+              << " is at or below 2/3: the Laplacian (bias) estimate does not converge and the "
+                 "error bounds are unreliable\n";
   pb::ThreadLimit threads(options.threads);
   pb::Renderer renderer(scene, options);
   if (saved) renderer.restore(*saved);

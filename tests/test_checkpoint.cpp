@@ -1,4 +1,5 @@
 // Checkpoints, resume and interruption (README "Checkpoints").
+#include "process_fixture.h"
 #include "render_fixture.h"
 
 #include "photonbound/checkpoint.h"
@@ -25,19 +26,7 @@ namespace {
 
 namespace fs = std::filesystem;
 
-class Checkpoints : public ::testing::Test {
- protected:
-  void SetUp() override {
-    dir_ =
-        fs::temp_directory_path() /
-        ("pb_ck_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string path(const std::string& name) const { return (dir_ / name).string(); }
-  fs::path dir_;
-};
+class Checkpoints : public test::TempDirTest {};
 
 RenderOptions small_options() {
   RenderOptions o = test::quick_options("cornell.gltf", 32, 8);

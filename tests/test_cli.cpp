@@ -1,11 +1,7 @@
 // The command line as a user meets it: exit codes (0 done, 1 failure, 2 usage), one-line
 // messages, and no output file after any failure.
-#include <gtest/gtest.h>
+#include "process_fixture.h"
 
-#include <sys/wait.h>
-
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
@@ -13,46 +9,18 @@
 namespace {
 
 namespace fs = std::filesystem;
+using pb::test::Outcome;
+using pb::test::quote;
 
-struct Outcome {
-  int code = -1;
-  std::string err;  // stderr
-};
-
-std::string quote(const std::string& s) {
-  std::string q = "'";
-  for (char c : s) q += (c == '\'') ? std::string("'\\''") : std::string(1, c);
-  return q + "'";
-}
-
-Outcome run(const std::string& args) {
-  const std::string cmd = std::string(PHOTONBOUND_EXE) + " " + args + " 2>&1 >/dev/null";
-  Outcome r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), int(buf.size()), pipe)) r.err += buf.data();
-  const int status = pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
-}
+Outcome run(const std::string& args) { return pb::test::run_photonbound(args); }
 
 std::string scene(const std::string& name) { return std::string(PHOTONBOUND_SCENES) + "/" + name; }
 
-class Cli : public ::testing::Test {
+class Cli : public pb::test::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ =
-        fs::temp_directory_path() /
-        ("pb_cli_" + std::string(::testing::UnitTest::GetInstance()->current_test_info()->name()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-  std::string out() const { return (dir_ / "out.exr").string(); }
+  std::string out() const { return path("out.exr"); }
   // Nothing at all may be left in the output folder after a failure (no temporary either).
   bool folder_empty() const { return fs::is_empty(dir_); }
-  fs::path dir_;
 };
 
 void expect_one_line(const Outcome& r) {

@@ -1,11 +1,7 @@
 // Every option with hostile values: each gives exit code 2 and a one-line message, never a
 // crash or a hang (issue "Numerically sound at the extremes": options fuzzed from the CLI side).
-#include <gtest/gtest.h>
+#include "process_fixture.h"
 
-#include <sys/wait.h>
-
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <set>
 #include <string>
@@ -13,23 +9,10 @@
 namespace {
 
 namespace fs = std::filesystem;
-
-struct Outcome {
-  int code = -1;
-  std::string err;
-};
+using pb::test::Outcome;
 
 Outcome run_in(const fs::path& dir, const std::string& args) {
-  const std::string cmd = "cd '" + dir.string() + "' && timeout 60 " + PHOTONBOUND_EXE + " " +
-                          args + " 2>&1 >/dev/null";
-  Outcome r;
-  FILE* pipe = popen(cmd.c_str(), "r");
-  if (!pipe) return r;
-  std::array<char, 4096> buf{};
-  while (fgets(buf.data(), int(buf.size()), pipe)) r.err += buf.data();
-  const int status = pclose(pipe);
-  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  return r;
+  return pb::test::run_photonbound(args, dir.string());
 }
 
 TEST(SlowCliFuzz, HostileValuesGiveUsageErrors) {
@@ -37,14 +20,24 @@ TEST(SlowCliFuzz, HostileValuesGiveUsageErrors) {
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string scene = std::string(PHOTONBOUND_SCENES) + "/plane_point.gltf";
-  const std::string base = "render '" + scene + "' -o out.exr --resolution 8x8 --photons-per-pass 100 ";
-  const char* flags[] = {"--passes", "--time", "--target-error", "--photons-per-pass", "--alpha",
-                         "--radius", "--max-depth", "--resolution", "--threads", "--seed",
-                         "--direct", "--confidence", "--min-passes", "--error-metric",
-                         "--checkpoint-every"};
+  const std::string base =
+      "render '" + scene + "' -o out.exr --resolution 8x8 --photons-per-pass 100 ";
+  const char* flags[] = {
+      "--passes", "--time",       "--target-error", "--photons-per-pass", "--alpha",
+      "--radius", "--max-depth",  "--resolution",   "--threads",          "--seed",
+      "--direct", "--confidence", "--min-passes",   "--error-metric",     "--checkpoint-every"};
   // Shell-quoted: empty, negative, NaN, infinities, overflow, non-numeric, hex, padded, a flag.
-  const char* values[] = {"''", "-1", "nan", "-inf", "1e400", "abc", "0x10", "' 3'", "'3 '",
-                          "--", "99999999999999999999999"};
+  const char* values[] = {"''",
+                          "-1",
+                          "nan",
+                          "-inf",
+                          "1e400",
+                          "abc",
+                          "0x10",
+                          "' 3'",
+                          "'3 '",
+                          "--",
+                          "99999999999999999999999"};
   // Values that are legitimately in range for a flag (checked to succeed instead).
   const std::set<std::pair<std::string, std::string>> valid = {
       {"--radius", "99999999999999999999999"}, {"--target-error", "99999999999999999999999"}};
