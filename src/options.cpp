@@ -179,8 +179,8 @@ ResumeOptions parse_resume(int argc, const char* const* argv, int first) {
   std::vector<std::string> positional, given;
   parse_flags(argc, argv, first, r.overrides, positional, given);
   static const std::vector<std::string> allowed = {
-      "-o",      "--passes",  "--time",     "--target-error", "--checkpoint-every",
-      "--state", "--threads", "--progress", "--quiet",   "--log", "--reference"};
+      "-o",        "--passes",   "--time",  "--target-error", "--checkpoint-every", "--state",
+      "--threads", "--progress", "--quiet", "--log",          "--reference"};
   for (const std::string& g : given)
     if (std::find(allowed.begin(), allowed.end(), g) == allowed.end())
       fail("resume: " + g + " cannot be given when resuming: the state file fixes it");
@@ -250,12 +250,24 @@ void validate(const RenderOptions& o) {
     fail("render: no stop condition: give --passes, --time or --target-error");
   if (o.time_seconds && !(*o.time_seconds > 0.0 && *o.time_seconds <= 1e9))
     fail("--time: must be in (0, 1e9] seconds");
-  if (o.target_error && !(*o.target_error > 0.0)) fail("--target-error: must be greater than 0");
+  // Every range of README "Command line" is checked here too, not only by the parser: options
+  // built in process (tests, the library) must meet the same ranges.
+  if (o.passes && !(*o.passes >= 1 && *o.passes <= 1000000000000ULL))
+    fail("--passes: must be in [1, 1e12]");
+  if (o.target_error && !(*o.target_error > 0.0 && std::isfinite(*o.target_error)))
+    fail("--target-error: must be a finite number greater than 0");
   if (!(o.alpha > 0.0 && o.alpha <= 1.0)) fail("--alpha: must be in (0, 1]");
   if (o.radius && !(*o.radius > 0.0 && *o.radius < 1e30)) fail("--radius: must be in (0, 1e30)");
   if (!(o.confidence > 0.0 && o.confidence < 1.0)) fail("--confidence: must be in (0, 1)");
-  if (o.photons_per_pass < 1) fail("--photons-per-pass: must be at least 1");
-  if (o.min_passes < 2) fail("--min-passes: must be at least 2");
+  if (!(o.photons_per_pass >= 1 && o.photons_per_pass <= 1000000000ULL))
+    fail("--photons-per-pass: must be in [1, 1e9]");
+  if (!(o.max_depth >= 0 && o.max_depth <= 32)) fail("--max-depth: must be in [0, 32]");
+  if ((o.width && !(*o.width >= 1 && *o.width <= 16384)) ||
+      (o.height && !(*o.height >= 1 && *o.height <= 16384)))
+    fail("--resolution: width and height must be in [1, 16384]");
+  if (!(o.threads >= 0 && o.threads <= 1024)) fail("--threads: must be in [0, 1024]");
+  if (!(o.min_passes >= 2 && o.min_passes <= 1000000000000ULL))
+    fail("--min-passes: must be in [2, 1e12]");
   if (!o.reference_path.empty() && o.log_path.empty())
     fail("--reference: only used by --log (give --log FILE.jsonl too)");
   if (o.checkpoint_every && !(*o.checkpoint_every > 0.0 && *o.checkpoint_every <= 1e9))
@@ -314,7 +326,7 @@ stop conditions (at least one; whichever is reached first):
 options:
   --photons-per-pass M   photons emitted per pass (1 .. 1e9; default 100000)
   --alpha A              PPM radius reduction (0, 1] (default 0.7)
-  --radius R             initial search radius in scene units (> 0; default 4 pixel footprints)
+  --radius R             initial search radius in scene units (0, 1e30) (default 4 pixel footprints)
   --max-depth D          specular bounces of camera paths (0 .. 32; default 8)
   --resolution WxH       image size (1 .. 16384 each; default 512 wide, camera aspect)
   --camera NAME          glTF camera name, "camera N" when unnamed (default: the first one)
