@@ -40,12 +40,21 @@ Scenes (analytic answers are radiances in the renderer's units):
                      T = (1-R)/(1+R) = 0.923, offset by the slab pulling the light's image
                      0.067 m closer); floor radiance there ~ 0.8/pi * 0.547 = 0.139, plus
                      ~2% from floor <-> slab-underside interreflection.
+
+Not in scenes/ (25 MB; generated on demand, by the benchmark on first use, or with
+python3 tools/make_scenes.py --heavy DIR):
+
+  cornell_heavy.glb  The default scene with the mirror sphere replaced by a displaced
+                     clay-coloured Lambertian sphere of 1,046,528 triangles (1024 x 512 UV
+                     grid, radius 0.33 (1 + 0.06 sin 9 theta sin 9 phi), analytic normals).
+                     Benchmark scene (at least 1 M triangles); no analytic answer.
 """
 
 import base64
 import json
 import math
 import struct
+import sys
 from pathlib import Path
 
 FLOAT, UINT = 5126, 5125  # glTF componentType
@@ -245,6 +254,48 @@ def uv_sphere(center, radius, slices=64, stacks=32):
     return Geometry([add(center, scale(d, radius)) for d in dirs], dirs, idx)
 
 
+def displaced_sphere(center, radius, slices, stacks, amplitude, frequency):
+    """UV sphere with radius r = radius (1 + amplitude sin(f theta) sin(f phi)), outward winding.
+
+    Same topology as uv_sphere; normals are the analytic normals of the displaced surface
+    (dp/dtheta x dp/dphi), radial at the poles. Written with flat loops: ~1 M triangles."""
+    a, f = amplitude, frequency
+    positions, normals = [], []
+
+    def vertex(theta, phi):
+        st, ct, sp, cp = math.sin(theta), math.cos(theta), math.sin(phi), math.cos(phi)
+        d = (st * cp, ct, st * sp)
+        r = radius * (1.0 + a * math.sin(f * theta) * math.sin(f * phi))
+        r_t = radius * a * f * math.cos(f * theta) * math.sin(f * phi)
+        # dp/dphi / sin(theta) = (r_phi / sin theta) d + r (-sin phi, 0, cos phi)
+        r_p = radius * a * f * math.sin(f * theta) * math.cos(f * phi) / st
+        dt = (ct * cp, -st, ct * sp)
+        p_t = (r_t * d[0] + r * dt[0], r_t * d[1] + r * dt[1], r_t * d[2] + r * dt[2])
+        p_p = (r_p * d[0] - r * sp, r_p * d[1], r_p * d[2] + r * cp)
+        n = normalize(cross(p_p, p_t))
+        positions.append((center[0] + r * d[0], center[1] + r * d[1], center[2] + r * d[2]))
+        normals.append(n)
+
+    positions.append(add(center, (0.0, radius, 0.0)))
+    normals.append((0.0, 1.0, 0.0))
+    for i in range(1, stacks):
+        for j in range(slices):
+            vertex(math.pi * i / stacks, 2.0 * math.pi * j / slices)
+    positions.append(add(center, (0.0, -radius, 0.0)))
+    normals.append((0.0, -1.0, 0.0))
+    south = len(positions) - 1
+    idx = []
+    for j in range(slices):
+        j1 = (j + 1) % slices
+        idx += [0, 1 + j1, 1 + j]
+        for i in range(1, stacks - 1):
+            r0, r1 = 1 + (i - 1) * slices, 1 + i * slices
+            idx += [r0 + j, r0 + j1, r1 + j, r0 + j1, r1 + j1, r1 + j]
+        last = 1 + (stacks - 2) * slices
+        idx += [last + j, last + j1, south]
+    return Geometry(positions, normals, idx)
+
+
 # ----------------------------------------------------------------------------- glTF builder
 
 
@@ -428,6 +479,29 @@ def build_cornell():
     sphere = uv_sphere((0.0, 0.0, 0.0), 0.35)  # placed by node translations
     b.mesh_node("glass_sphere", [(sphere, glass)], translation=(0.45, 0.35, 0.4))
     b.mesh_node("mirror_sphere", [(sphere, mirror)], translation=(-0.45, 0.35, -0.35))
+    b.camera_node("camera", eye=(0.0, 1.0, 3.4), target=(0.0, 1.0, 0.0), yfov=0.78)
+    return b
+
+
+def build_cornell_heavy():
+    """The default scene with the mirror sphere replaced by a ~1 M-triangle displaced sphere."""
+    b = GltfBuilder()
+    white = b.lambertian("white", (0.75, 0.75, 0.75))
+    red = b.lambertian("red", (0.63, 0.065, 0.05))
+    green = b.lambertian("green", (0.14, 0.45, 0.09))
+    lamp = b.lambertian("light", (0.0, 0.0, 0.0), radiance=40.0)
+    glass = b.glass("glass", 1.5)
+    clay = b.lambertian("clay", (0.7, 0.6, 0.5))
+
+    walls = box_faces((-1.0, 0.0, -1.0), (1.0, 2.0, 1.0), inward=True)
+    b.mesh_node("walls", [(merge([walls["-y"], walls["+y"], walls["-z"]]), white),
+                          (walls["-x"], red), (walls["+x"], green)])
+    b.mesh_node("light", [(horizontal_quad((0.0, 1.98, 0.0), 0.15, 0.15, facing_up=False),
+                           lamp)])
+    b.mesh_node("glass_sphere", [(uv_sphere((0.0, 0.0, 0.0), 0.35), glass)],
+                translation=(0.45, 0.35, 0.4))
+    bumpy = displaced_sphere((0.0, 0.0, 0.0), 0.33, 1024, 512, 0.06, 9.0)
+    b.mesh_node("bumpy_sphere", [(bumpy, clay)], translation=(-0.45, 0.37, -0.35))
     b.camera_node("camera", eye=(0.0, 1.0, 3.4), target=(0.0, 1.0, 0.0), yfov=0.78)
     return b
 
@@ -707,7 +781,8 @@ def check_spot(s):
     check(near(s["lights"][0][1], (0, -1, 0)), "spot must point down")
 
 
-SCENE_CHECKS = {"cornell.gltf": check_cornell, "closed_box.gltf": check_closed_box,
+SCENE_CHECKS = {"cornell.gltf": check_cornell, "cornell_heavy.glb": check_cornell,
+                "closed_box.gltf": check_closed_box,
                 "spot.gltf": check_spot, "glass_slab.gltf": check_faces_up,
                 "plane_point.gltf": check_faces_up}
 SAME_AS_PLANE_POINT = ("plane_point.glb", "plane_point_external.gltf", "nested.gltf")
@@ -760,7 +835,27 @@ OUTPUTS = [  # (file name, builder, writer)
 ]
 
 
+HEAVY = ("cornell_heavy.glb", build_cornell_heavy, GltfBuilder.write_glb)
+
+
+def write_heavy(out_dir):
+    """--heavy DIR: writes and validates only the benchmark's heavy scene, into DIR."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    name, build, write = HEAVY
+    write(build(), out_dir / name)
+    try:
+        _, summary = validate(out_dir / name)
+    except (Invalid, KeyError, ValueError, struct.error) as e:
+        raise SystemExit(f"make_scenes: {name}: INVALID: {e}")
+    print(summary)
+
+
 def main():
+    if len(sys.argv) == 3 and sys.argv[1] == "--heavy":
+        write_heavy(Path(sys.argv[2]))
+        return
+    if len(sys.argv) != 1:
+        raise SystemExit("usage: make_scenes.py [--heavy DIR]")
     out_dir = Path(__file__).resolve().parent.parent / "scenes"
     out_dir.mkdir(exist_ok=True)
     for name, build, write in OUTPUTS:
