@@ -111,10 +111,15 @@ class HashGrid {
     }
   }
 
+  // Hashes and sorts every photon into one level (hash_grid.cpp).
+  void build_level(Level& lv, std::span<const vec3> positions, int bits);
+
   std::vector<Level> levels_;      // [0, level_count_) in use; the rest kept for reuse
   std::vector<int> level_map_;     // level k (0..L-1) -> slot of the smallest built level >= k
   std::vector<uint8_t> used_;      // build scratch: level k is used by some radius
   std::vector<uint32_t> buckets_;  // build scratch: bucket of each photon
+  std::vector<uint64_t> pairs_;    // build scratch: bucket << 32 | photon, by super-bucket
+  std::vector<uint32_t> histogram_, super_start_;  // build scratch of the first sort round
   int level_count_ = 0;
   size_t photon_count_ = 0;
   float r_min_ = 1.0f;
