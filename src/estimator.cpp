@@ -59,7 +59,7 @@ PointEstimate estimate(const PointState& s, uint64_t passes, double photons_per_
   const dvec3 a = 0.5 * kernel::kSecondMoment * lap;
   e.bias = a * s.mean_r2;
 
-  e.known = passes >= 2 && s.photons > 0;
+  e.known = passes >= 2 && s.photons >= kMinPhotonsForBound;
   if (passes >= 2) {
     // Retroactive correction X'_j = X_j - a R_j^2 with the newest a (section 4).
     const dvec3 s2 = glm::max(dvec3(0.0), (s.c_xx - 2.0 * a * s.c_xr + a * a * s.c_rr) / (i - 1.0));

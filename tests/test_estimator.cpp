@@ -531,7 +531,7 @@ TEST(Estimator, StudentTQuantilesMatchTable) {
   EXPECT_NEAR(student_t_quantile(1e7, 0.95), student_t_quantile(1.0000001e7, 0.95), 1e-6);
 }
 
-TEST(Estimator, KnownOnlyWithPhotonsAndTwoPasses) {
+TEST(Estimator, KnownOnlyWithEnoughPhotonsAndTwoPasses) {
   EstimatorParams p;
   p.alpha = kAlpha;
   p.photons_per_pass = kMe;
@@ -548,7 +548,7 @@ TEST(Estimator, KnownOnlyWithPhotonsAndTwoPasses) {
       EXPECT_NEAR(e.radiance.x, 0.3, 1e-15);
     }
   }
-  // With photons from pass 1: unknown after 1 pass, known from 2 passes.
+  // With 3 photons a pass from pass 1: unknown after 1 pass, known from 2 passes (6 photons).
   {
     PointState s;
     s.r2 = 0.01;
@@ -561,7 +561,7 @@ TEST(Estimator, KnownOnlyWithPhotonsAndTwoPasses) {
     accumulate_pass(s, g, p, 2);
     EXPECT_TRUE(estimate(s, 2, kMe).known);
   }
-  // Photons arriving only in pass 3: unknown at 2 passes, known at 3.
+  // One photon a pass from pass 3: unknown until the fifth photon (pass 7), known from then on.
   {
     PointState s;
     s.r2 = 0.01;
@@ -572,8 +572,11 @@ TEST(Estimator, KnownOnlyWithPhotonsAndTwoPasses) {
     PassGather g;
     g.count = 1;
     g.phi = dvec3(0.1);
-    accumulate_pass(s, g, p, 3);
-    EXPECT_TRUE(estimate(s, 3, kMe).known);
+    for (uint64_t j = 3; j <= 8; ++j) {
+      accumulate_pass(s, g, p, j);
+      EXPECT_EQ(estimate(s, j, kMe).known, s.photons >= kMinPhotonsForBound) << "pass " << j;
+    }
+    EXPECT_TRUE(estimate(s, 8, kMe).known);
   }
 }
 

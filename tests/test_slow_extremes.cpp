@@ -57,7 +57,7 @@ TEST(SlowExtremes, RareArrivalsRendered) {
       long known = 0, covered = 0, streak = 0, streak_covered = 0, few = 0, few_covered = 0;
       for (size_t p = 0; p < n; ++p) {
         const PointState& s = run.r->states()[p];
-        if (s.photons == 0) continue;
+        if (s.photons < kMinPhotonsForBound) continue;
         const double exact = analytic::plane_point(run.r->eye().points[p].position);
         const double l = img.radiance[3 * p], b = img.bound[3 * p];
         EXPECT_GE(b, 0.999 * q.two_sided_t() * l / std::sqrt(double(s.photons)))
