@@ -1,14 +1,15 @@
 // Build of the multi-level counting-sort hash grid (design notes in hash_grid.h).
 //
 // Per level: hash every photon to its bucket (in parallel), then a two-round stable counting
-// sort. A single counting sort scatters into the whole bucket table (8 bytes per photon) at
-// random, a cache miss per photon once the cells are small enough that neighbouring photons land
-// in different buckets (after the radii have shrunk); that was 60% of the build. So round 1
-// partitions (bucket, photon) pairs by the bucket's top bits into at most 256 super-buckets
-// (a small histogram, sequential output streams), and round 2 counting-sorts each super-bucket
-// within its own slice of the table, which fits in L2. Both rounds are stable and work over a
-// fixed number of blocks, so entries come out exactly as the single serial sort made them
-// (bucket order, ascending photon index within a bucket) for every thread count.
+// sort. A single counting sort scatters into the whole bucket table at random, a cache miss per
+// photon once the cells are small enough that neighbouring photons land in different buckets
+// (after the radii have shrunk); that scatter was about half of the build. So round 1
+// partitions the entries by the bucket's top bits into at most 256 super-buckets (a small
+// histogram, sequential output streams), and round 2 counting-sorts each super-bucket within
+// its own slice of the table, which fits in L2. Both rounds are stable and work over a fixed
+// number of blocks, so entries come out exactly as the single serial sort made them (bucket
+// order, ascending photon index within a bucket) for every thread count. Scratch: 24 bytes per
+// photon, kept for the next build.
 #include "photonbound/hash_grid.h"
 
 #include "photonbound/parallel.h"
@@ -46,7 +47,7 @@ void HashGrid::build_level(Level& lv, std::span<const vec3> positions, int bits)
     }
   });
 
-  // Round 1: stable partition of (bucket, photon) pairs by super-bucket = bucket >> super_shift.
+  // Round 1: stable partition of the entries by super-bucket = bucket >> super_shift.
   const int super_bits = std::min(kSuperBits, bits);
   const int super_shift = bits - super_bits;
   const size_t supers = size_t(1) << super_bits;
@@ -71,12 +72,16 @@ void HashGrid::build_level(Level& lv, std::span<const vec3> positions, int bits)
     }
   }
   super_start_[supers] = sum;
-  pairs_.resize(n);
+  staged_.resize(n);
+  staged_buckets_.resize(n);
   parallel_for(kBlocks, 1, [&](size_t b0, size_t b1) {
     for (size_t b = b0; b < b1; ++b) {
       uint32_t* h = histogram_.data() + b * supers;
-      for (size_t i = b * block; i < std::min(n, (b + 1) * block); ++i)
-        pairs_[h[buckets_[i] >> super_shift]++] = uint64_t(buckets_[i]) << 32 | i;
+      for (size_t i = b * block; i < std::min(n, (b + 1) * block); ++i) {
+        const uint32_t slot = h[buckets_[i] >> super_shift]++;
+        staged_[slot] = Entry{positions[i], uint32_t(i)};
+        staged_buckets_[slot] = buckets_[i];
+      }
     }
   });
 
@@ -90,15 +95,11 @@ void HashGrid::build_level(Level& lv, std::span<const vec3> positions, int bits)
       const size_t h0 = s << super_shift, h1 = (s + 1) << super_shift;
       uint32_t* start = lv.start.data();
       std::fill(start + h0, start + h1, 0u);
-      const uint64_t* first = pairs_.data() + super_start_[s];
-      const uint64_t* last = pairs_.data() + super_start_[s + 1];
-      for (const uint64_t* q = first; q != last; ++q) ++start[*q >> 32];
+      const size_t first = super_start_[s], last = super_start_[s + 1];
+      for (size_t q = first; q != last; ++q) ++start[staged_buckets_[q]];
       uint32_t acc = super_start_[s];
       for (size_t h = h0; h < h1; ++h) start[h] = acc += start[h];
-      for (const uint64_t* q = last; q-- != first;) {
-        const uint32_t i = uint32_t(*q);
-        lv.entries[--start[*q >> 32]] = Entry{positions[i], i};
-      }
+      for (size_t q = last; q-- != first;) lv.entries[--start[staged_buckets_[q]]] = staged_[q];
     }
   });
   lv.start[table] = uint32_t(n);
@@ -109,23 +110,51 @@ void HashGrid::build_level(Level& lv, std::span<const vec3> positions, int bits)
 // at least 2^-24), so frexp() of the quotient gives the exact smallest k. With all radii equal
 // every radius maps to level 0 and exactly one level is built.
 void HashGrid::build(std::span<const vec3> positions, std::span<const float> radii) {
-  // Validate everything before touching state, so a throw leaves the previous grid usable.
+  // Validate everything before touching state, so a throw leaves the previous grid usable. The
+  // scans run over fixed blocks in parallel (min, max and the bounds do not depend on order).
+  struct Scan {
+    float r_min = std::numeric_limits<float>::infinity(), r_max = 0.0f;
+    bool bad_radius = false, bad_position = false;
+    float first_bad = 0.0f;
+    Bounds bounds;
+  };
+  Scan scans[kBlocks];
+  const size_t rblock = (radii.size() + kBlocks - 1) / kBlocks;
+  const size_t pblock = (positions.size() + kBlocks - 1) / kBlocks;
+  parallel_for(kBlocks, 1, [&](size_t b0, size_t b1) {
+    for (size_t b = b0; b < b1; ++b) {
+      Scan& sc = scans[b];
+      for (size_t i = b * rblock; i < std::min(radii.size(), (b + 1) * rblock); ++i) {
+        const float r = radii[i];
+        if (!(r > 0.0f) || !std::isfinite(r)) {
+          if (!sc.bad_radius) sc.first_bad = r;
+          sc.bad_radius = true;
+        }
+        sc.r_min = std::min(sc.r_min, r);
+        sc.r_max = std::max(sc.r_max, r);
+      }
+      for (size_t i = b * pblock; i < std::min(positions.size(), (b + 1) * pblock); ++i) {
+        sc.bad_position |= !is_finite(positions[i]);
+        sc.bounds.extend(positions[i]);
+      }
+    }
+  });
   float r_min = std::numeric_limits<float>::infinity(), r_max = 0.0f;
-  for (const float r : radii) {
-    if (!(r > 0.0f) || !std::isfinite(r))
-      throw std::invalid_argument("HashGrid::build: query radius " + std::to_string(r) +
+  Bounds bounds;
+  for (const Scan& sc : scans) {
+    if (sc.bad_radius)
+      throw std::invalid_argument("HashGrid::build: query radius " + std::to_string(sc.first_bad) +
                                   " is not finite and > 0");
-    r_min = std::min(r_min, r);
-    r_max = std::max(r_max, r);
+    r_min = std::min(r_min, sc.r_min);
+    r_max = std::max(r_max, sc.r_max);
+    bounds.lo = glm::min(bounds.lo, sc.bounds.lo);
+    bounds.hi = glm::max(bounds.hi, sc.bounds.hi);
   }
   // Bucket indices are stored as uint32 and a table holds 2^b >= 2n buckets.
   if (positions.size() > (size_t(1) << 31))
     throw std::length_error("HashGrid::build: more than 2^31 photons");
-  Bounds bounds;
-  for (const vec3& p : positions) {
-    if (!is_finite(p)) throw std::invalid_argument("HashGrid::build: non-finite photon position");
-    bounds.extend(p);
-  }
+  for (const Scan& sc : scans)
+    if (sc.bad_position) throw std::invalid_argument("HashGrid::build: non-finite photon position");
 
   const size_t n = positions.size();
   photon_count_ = n;
@@ -136,8 +165,15 @@ void HashGrid::build(std::span<const vec3> positions, std::span<const float> rad
 
   // Mark the levels the radii use; build those, in ascending k, into slots 0, 1, ...
   const int top = level_of(r_max, r_min);
-  used_.assign(size_t(top) + 1, 0);
-  for (const float r : radii) used_[size_t(level_of(r, r_min))] = 1;
+  const size_t levels = size_t(top) + 1;
+  used_.assign(kBlocks * levels, 0);  // per block, then merged into the first block's row
+  parallel_for(kBlocks, 1, [&](size_t b0, size_t b1) {
+    for (size_t b = b0; b < b1; ++b)
+      for (size_t i = b * rblock; i < std::min(radii.size(), (b + 1) * rblock); ++i)
+        used_[b * levels + size_t(level_of(radii[i], r_min))] = 1;
+  });
+  for (size_t b = 1; b < kBlocks; ++b)
+    for (size_t k = 0; k < levels; ++k) used_[k] |= used_[b * levels + k];
   level_map_.assign(size_t(top) + 1, -1);
   for (int k = 0; k <= top; ++k)
     if (used_[size_t(k)]) level_map_[size_t(k)] = level_count_++;
@@ -168,10 +204,11 @@ void HashGrid::build(std::span<const vec3> positions, std::span<const float> rad
 }
 
 size_t HashGrid::memory_bytes() const {
-  size_t bytes = levels_.capacity() * sizeof(Level) + level_map_.capacity() * sizeof(int) +
-                 used_.capacity() * sizeof(uint8_t) + buckets_.capacity() * sizeof(uint32_t) +
-                 pairs_.capacity() * sizeof(uint64_t) + histogram_.capacity() * sizeof(uint32_t) +
-                 super_start_.capacity() * sizeof(uint32_t);
+  size_t bytes =
+      levels_.capacity() * sizeof(Level) + level_map_.capacity() * sizeof(int) +
+      used_.capacity() * sizeof(uint8_t) + buckets_.capacity() * sizeof(uint32_t) +
+      staged_.capacity() * sizeof(Entry) + staged_buckets_.capacity() * sizeof(uint32_t) +
+      histogram_.capacity() * sizeof(uint32_t) + super_start_.capacity() * sizeof(uint32_t);
   for (const Level& lv : levels_)
     bytes += lv.start.capacity() * sizeof(uint32_t) + lv.entries.capacity() * sizeof(Entry);
   return bytes;

@@ -81,8 +81,13 @@ class HashGrid {
   static constexpr int kSeenCapacity = 64;
   static constexpr double kCellLimit = 0x1p62;  // keeps floor(x / s) inside int64
 
+  // floor(x * inv_cell) clamped to +-2^62, as truncation and a correction below zero: the same
+  // value, and cheaper than std::floor's inline expansion on the x86-64 baseline (no SSE4.1
+  // rounding instruction); about 10% of a grid build.
   static int64_t cell_coord(double x, double inv_cell) {
-    return int64_t(std::clamp(std::floor(x * inv_cell), -kCellLimit, kCellLimit));
+    const double f = std::clamp(x * inv_cell, -kCellLimit, kCellLimit);
+    const int64_t t = int64_t(f);
+    return t - (double(t) > f ? 1 : 0);
   }
   static size_t bucket_of(int64_t x, int64_t y, int64_t z, int shift) {
     uint64_t h = uint64_t(x) * 0x9e3779b97f4a7c15ULL + uint64_t(y) * 0xc2b2ae3d27d4eb4fULL +
@@ -118,7 +123,8 @@ class HashGrid {
   std::vector<int> level_map_;     // level k (0..L-1) -> slot of the smallest built level >= k
   std::vector<uint8_t> used_;      // build scratch: level k is used by some radius
   std::vector<uint32_t> buckets_;  // build scratch: bucket of each photon
-  std::vector<uint64_t> pairs_;    // build scratch: bucket << 32 | photon, by super-bucket
+  std::vector<Entry> staged_;      // build scratch: entries by super-bucket
+  std::vector<uint32_t> staged_buckets_;           // build scratch: their buckets
   std::vector<uint32_t> histogram_, super_start_;  // build scratch of the first sort round
   int level_count_ = 0;
   size_t photon_count_ = 0;
