@@ -1,0 +1,316 @@
+// photonbound-bench [--quick] [SCENE...]: photon throughput against Embree's raw ray rate,
+// scaling, memory, grid and error-estimation costs (issue 5). bench/README.md explains every
+// figure and holds this machine's output. Timings are printed, never asserted.
+#include "bench.h"
+
+#include "photonbound/gltf_loader.h"
+#include "photonbound/parallel.h"
+#include "photonbound/renderer.h"
+
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace bench {
+namespace {
+
+struct Config {
+  uint64_t photons = 1000000;  // per pass: the issue's figure
+  size_t raw_rays = size_t(1) << 20;
+  int raw_reps = 7;
+  int trace_passes_1 = 5, trace_passes_all = 7;
+  int loop_passes = 8;
+  int width = 512, height = 512;  // the renderer's default for a square camera
+  bool big_render = true;         // the 1920x1080 memory run
+};
+
+constexpr double kMiB = 1024.0 * 1024.0;
+constexpr double kGiB = 1024.0 * kMiB;
+
+// One line of the goal table, collected while measuring and printed at the end.
+struct Goal {
+  std::string what, measured, goal;
+  bool met;
+};
+std::vector<Goal> goals;
+
+void goal(const std::string& what, const std::string& measured, const std::string& target,
+          bool met) {
+  goals.push_back({what, measured, target, met});
+}
+
+std::string fmt(const char* f, double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, f, v);
+  return buf;
+}
+
+// The 1, 5 and 15 minute load averages (/proc/loadavg), to judge how busy the machine was.
+std::string load_average() {
+  std::ifstream f("/proc/loadavg");
+  double a = 0, b = 0, c = 0;
+  if (!(f >> a >> b >> c)) return "unknown";
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.2f %.2f %.2f", a, b, c);
+  return buf;
+}
+
+std::string heavy_scene() {
+  const std::string dir = std::string(PHOTONBOUND_BENCH_DIR) + "/scenes";
+  const std::string path = dir + "/cornell_heavy.glb";
+  if (!std::filesystem::exists(path)) {
+    std::printf("generating %s (tools/make_scenes.py --heavy, ~10 s)\n", path.c_str());
+    std::fflush(stdout);
+    const std::string cmd = "python3 '" + std::string(PHOTONBOUND_SOURCE_DIR) +
+                            "/tools/make_scenes.py' --heavy '" + dir + "' >/dev/null";
+    if (std::system(cmd.c_str()) != 0) throw std::runtime_error("cannot generate " + path);
+  }
+  return path;
+}
+
+// 1920x1080 default scene at 1M photons per pass through pb::Renderer itself: peak RSS of the
+// whole render (scene, eye pass, points, states, photons, grid), per-phase times per pass.
+void big_render(const std::string& path, const Config& c) {
+  std::printf("\n== 1920x1080 render of %s at %.0fk photons/pass (pb::Renderer, all threads)\n",
+              path.c_str(), double(c.photons) / 1e3);
+  reset_peak_rss();
+  const double rss0 = peak_rss_bytes();
+  const pb::Scene scene = pb::load_gltf(path);
+  pb::RenderOptions o;
+  o.scene = path;
+  o.output = "unused.exr";
+  o.width = 1920;
+  o.height = 1080;
+  o.photons_per_pass = c.photons;
+  o.passes = 2;
+  o.progress = pb::ProgressMode::Never;
+  pb::Renderer r(scene, o);
+  r.step();
+  r.step();
+  const double peak = peak_rss_bytes();
+  const pb::PhaseTimings& t = r.timings();
+  const size_t points = r.states().size();
+
+  // The grid's share: the renderer's grid is private, so build the same grid (one pass of
+  // photons, the renderer's current radii) beside it, after the RSS reading.
+  pb::PhotonTracer tracer(r.world(), false);
+  std::vector<pb::PhotonHit> hits;
+  tracer.run(kSeed, 3, c.photons, hits);
+  std::vector<pb::vec3> positions(hits.size());
+  for (size_t k = 0; k < hits.size(); ++k) positions[k] = hits[k].position;
+  std::vector<float> radii(points);
+  for (size_t k = 0; k < points; ++k) radii[k] = float(std::sqrt(r.states()[k].r2));
+  pb::HashGrid grid;
+  grid.build(positions, radii);
+  const double fixed = double(sizeof(pb::MeasurementPoint) + sizeof(pb::PointState) + 4);
+  const double per_point = fixed + double(grid.memory_bytes()) / double(points);
+  const double pass = (t.trace + t.grid + t.gather) / 2.0;
+
+  std::printf("  measurement points       %zu (%.2f per pixel); eye pass %.2f s\n", points,
+              double(points) / (1920.0 * 1080.0), t.eye);
+  std::printf(
+      "  pass time                %.3f s (trace %.3f, grid %.3f = %.1f%%, gather+update "
+      "%.3f)\n",
+      pass, t.trace / 2, t.grid / 2, 100.0 * t.grid / 2 / pass, t.gather / 2);
+  std::printf(
+      "  bytes per point          %.1f = %zu MeasurementPoint + %zu PointState + 4 radius"
+      " + %.1f grid (%.1f MiB, %d levels)\n",
+      per_point, sizeof(pb::MeasurementPoint), sizeof(pb::PointState),
+      double(grid.memory_bytes()) / double(points), double(grid.memory_bytes()) / kMiB,
+      grid.level_count());
+  std::printf("  peak RSS                 %.0f MiB (%.3f of the 2 GiB limit; %.0f MiB at start)\n",
+              peak / kMiB, peak / (2.0 * kGiB), rss0 / kMiB);
+  goal("1080p peak RSS (default scene, 1M/pass)", fmt("%.0f MiB", peak / kMiB), "< 2048 MiB",
+       peak < 2.0 * kGiB);
+  goal("bytes per point incl. grid (1080p)", fmt("%.1f", per_point), "<= 256", per_point <= 256.0);
+  goal("grid rebuild / pass (1080p, 1M/pass)", fmt("%.1f%%", 100.0 * t.grid / 2 / pass), "<= 10%",
+       t.grid / 2 <= 0.1 * pass);
+}
+
+void run_scene(const std::string& path, const Config& c, int all) {
+  const double t0 = now();
+  const pb::Scene scene = pb::load_gltf(path);
+  const double load = seconds_since(t0);
+  const double t1 = now();
+  const pb::World world(scene);
+  const double build = seconds_since(t1);
+  const std::string name = std::filesystem::path(path).filename().string();
+  std::printf("\n== %s: %zu triangles (load %.2f s, Embree build %.2f s)\n", path.c_str(),
+              scene.triangle_count(), load, build);
+
+  const RayRate raw1 = raw_ray_rate(world, 1, c.raw_rays, c.raw_reps);
+  const RayRate rawn = raw_ray_rate(world, all, c.raw_rays, c.raw_reps);
+  std::printf(
+      "  raw Embree rays/s        1 thread %.2f M, %d threads %.2f M (%.2fx); %.0f%% hit"
+      " [the limit]\n",
+      raw1.rays_per_s / 1e6, all, rawn.rays_per_s / 1e6, rawn.rays_per_s / raw1.rays_per_s,
+      100.0 * raw1.hit_fraction);
+
+  const PhotonRate ph1 = photon_pass_rate(world, 1, c.photons, c.trace_passes_1);
+  const PhotonRate phn = photon_pass_rate(world, all, c.photons, c.trace_passes_all);
+  const double scaling = phn.rays_per_s / ph1.rays_per_s;
+  std::printf(
+      "  photon pass rays/s       1 thread %.2f M (%.2f of raw), %d threads %.2f M "
+      "(%.2f of raw); %d/1 threads %.2fx\n",
+      ph1.rays_per_s / 1e6, ph1.rays_per_s / raw1.rays_per_s, all, phn.rays_per_s / 1e6,
+      phn.rays_per_s / rawn.rays_per_s, all, scaling);
+  std::printf(
+      "  photon paths/s           1 thread %.2f M, %d threads %.2f M; %.2f rays and %.2f "
+      "stored hits per path\n",
+      ph1.paths_per_s / 1e6, all, phn.paths_per_s / 1e6, phn.rays_per_path, phn.hits_per_path);
+  // The ratio without the spatial ordering, which is there for the gather, not for tracing.
+  const double trace_only = phn.rays_per_s * phn.seconds / (phn.seconds - phn.order_seconds);
+  std::printf(
+      "  photon pass time         1 thread %.3f s, %d threads %.3f s per pass, of which "
+      "spatial ordering of the hits %.3f / %.3f s (without it %.2f of raw)\n",
+      ph1.seconds, all, phn.seconds, ph1.order_seconds, phn.order_seconds,
+      trace_only / rawn.rays_per_s);
+  goal(name + ": photon pass / raw rays (" + std::to_string(all) + " thr)",
+       fmt("%.2f", phn.rays_per_s / rawn.rays_per_s), ">= 0.60",
+       phn.rays_per_s >= 0.6 * rawn.rays_per_s);
+  goal(name + ": photon pass / raw rays (1 thr)", fmt("%.2f", ph1.rays_per_s / raw1.rays_per_s),
+       ">= 0.60", ph1.rays_per_s >= 0.6 * raw1.rays_per_s);
+  goal(name + ": photon pass scaling " + std::to_string(all) + "/1 threads", fmt("%.2fx", scaling),
+       ">= 1.8x", scaling >= 1.8);
+
+  const EyeSetup eye = eye_setup(world, c.width, c.height);
+  std::printf("  eye pass                 %.3f s at %dx%d (%zu points)\n", eye.seconds, c.width,
+              c.height, eye.eye.points.size());
+
+  const PassLoop L = pass_loop(world, eye, c.photons, c.loop_passes);
+  const double pass = L.on_pass(), grid = L.grid_prep + L.grid_build;
+  std::printf("  pass at %dx%d, %.0fk photons (median of %d, %d threads):\n", c.width, c.height,
+              double(c.photons) / 1e3, L.passes, all);
+  std::printf("    trace                  %.3f s (%.0fk stored hits)\n", L.trace,
+              L.hits_per_pass / 1e3);
+  std::printf(
+      "    grid rebuild           %.3f s = %.1f%% of the pass (HashGrid::build %.3f, "
+      "arrays %.3f; %d levels)\n",
+      grid, 100.0 * grid / pass, L.grid_build, L.grid_prep, L.grid_levels);
+  std::printf(
+      "    gather+update          %.3f s (next-event samples alone %.3f; %.1f photons "
+      "gathered per point)\n",
+      L.gather_on, L.nee, L.gathered);
+  std::printf("    pass, bounds on        %.3f s\n", pass);
+  std::printf(
+      "    pass, bounds off       %.3f s (gather+update %.3f; tau/R^2 differ at %zu of %zu "
+      "points)\n",
+      L.off_pass(), L.gather_off, L.tau_mismatches, L.points);
+  const double overhead = pass / L.off_pass() - 1.0;
+  std::printf("    error-estimation cost  %.1f%% of the bounds-off pass (%.1f%% of its gather)\n",
+              100.0 * overhead, 100.0 * (L.gather_on / L.gather_off - 1.0));
+  const double spass = L.trace + L.grid_prep + L.shrunk_grid_build + L.shrunk_gather_on;
+  const double sgrid = L.grid_prep + L.shrunk_grid_build;
+  std::printf(
+      "    radii shrunk 100x      grid %.3f s = %.1f%% of a %.3f s pass (%d levels; "
+      "gather+update %.3f)\n",
+      sgrid, 100.0 * sgrid / spass, spass, L.shrunk_grid_levels, L.shrunk_gather_on);
+  const double fixed = double(sizeof(pb::MeasurementPoint) + sizeof(pb::PointState) + 4);
+  const double per_point = fixed + double(L.grid_bytes) / double(L.points);
+  std::printf(
+      "  bytes per point          %.1f = %zu MeasurementPoint + %zu PointState + 4 radius + "
+      "%.1f grid (%.1f MiB)\n",
+      per_point, sizeof(pb::MeasurementPoint), sizeof(pb::PointState),
+      double(L.grid_bytes) / double(L.points), double(L.grid_bytes) / kMiB);
+  std::printf("  peak RSS so far          %.0f MiB\n", peak_rss_bytes() / kMiB);
+
+  goal(name + ": error-estimation overhead", fmt("%.1f%%", 100.0 * overhead), "<= 10%",
+       overhead <= 0.10);
+  goal(name + ": grid rebuild / pass (512^2)", fmt("%.1f%%", 100.0 * grid / pass), "<= 10%",
+       grid <= 0.1 * pass);
+  goal(name + ": same, radii shrunk 100x", fmt("%.1f%%", 100.0 * sgrid / spass), "<= 10%",
+       sgrid <= 0.1 * spass);
+  goal(name + ": bytes per point incl. grid (512^2)", fmt("%.1f", per_point), "<= 256",
+       per_point <= 256.0);
+}
+
+// --profile PHASE: only that phase, for a profiler (perf, callgrind). raw, trace and pass run on
+// one thread and report CPU seconds of the process; grid runs on all threads (wall clock).
+int profile(const std::string& phase, const std::string& path, const Config& c) {
+  if (phase != "grid") use_cpu_time();
+  const pb::Scene scene = pb::load_gltf(path);
+  const pb::World world(scene);
+  if (phase == "raw") {
+    const RayRate r = raw_ray_rate(world, 1, c.raw_rays, c.raw_reps);
+    std::printf("raw: %.2f M rays/s\n", r.rays_per_s / 1e6);
+  } else if (phase == "trace") {
+    const PhotonRate r = photon_pass_rate(world, 1, c.photons, c.trace_passes_1);
+    std::printf("trace: %.2f M rays/s\n", r.rays_per_s / 1e6);
+  } else if (phase == "pass") {
+    pb::ThreadLimit limit(1);
+    const PassLoop L =
+        pass_loop(world, eye_setup(world, c.width, c.height), c.photons, c.loop_passes);
+    std::printf("pass: trace %.3f grid %.3f gather on %.3f off %.3f shrunk grid %.3f\n", L.trace,
+                L.grid_build, L.gather_on, L.gather_off, L.shrunk_grid_build);
+  } else if (phase == "grid") {  // all threads, wall clock: mostly grid builds
+    const PassLoop L = pass_loop(world, eye_setup(world, c.width, c.height), c.photons, 2, 40);
+    std::printf("grid: build %.4f s, radii shrunk 100x %.4f s (%d levels)\n", L.grid_build,
+                L.shrunk_grid_build, L.shrunk_grid_levels);
+  } else {
+    std::fprintf(stderr, "photonbound-bench: --profile raw|trace|pass|grid\n");
+    return 2;
+  }
+  return 0;
+}
+
+int run(int argc, char** argv) {
+  Config c;
+  std::vector<std::string> scenes;
+  std::string phase;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--profile" && i + 1 < argc) {
+      phase = argv[++i];
+    } else if (a == "--quick") {
+      c.photons = 100000;
+      c.raw_rays = size_t(1) << 18;
+      c.raw_reps = c.trace_passes_1 = c.trace_passes_all = c.loop_passes = 2;
+      c.big_render = false;
+    } else if (a == "--help" || a == "-h") {
+      std::printf(
+          "usage: photonbound-bench [--quick] [--profile raw|trace|pass|grid] [SCENE ...]\n");
+      return 0;
+    } else if (!a.empty() && a[0] == '-') {
+      std::fprintf(stderr, "photonbound-bench: unknown option %s\n", a.c_str());
+      return 2;
+    } else {
+      scenes.push_back(a);
+    }
+  }
+  const std::string cornell = std::string(PHOTONBOUND_SOURCE_DIR) + "/scenes/cornell.gltf";
+  if (!phase.empty()) return profile(phase, scenes.empty() ? cornell : scenes[0], c);
+  if (scenes.empty()) scenes = {cornell, heavy_scene()};
+  const int all = pb::ThreadLimit(0).threads();
+  std::printf(
+      "photonbound-bench: %d hardware threads; %.0fk photons per pass; medians of "
+      "repeated runs; load average %s\n",
+      all, double(c.photons) / 1e3, load_average().c_str());
+  if (c.big_render) big_render(cornell, c);
+  for (const std::string& s : scenes) run_scene(s, c, all);
+
+  std::printf(
+      "\nload average at the end %s (other processes on a 2-core machine skew every "
+      "figure)\n",
+      load_average().c_str());
+  std::printf("\n%-52s %-12s %-11s %s\n", "goal", "measured", "target", "met");
+  for (const Goal& g : goals)
+    std::printf("%-52s %-12s %-11s %s\n", g.what.c_str(), g.measured.c_str(), g.goal.c_str(),
+                g.met ? "yes" : "NO");
+  return 0;
+}
+
+}  // namespace
+}  // namespace bench
+
+int main(int argc, char** argv) {
+  try {
+    return bench::run(argc, argv);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "photonbound-bench: %s\n", e.what());
+    return 1;
+  }
+}

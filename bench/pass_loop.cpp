@@ -1,0 +1,190 @@
+// The renderer's pass loop, phase by phase (Renderer::step), with and without error estimation,
+// and the grid rebuild after the radii have shrunk 100x.
+#include "bench.h"
+#include "plain.h"
+
+#include "photonbound/camera.h"
+#include "photonbound/gather.h"
+#include "photonbound/parallel.h"
+#include "photonbound/rng.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace bench {
+
+namespace {
+
+// Renderer's constants (src/renderer.cpp): 4 pixel footprints, floor 1e-6 of the scene size.
+constexpr double kFootprintsPerRadius = 4.0;
+constexpr double kMinRadiusFraction = 1e-6;
+constexpr double kAlpha = 0.7;
+constexpr size_t kGrain = 256;  // Renderer::step's gather grain
+
+struct Phase {
+  std::vector<double> t;
+  void add(double t0) { t.push_back(seconds_since(t0)); }
+  double median() const { return bench::median(t); }
+};
+
+// Renderer::step's gather loop: gather, next-event sample, estimator update.
+void gather_on(const pb::World& world, const pb::EyePassResult& eye, const pb::HashGrid& grid,
+               const std::vector<pb::PhotonHit>& hits, const pb::EstimatorParams& params,
+               uint64_t pass, std::vector<pb::PointState>& states) {
+  pb::parallel_for(states.size(), kGrain, [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) {
+      pb::PassGather g;
+      pb::gather_photons(eye.points[k], states[k].r2, grid, hits, g);
+      pb::Rng rng(kSeed, pass, k, pb::Stream::DirectLight);
+      g.direct = pb::direct_light(world, eye.points[k], rng);
+      pb::accumulate_pass(states[k], g, params, pass);
+    }
+  });
+}
+
+void gather_off(const pb::World& world, const pb::EyePassResult& eye, const pb::HashGrid& grid,
+                const std::vector<pb::PhotonHit>& hits, const pb::EstimatorParams& params,
+                uint64_t pass, std::vector<PlainState>& states) {
+  pb::parallel_for(states.size(), kGrain, [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) {
+      pb::dvec3 phi;
+      uint64_t count = 0;
+      gather_plain(eye.points[k], states[k].r2, grid, hits, phi, count);
+      pb::Rng rng(kSeed, pass, k, pb::Stream::DirectLight);
+      const pb::dvec3 direct = pb::direct_light(world, eye.points[k], rng);
+      accumulate_plain(states[k], phi, count, direct, params.alpha, params.min_r2);
+    }
+  });
+}
+
+}  // namespace
+
+EyeSetup eye_setup(const pb::World& world, int width, int height) {
+  EyeSetup s;
+  const pb::PinholeCamera camera(world.scene().cameras.at(0), width, height);
+  const double t0 = now();
+  s.eye = pb::run_eye_pass(world, camera, 8);
+  s.seconds = seconds_since(t0);
+  const double r_min = kMinRadiusFraction * world.scene_size();
+  s.min_r2 = r_min * r_min;
+  std::vector<float> f(s.eye.points.size());
+  for (size_t k = 0; k < f.size(); ++k) f[k] = s.eye.points[k].footprint;
+  double r = 0.01 * world.scene_size();
+  if (!f.empty()) {
+    std::nth_element(f.begin(), f.begin() + f.size() / 2, f.end());
+    r = kFootprintsPerRadius * f[f.size() / 2];
+  }
+  s.r0 = std::max(r, r_min);
+  return s;
+}
+
+PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photons, int passes,
+                   int build_reps) {
+  const pb::EyePassResult& eye = setup.eye;
+  const size_t n = eye.points.size();
+  pb::EstimatorParams params;
+  params.alpha = kAlpha;
+  params.photons_per_pass = double(photons);
+  params.min_r2 = setup.min_r2;
+  pb::PointState initial;
+  initial.r2 = setup.r0 * setup.r0;
+  std::vector<pb::PointState> on(n, initial);
+  PlainState plain_initial;
+  plain_initial.r2 = initial.r2;
+  std::vector<PlainState> off(n, plain_initial);
+
+  pb::PhotonTracer tracer(world, false);
+  pb::HashGrid grid;
+  std::vector<pb::PhotonHit> hits;
+  std::vector<pb::vec3> positions;
+  std::vector<float> radii(n);
+  std::vector<pb::dvec3> direct(n);  // the next-event-only timing writes here
+  Phase trace, prep, build, t_on, t_off, t_nee;
+  double stored = 0.0;
+
+  for (int p = 1; p <= passes; ++p) {
+    const uint64_t pass = uint64_t(p);
+    double t0 = now();
+    tracer.run(kSeed, pass, photons, hits);
+    trace.add(t0);
+    stored += double(hits.size());
+
+    t0 = now();
+    positions.resize(hits.size());
+    for (size_t k = 0; k < hits.size(); ++k) positions[k] = hits[k].position;
+    for (size_t k = 0; k < n; ++k) radii[k] = float(std::sqrt(on[k].r2));
+    prep.add(t0);
+    t0 = now();
+    grid.build(positions, radii);
+    build.add(t0);
+
+    // Alternate the order so neither variant always finds the other's data in the caches.
+    for (int v = 0; v < 2; ++v) {
+      t0 = now();
+      if ((v == 0) == (p % 2 == 1)) {
+        gather_on(world, eye, grid, hits, params, pass, on);
+        t_on.add(t0);
+      } else {
+        gather_off(world, eye, grid, hits, params, pass, off);
+        t_off.add(t0);
+      }
+    }
+    t0 = now();
+    pb::parallel_for(n, kGrain, [&](size_t begin, size_t end) {
+      for (size_t k = begin; k < end; ++k) {
+        pb::Rng rng(kSeed, pass, k, pb::Stream::DirectLight);
+        direct[k] = pb::direct_light(world, eye.points[k], rng);
+      }
+    });
+    t_nee.add(t0);
+  }
+
+  PassLoop r;
+  r.passes = passes;
+  r.points = n;
+  r.hits_per_pass = stored / passes;
+  r.trace = trace.median();
+  r.grid_prep = prep.median();
+  r.gather_on = t_on.median();
+  r.gather_off = t_off.median();
+  r.nee = t_nee.median();
+
+  for (size_t k = 0; k < n; ++k) {
+    if (on[k].tau != off[k].tau || on[k].r2 != off[k].r2) ++r.tau_mismatches;
+    r.gathered += double(on[k].photons);
+  }
+  r.gathered /= double(std::max<size_t>(n, 1)) * passes;
+
+  // The build alone is short and the machine noisy: time it again, repeatedly, on the last
+  // pass's photons and radii; then with every radius 100x smaller (R^2 / 10^4).
+  for (int rep = 0; rep < build_reps; ++rep) {
+    const double t0 = now();
+    grid.build(positions, radii);
+    build.add(t0);
+  }
+  r.grid_build = build.median();
+  r.grid_levels = grid.level_count();
+  r.grid_bytes = grid.memory_bytes();
+  for (size_t k = 0; k < n; ++k) {
+    on[k].r2 = std::max(on[k].r2 * 1e-4, params.min_r2);
+    radii[k] = float(std::sqrt(on[k].r2));
+  }
+  Phase sbuild, sgather;
+  for (int rep = 0; rep < build_reps; ++rep) {
+    const double t0 = now();
+    grid.build(positions, radii);
+    sbuild.add(t0);
+  }
+  for (int rep = 0; rep < 2; ++rep) {
+    std::vector<pb::PointState> scratch = on;
+    const double t0 = now();
+    gather_on(world, eye, grid, hits, params, uint64_t(passes + 1), scratch);
+    sgather.add(t0);
+  }
+  r.shrunk_grid_build = sbuild.median();
+  r.shrunk_gather_on = sgather.median();
+  r.shrunk_grid_levels = grid.level_count();
+  return r;
+}
+
+}  // namespace bench
