@@ -33,8 +33,8 @@ class PhotonTracer {
   // their position on a 1024^3 lattice over the hits' bounds, ties in photon order. The order
   // depends only on the hits, not on the threads. Why: a gather reads hits[k] for every photon
   // near its point; in photon order each is a cache miss, in Morton order a point's photons are
-  // a few contiguous runs that the neighbouring points read again (bench/README.md: 2.3x faster
-  // gather at 1 M photons per pass, and a faster grid build).
+  // a few contiguous runs that the neighbouring points read again (bench/README.md: a 2.1-2.4x
+  // faster gather at 1 M photons per pass, and a faster grid build).
   PhotonPassStats run(uint64_t seed, uint64_t pass, uint64_t count, std::vector<PhotonHit>& hits);
 
   // A photon path never takes more bounces than this; Russian roulette ends almost all first.
