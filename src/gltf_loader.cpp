@@ -52,8 +52,8 @@ bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, in
 
 // .glb by extension, otherwise glTF JSON. Every error tinygltf reports is fatal, even when it
 // returns true (2.7 drops e.g. a baseColorFactor of the wrong length with only a message).
-tinygltf::Model parse(const std::string& path, std::vector<std::string>& warnings) {
-  const std::vector<unsigned char> bytes = read_file(path);
+tinygltf::Model parse(const std::string& path, const std::vector<unsigned char>& bytes,
+                      std::vector<std::string>& warnings) {
   const bool glb = std::filesystem::path(path).extension() == ".glb";
   const uint32_t size = glb ? check_glb(path, bytes) : uint32_t(bytes.size());
   const std::string dir = std::filesystem::path(path).parent_path().string();
@@ -514,6 +514,25 @@ void Loader::finish() {
   for (const PunctualLight& l : scene_.lights) lit |= max_component(l.intensity) > 0.0f;
   for (const Mesh& m : scene_.meshes) lit |= scene_.materials[m.material].emits();
   if (!lit) fail("no light: the scene has no punctual light and no emissive triangles");
+  // Photon flux is carried in float: the total emitted power (4 pi I per point light, an upper
+  // bound for a spot; pi A Le per emissive triangle, summed over the channels) must fit, or the
+  // light distribution overflows later with no file to name.
+  double power = 0.0;
+  for (const PunctualLight& l : scene_.lights)
+    power += 4.0 * kPiD * (double(l.intensity.x) + l.intensity.y + l.intensity.z);
+  for (const Mesh& m : scene_.meshes) {
+    const vec3 le = scene_.materials[m.material].emission;
+    if (!scene_.materials[m.material].emits()) continue;
+    for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+      const dvec3 p0(m.positions[m.indices[t]]);
+      const double area = 0.5 * glm::length(glm::cross(dvec3(m.positions[m.indices[t + 1]]) - p0,
+                                                       dvec3(m.positions[m.indices[t + 2]]) - p0));
+      power += kPiD * area * (double(le.x) + le.y + le.z);
+    }
+  }
+  if (!(power <= double(std::numeric_limits<float>::max())))
+    fail("the lights emit " + num(power) +
+         " W in total, beyond the float range (3.4e+38) photon power is carried in");
   for (const Mesh& m : scene_.meshes)
     for (uint32_t i : m.indices) scene_.bounds.extend(m.positions[i]);
   scene_.source = file_;
@@ -521,9 +540,11 @@ void Loader::finish() {
 
 }  // namespace
 
-Scene load_gltf(const std::string& path) {
+Scene load_gltf(const std::string& path) { return load_gltf_bytes(path, read_file(path)); }
+
+Scene load_gltf_bytes(const std::string& path, const std::vector<unsigned char>& bytes) {
   std::vector<std::string> warnings;
-  const tinygltf::Model model = parse(path, warnings);
+  const tinygltf::Model model = parse(path, bytes, warnings);
   return Loader(path, model).run(warnings);
 }
 

@@ -1,9 +1,11 @@
 // glTF loader tests. Every test writes its own small glTF into a temporary directory; only
 // SmokeLoadsShippedScenes reads scenes/ (and skips when it is empty).
 #include "photonbound/gltf_loader.h"
+#include "photonbound/world.h"
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -720,6 +722,17 @@ TEST_F(LoaderTest, NegativeIntensity) {
   expect_error(g, "light 'dark': intensity and color must be finite and >= 0");
 }
 
+TEST_F(LoaderTest, PowerBeyondFloatRange) {
+  // Each intensity fits in a float; their total power (4 pi I per light) does not.
+  Gltf g = basic();
+  g.lights[0] = "{\"name\":\"flood\",\"type\":\"point\",\"intensity\":3e38}";
+  expect_error(g, "the lights emit");
+  expect_error(g, "beyond the float range");
+  // 1e30, the extremes suite's brightest emitter, still loads.
+  g.lights[0] = "{\"name\":\"bright\",\"type\":\"point\",\"intensity\":1e30}";
+  EXPECT_EQ(load(g).lights.size(), 1u);
+}
+
 TEST_F(LoaderTest, LightIndexOutOfRange) {
   Gltf g = basic();
   g.nodes[2] = "{\"name\":\"lamp\",\"extensions\":{\"KHR_lights_punctual\":{\"light\":3}}}";
@@ -813,6 +826,63 @@ TEST_F(LoaderTest, SmokeLoadsShippedScenes) {
     for (const pb::Mesh& m : s.meshes) lit = lit || s.materials[m.material].emits();
     EXPECT_TRUE(lit);
     EXPECT_FALSE(s.bounds.empty());
+  }
+}
+
+// Every byte of a message is printable ASCII or part of valid UTF-8: no control characters.
+bool printable_utf8(const std::string& m) {
+  for (size_t i = 0; i < m.size();) {
+    const auto b = (unsigned char)m[i];
+    if (b < 0x20 || b == 0x7f) return false;
+    size_t n = b < 0x80 ? 1 : b >= 0xf0 ? 4 : b >= 0xe0 ? 3 : b >= 0xc2 ? 2 : 0;
+    if (n == 0 || i + n > m.size()) return false;
+    for (size_t k = 1; k < n; ++k)
+      if (((unsigned char)m[i + k] & 0xc0) != 0x80) return false;
+    i += n;
+  }
+  return true;
+}
+
+TEST_F(LoaderTest, MessagesQuotingHostileBytesStayOneLineOfText) {
+  // A node name with invalid UTF-8, a control character and a line break, and a JSON syntax
+  // error right after a stray high byte (the parser quotes the last bytes it read).
+  Gltf g = basic();
+  g.nodes.push_back("{\"name\":\"bad\\u0001\\n\xd6\xff name\",\"mesh\":7}");
+  const std::string named = write("named.gltf", g.json());
+  const std::string broken = write("broken.gltf", std::string("{\"asset\": \xd6\x01\n}"));
+  for (const std::string& path : {named, broken}) {
+    try {
+      load_gltf(path);
+      ADD_FAILURE() << path << " loaded";
+    } catch (const SceneError& e) {
+      const std::string m = e.what();
+      EXPECT_EQ(m.rfind(path + ": ", 0), 0u) << m;
+      EXPECT_TRUE(printable_utf8(m)) << m;
+    }
+  }
+}
+
+// Inputs kept from the libFuzzer runs of the loader (tools/fuzz.sh; tests/data/fuzz/README.md):
+// each must load into a scene the renderer can prepare, or be refused with one line of text
+// that names the file. Under tools/sanitize.sh this replays them with ASan and UBSan.
+TEST(LoaderFuzzRegressions, LoadOrRefuseWithOneLine) {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(PHOTONBOUND_TEST_DATA "/fuzz"))
+    if (e.path().extension() == ".gltf" || e.path().extension() == ".glb")
+      files.push_back(e.path());
+  ASSERT_GE(files.size(), 7u) << "the fuzz regression inputs are missing";
+  std::sort(files.begin(), files.end());
+  for (const fs::path& f : files) {
+    SCOPED_TRACE(f.string());
+    try {
+      const Scene s = load_gltf(f.string());
+      const pb::World world(s);
+      EXPECT_GT(world.scene_size(), 0.0f);
+    } catch (const SceneError& e) {
+      const std::string m = e.what();
+      EXPECT_EQ(m.rfind(f.string() + ": ", 0), 0u) << m;
+      EXPECT_TRUE(printable_utf8(m)) << m;
+    }
   }
 }
 

@@ -2,6 +2,7 @@
 # Installs the Debian 12 packages photonbound needs to build, test and run its tools.
 # Idempotent: packages already present are not touched, and apt is not called at all
 # when nothing is missing. Runs as root, or through sudo when that is available.
+# Extra package names given as arguments are installed too (tools/fuzz.sh asks for clang).
 set -euo pipefail
 
 packages=(
@@ -9,6 +10,7 @@ packages=(
   libembree-dev libopenimageio-dev libopenexr-dev libglm-dev libtinygltf-dev
   libtbb-dev libboost-dev libgtest-dev
   python3
+  "$@"
 )
 
 missing=()

@@ -6,6 +6,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace pb {
 
@@ -20,5 +21,10 @@ class SceneError : public std::runtime_error {
 // non-finite or absurd coordinates, unsupported primitive modes or light types, no camera,
 // no light with positive power. Degenerate triangles are skipped and counted.
 Scene load_gltf(const std::string& path);
+
+// The same for a file already in memory (the fuzz target's entry point). `path` names the input
+// in messages, its extension picks .glb or JSON, and its folder is where external buffers are
+// looked up.
+Scene load_gltf_bytes(const std::string& path, const std::vector<unsigned char>& bytes);
 
 }  // namespace pb
