@@ -67,13 +67,8 @@ EyeSetup eye_setup(const pb::World& world, int width, int height) {
   s.seconds = seconds_since(t0);
   const double r_min = kMinRadiusFraction * world.scene_size();
   s.min_r2 = r_min * r_min;
-  std::vector<float> f(s.eye.points.size());
-  for (size_t k = 0; k < f.size(); ++k) f[k] = s.eye.points[k].footprint;
   double r = 0.01 * world.scene_size();
-  if (!f.empty()) {
-    std::nth_element(f.begin(), f.begin() + f.size() / 2, f.end());
-    r = kFootprintsPerRadius * f[f.size() / 2];
-  }
+  if (!s.eye.points.empty()) r = kFootprintsPerRadius * double(s.eye.median_footprint);
   s.r0 = std::max(r, r_min);
   return s;
 }

@@ -24,7 +24,7 @@ void gather_plain(const pb::MeasurementPoint& point, double r2, const pb::HashGr
     const double t = std::min(1.0, std::sqrt(double(dist2) * inv_r2));
     phi += pb::kernel::weight(t) * flux;
   });
-  phi_out = pb::dvec3(point.brdf) * phi;
+  phi_out = pb::dvec3(point.f) * phi;
   count_out = count;
 }
 

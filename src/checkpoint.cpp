@@ -5,6 +5,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -19,18 +20,65 @@ namespace {
 constexpr char kMagic[8] = {'P', 'B', 'S', 'T', 'A', 'T', 'E', '\0'};
 static_assert(std::is_trivially_copyable_v<PointState>);
 
-// 64-bit checksum over 8-byte words (SplitMix64 mixing of each word and its position).
-uint64_t checksum(const char* data, size_t size) {
-  uint64_t h = 0x6a09e667f3bcc909ULL ^ size;
-  size_t i = 0;
-  for (; i + 8 <= size; i += 8) {
-    uint64_t w;
-    std::memcpy(&w, data + i, 8);
-    h = mix64(h ^ (w + i));
+// 64-bit checksum over 8-byte words: SplitMix64 mixing of each word with its byte position, in
+// four independent lanes (word k goes to lane k mod 4) so that consecutive words do not wait
+// for each other's mixing: one chain ran at ~1.6 GB/s, four at ~4 on this machine, and a
+// checkpoint sums every point state. The bytes may arrive in pieces of any size.
+class Checksum {
+ public:
+  explicit Checksum(uint64_t total_size) {
+    for (uint64_t j = 0; j < 4; ++j) lane_[j] = 0x6a09e667f3bcc909ULL ^ total_size ^ (j << 56);
   }
-  uint64_t tail = 0;
-  std::memcpy(&tail, data + i, size - i);
-  return mix64(h ^ tail ^ 0x5bd1e995ULL);
+  void add(const char* p, size_t n) {
+    if (fill_ > 0) {  // complete the word a previous piece left open
+      const size_t take = std::min(n, 8 - fill_);
+      std::memcpy(buf_ + fill_, p, take);
+      fill_ += take;
+      p += take;
+      n -= take;
+      if (fill_ < 8) return;
+      word(buf_);
+      fill_ = 0;
+    }
+    for (; n >= 8 && (k_ & 3) != 0; p += 8, n -= 8) word(p);
+    for (; n >= 32; p += 32, n -= 32) {  // one word per lane, independent chains
+      for (uint64_t j = 0; j < 4; ++j) {
+        uint64_t w;
+        std::memcpy(&w, p + 8 * j, 8);
+        lane_[j] = mix64(lane_[j] ^ (w + 8 * (k_ + j)));
+      }
+      k_ += 4;
+    }
+    for (; n >= 8; p += 8, n -= 8) word(p);
+    std::memcpy(buf_, p, n);
+    fill_ = n;
+  }
+  uint64_t finish() const {
+    uint64_t tail = 0;
+    std::memcpy(&tail, buf_, fill_);
+    uint64_t h = mix64(lane_[0] ^ tail ^ 0x5bd1e995ULL);
+    for (int j = 1; j < 4; ++j) h = mix64(h ^ lane_[j]);
+    return h;
+  }
+
+ private:
+  void word(const char* p) {
+    uint64_t w;
+    std::memcpy(&w, p, 8);
+    uint64_t& h = lane_[k_ & 3];
+    h = mix64(h ^ (w + 8 * k_));
+    ++k_;
+  }
+  uint64_t lane_[4];
+  uint64_t k_ = 0;  // words so far
+  char buf_[8] = {};
+  size_t fill_ = 0;
+};
+
+uint64_t checksum(const char* data, size_t size) {
+  Checksum c(size);
+  c.add(data, size);
+  return c.finish();
 }
 
 class Writer {
@@ -158,23 +206,29 @@ std::string errno_text() { return std::strerror(errno); }
 }  // namespace
 
 void write_file_atomic(const std::string& path, const std::string& bytes) {
+  write_file_atomic(path, {std::string_view(bytes)});
+}
+
+void write_file_atomic(const std::string& path, std::initializer_list<std::string_view> pieces) {
   const std::filesystem::path p(path);
   const std::string tmp =
       (p.parent_path() / ("." + p.filename().string() + ".tmp" + std::to_string(::getpid())))
           .string();
   const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
   if (fd < 0) throw StateError(path + ": cannot write (" + errno_text() + ")");
-  size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0 && errno == EINTR) continue;
-    if (n <= 0) {
-      const std::string err = errno_text();
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      throw StateError(path + ": cannot write (" + err + ")");
+  for (const std::string_view bytes : pieces) {
+    size_t done = 0;
+    while (done < bytes.size()) {
+      const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) {
+        const std::string err = errno_text();
+        ::close(fd);
+        ::unlink(tmp.c_str());
+        throw StateError(path + ": cannot write (" + err + ")");
+      }
+      done += size_t(n);
     }
-    done += size_t(n);
   }
   // The data must be on disk before the rename makes it the file of record.
   if (::fsync(fd) != 0 || ::close(fd) != 0) {
@@ -210,9 +264,16 @@ void save_state(const std::string& path, const SavedRender& s) {
   w.u64(s.loop.early_pass);
   w.f64(s.loop.early_bound);
   w.u64(s.states.size());
-  w.raw(s.states.data(), s.states.size() * sizeof(PointState));
-  w.u64(checksum(w.bytes().data(), w.bytes().size()));
-  write_file_atomic(path, w.bytes());
+  // The states go to the file straight from the snapshot, without a copy into the buffer.
+  const std::string_view head(w.bytes());
+  const std::string_view states(reinterpret_cast<const char*>(s.states.data()),
+                                s.states.size() * sizeof(PointState));
+  Checksum sum(head.size() + states.size());
+  sum.add(head.data(), head.size());
+  sum.add(states.data(), states.size());
+  const uint64_t stored = sum.finish();
+  write_file_atomic(path,
+                    {head, states, std::string_view(reinterpret_cast<const char*>(&stored), 8)});
 }
 
 SavedRender load_state(const std::string& path) {

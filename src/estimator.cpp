@@ -26,7 +26,6 @@ void accumulate_pass(PointState& s, const PassGather& g, const EstimatorParams& 
   s.c_xx += dx * (x - s.mean_x);
   s.c_xr += dx * (r2_pass - s.mean_r2);
   s.c_rr += dr * (r2_pass - s.mean_r2);
-  s.direct_sum += g.direct;
   s.photons += g.count;
 
   // PPM update (section 3, HOJ08): only photons that could contribute shrink the radius.
@@ -52,7 +51,9 @@ PointEstimate estimate(const PointState& s, uint64_t passes, double photons_per_
   PointEstimate e;
   if (passes == 0) return e;
   const double i = double(passes);
-  e.radiance = s.direct_sum / i + photon_radiance(s, passes, photons_per_pass);
+  // L_i = mean_j X_j. Equal to D-bar + tau / (pi R^2 i M_e) by the key identity, but read from
+  // the streaming mean, so the state keeps no separate sum of the D_j.
+  e.radiance = s.mean_x;
 
   // Bias (section 3): a = 0.5 k2 Lap_i with Lap_i = tauLap / (pi R^2 i M_e); B = a mean_j(R_j^2).
   const dvec3 lap = s.tau_lap / (kPiD * s.r2 * i * photons_per_pass);

@@ -3,6 +3,7 @@
 #include "photonbound/bsdf.h"
 #include "photonbound/parallel.h"
 
+#include <algorithm>
 #include <atomic>
 
 namespace pb {
@@ -18,14 +19,15 @@ struct PathVertex {
 
 struct PixelOutput {
   std::vector<MeasurementPoint> points;
+  std::vector<float> footprints;  // one per point
   dvec3 emission{0.0};
   uint64_t truncated = 0;
 };
 
 // Follows every branch of one pixel's camera path. The tree has at most 2^max_depth leaves;
 // an explicit stack keeps it iterative.
-void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth, uint32_t pixel,
-                 int x, int y, PixelOutput& out) {
+void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth, int x, int y,
+                 PixelOutput& out) {
   PathVertex stack[64];
   int top = 0;
   stack[top++] = {camera.origin(), camera.direction(x, y), vec3(1.0f), vec3(0.0f), 0.0f, 0};
@@ -47,11 +49,11 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
       p.position = s.position;
       p.normal = front ? s.ng : -s.ng;
       p.shading = front ? s.ns : -s.ns;
-      p.brdf = lambertian(m.base_color);
-      p.weight = v.weight;
-      p.pixel = pixel;
-      p.footprint = length * camera.pixel_angle();
-      if (max_component(p.brdf) > 0.0f) out.points.push_back(p);
+      p.f = v.weight * lambertian(m.base_color);
+      if (max_component(p.f) > 0.0f) {
+        out.points.push_back(p);
+        out.footprints.push_back(length * camera.pixel_angle());
+      }
       continue;
     }
     if (v.depth >= max_depth) {
@@ -79,18 +81,24 @@ EyePassResult run_eye_pass(const World& world, const PinholeCamera& camera, int 
 
   // One output per row, joined in row order: the point order is independent of threads.
   std::vector<std::vector<MeasurementPoint>> rows(size_t(r.height));
+  std::vector<std::vector<float>> row_footprints(size_t(r.height));
+  r.pixel_begin.assign(pixels + 1, 0);
   std::atomic<uint64_t> truncated{0};
   parallel_for(size_t(r.height), 1, [&](size_t begin, size_t end) {
     PixelOutput out;
     for (size_t y = begin; y < end; ++y) {
       out.points.clear();
+      out.footprints.clear();
       for (int x = 0; x < r.width; ++x) {
-        const uint32_t pixel = uint32_t(y * size_t(r.width) + size_t(x));
+        const size_t pixel = y * size_t(r.width) + size_t(x);
+        const size_t before = out.points.size();
         out.emission = dvec3(0.0);
-        trace_pixel(world, camera, max_depth, pixel, x, int(y), out);
+        trace_pixel(world, camera, max_depth, x, int(y), out);
         r.emission[pixel] = out.emission;
+        r.pixel_begin[pixel + 1] = uint32_t(out.points.size() - before);  // counts for now
       }
       rows[y] = out.points;
+      row_footprints[y] = out.footprints;
     }
     truncated += out.truncated;
   });
@@ -99,15 +107,19 @@ EyePassResult run_eye_pass(const World& world, const PinholeCamera& camera, int 
   size_t total = 0;
   for (const auto& row : rows) total += row.size();
   r.points.reserve(total);
-  r.pixel_begin.assign(pixels + 1, 0);
-  for (auto& row : rows) {
-    for (const MeasurementPoint& p : row) {
-      r.points.push_back(p);
-      ++r.pixel_begin[p.pixel + 1];
-    }
-    std::vector<MeasurementPoint>().swap(row);
+  std::vector<float> footprints;
+  footprints.reserve(total);
+  for (size_t y = 0; y < rows.size(); ++y) {
+    r.points.insert(r.points.end(), rows[y].begin(), rows[y].end());
+    footprints.insert(footprints.end(), row_footprints[y].begin(), row_footprints[y].end());
+    std::vector<MeasurementPoint>().swap(rows[y]);
   }
   for (size_t p = 0; p < pixels; ++p) r.pixel_begin[p + 1] += r.pixel_begin[p];
+  if (!footprints.empty()) {
+    std::nth_element(footprints.begin(), footprints.begin() + footprints.size() / 2,
+                     footprints.end());
+    r.median_footprint = footprints[footprints.size() / 2];
+  }
   return r;
 }
 

@@ -18,17 +18,16 @@ struct PixelResult {
 };
 
 // L_pix = Le_seen + sum_k W_k L_k; B_pix = sum_k W_k B_k; Var_pix = sum_k W_k^2 S_k^2 / i
-// (ESTIMATOR.md section 5).
+// (ESTIMATOR.md section 5). W_k is already inside each point's estimate (MeasurementPoint::f).
 PixelResult combine(const EyePassResult& eye, const std::vector<PointState>& states, size_t pixel,
                     uint64_t passes, double photons_per_pass) {
   PixelResult r;
   r.radiance = eye.emission[pixel];
   for (uint32_t k = eye.pixel_begin[pixel]; k < eye.pixel_begin[pixel + 1]; ++k) {
-    const dvec3 w(eye.points[k].weight);
     const PointEstimate e = estimate(states[k], passes, photons_per_pass);
-    r.radiance += w * e.radiance;
-    r.bias += w * e.bias;
-    r.variance += w * w * e.variance;
+    r.radiance += e.radiance;
+    r.bias += e.bias;
+    r.variance += e.variance;
     r.photons += double(states[k].photons);
     if (!r.has_points) r.radius = float(std::sqrt(states[k].r2));
     r.has_points = true;

@@ -28,7 +28,7 @@ void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& gr
     phi += kernel::weight(t) * flux;
     lap += kernel::laplacian_weight_r2(t) * flux;
   });
-  const dvec3 f(point.brdf);
+  const dvec3 f(point.f);
   out.phi += f * phi;
   out.phi_lap_r2 += f * lap;
   out.count += count;
@@ -40,7 +40,7 @@ dvec3 direct_light(const World& world, const MeasurementPoint& point, Rng& rng) 
   const float cos_s = glm::dot(s.wi, point.shading);
   if (cos_s <= 0.0f || glm::dot(s.wi, point.normal) <= 0.0f) return dvec3(0.0);
   if (world.occluded(point.position, point.normal, s.wi, s.distance)) return dvec3(0.0);
-  return dvec3(point.brdf * s.li * cos_s);
+  return dvec3(point.f * s.li * cos_s);
 }
 
 }  // namespace pb

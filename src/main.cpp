@@ -87,7 +87,12 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   pb::CheckpointPolicy checkpoint;
   if (options.checkpoint_every) {
     checkpoint.every = *options.checkpoint_every;
-    checkpoint.write = [&](const pb::RenderReport& r) { write_outputs(r, true); };
+    // On the background thread, from the snapshot (CheckpointPolicy).
+    checkpoint.write = [&](const pb::RenderReport& r, pb::SavedRender& saved) {
+      pb::write_exr(options.output, renderer.image(r, saved.states));
+      saved.scene_hash = scene_hash;
+      pb::save_state(state_path, saved);
+    };
   }
 
   const bool show = options.progress == pb::ProgressMode::Always ||
@@ -95,7 +100,8 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   if (show)
     std::cerr << "photonbound: " << renderer.eye().points.size() << " measurement points, "
               << threads.threads() << " threads" << (saved ? ", resumed" : "") << "\n";
-  const pb::RenderReport report = renderer.run(&g_stop, show ? &std::cerr : nullptr, checkpoint, log);
+  const pb::RenderReport report =
+      renderer.run(&g_stop, show ? &std::cerr : nullptr, checkpoint, log);
   // Ctrl-C keeps the work: the state is written then too.
   write_outputs(report, keep_state || report.stop_reason == "interrupted");
   if (show || report.stop_reason != "passes")

@@ -33,9 +33,9 @@ ExrImage pack_channels(const FilmImage& film) {
   return out;
 }
 
-ExrImage Renderer::image(const RenderReport& report) const {
+ExrImage Renderer::image(const RenderReport& report, const std::vector<PointState>& states) const {
   FilmImage film;
-  const FilmSummary summary = develop(eye_, states_, report.passes, film_settings(), &film);
+  const FilmSummary summary = develop(eye_, states, report.passes, film_settings(), &film);
   ExrImage out = pack_channels(film);
   out.metadata = describe(options_);
   out.metadata.insert(out.metadata.end(),

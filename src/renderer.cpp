@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <future>
 #include <sstream>
 
 namespace pb {
@@ -80,15 +81,12 @@ Renderer::Renderer(const Scene& scene, const RenderOptions& options)
   PointState initial;
   initial.r2 = r0 * r0;
   states_.assign(eye_.points.size(), initial);
-  radii_.resize(eye_.points.size());
+  radii_.assign(eye_.points.size(), float(std::sqrt(initial.r2)));
 }
 
 double Renderer::default_radius() const {
   if (eye_.points.empty()) return 0.01 * world_.scene_size();
-  std::vector<float> f(eye_.points.size());
-  for (size_t k = 0; k < f.size(); ++k) f[k] = eye_.points[k].footprint;
-  std::nth_element(f.begin(), f.begin() + f.size() / 2, f.end());
-  const double r = kFootprintsPerRadius * f[f.size() / 2];
+  const double r = kFootprintsPerRadius * double(eye_.median_footprint);
   return r > 0.0 && std::isfinite(r) ? r : 0.01 * world_.scene_size();
 }
 
@@ -108,7 +106,7 @@ FilmSettings Renderer::film_settings() const {
   return s;
 }
 
-void Renderer::step() {
+void Renderer::step(std::vector<PointState>* copy) {
   const uint64_t pass = ++loop_.passes;
   auto t = Clock::now();
   const PhotonPassStats stats = tracer_.run(options_.seed, pass, options_.photons_per_pass, hits_);
@@ -120,13 +118,15 @@ void Renderer::step() {
   if (n == 0) return;
   t = Clock::now();
   hit_positions_.resize(hits_.size());
-  for (size_t k = 0; k < hits_.size(); ++k) hit_positions_[k] = hits_[k].position;
-  for (size_t k = 0; k < n; ++k) radii_[k] = float(std::sqrt(states_[k].r2));
-  grid_.build(hit_positions_, radii_);
+  parallel_for(hits_.size(), 16384, [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) hit_positions_[k] = hits_[k].position;
+  });
+  grid_.build(hit_positions_, radii_);  // radii_ was filled by the previous update loop
   timings_.grid += seconds_since(t);
 
   t = Clock::now();
   const bool nee = options_.direct == DirectMode::NextEvent;
+  if (copy) copy->resize(n);
   parallel_for(n, 256, [&](size_t begin, size_t end) {
     for (size_t k = begin; k < end; ++k) {
       PassGather g;
@@ -136,6 +136,8 @@ void Renderer::step() {
         g.direct = direct_light(world_, eye_.points[k], rng);
       }
       accumulate_pass(states_[k], g, params_, pass);
+      radii_[k] = float(std::sqrt(states_[k].r2));
+      if (copy) (*copy)[k] = states_[k];
     }
   });
   timings_.gather += seconds_since(t);
@@ -182,7 +184,8 @@ void Renderer::write_log_line(const RenderReport& report, const PassLog& log) co
   if (log.reference) {
     FilmImage film;
     develop(eye_, states_, report.passes, film_settings(), &film);
-    const CompareResult c = compare_images(pack_channels(film), *log.reference, "render", "reference");
+    const CompareResult c =
+        compare_images(pack_channels(film), *log.reference, "render", "reference");
     line << ", \"mae\": " << c.mean_abs_error << ", \"rmse\": " << c.rmse
          << ", \"coverage\": " << c.coverage;
   }
@@ -208,8 +211,23 @@ RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress
   // A resumed render that already did its passes does not run another one.
   if (options_.passes && loop_.passes >= *options_.passes) report.stop_reason = "passes";
 
+  // The checkpoint in flight, if any: it returns its snapshot so the buffer is reused.
+  std::future<SavedRender> pending;
+  auto finish_pending = [&] {  // waits, rethrows a failed write, takes the buffer back
+    const auto t_wait = Clock::now();
+    SavedRender done = pending.get();
+    checkpoint_states_ = std::move(done.states);
+    timings_.checkpoint_stall += seconds_since(t_wait);
+  };
+
   while (report.stop_reason.empty()) {
-    step();
+    // Snapshot this pass when a checkpoint is due and none is being written.
+    const bool writer_idle =
+        !pending.valid() || pending.wait_for(std::chrono::seconds(0)) == std::future_status::ready;
+    if (pending.valid() && writer_idle) finish_pending();
+    const bool snap = checkpoint.every > 0.0 && writer_idle &&
+                      seconds_since(t0) - last_checkpoint >= checkpoint.every;
+    step(snap ? &checkpoint_states_ : nullptr);
     fill();
     const uint64_t pass = loop_.passes;
     const double run_seconds = seconds_since(t0);
@@ -249,13 +267,28 @@ RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress
       last_print = run_seconds;
       *progress << progress_line(report, run_seconds) << std::endl;
     }
-    if (report.stop_reason.empty() && checkpoint.every > 0.0 &&
-        run_seconds - last_checkpoint >= checkpoint.every) {
+    // The final image and state are written by the caller after run() returns, so a
+    // snapshot of the last pass is not written here.
+    if (snap && report.stop_reason.empty()) {
+      const auto t_submit = Clock::now();
       last_checkpoint = run_seconds;
-      report.summary = develop(eye_, states_, pass, settings, nullptr);
-      checkpoint.write(report);
+      SavedRender saved;
+      saved.options = options_;
+      saved.initial_radius = initial_radius_;
+      saved.loop = loop_;
+      saved.states = std::move(checkpoint_states_);
+      pending = std::async(std::launch::async,
+                           [this, &checkpoint, report, saved = std::move(saved)]() mutable {
+                             const auto t_write = Clock::now();
+                             checkpoint.write(report, saved);
+                             timings_.checkpoint_write += seconds_since(t_write);
+                             ++timings_.checkpoints;
+                             return std::move(saved);
+                           });
+      timings_.checkpoint_stall += seconds_since(t_submit);
     }
   }
+  if (pending.valid()) finish_pending();
   fill();
   report.summary = develop(eye_, states_, report.passes, settings, nullptr);
   return report;
@@ -267,6 +300,7 @@ void Renderer::restore(const SavedRender& saved) {
                      " measurement points but this scene and camera give " +
                      std::to_string(states_.size()));
   states_ = saved.states;
+  for (size_t k = 0; k < states_.size(); ++k) radii_[k] = float(std::sqrt(states_[k].r2));
   loop_ = saved.loop;
   initial_radius_ = saved.initial_radius;
 }

@@ -30,14 +30,18 @@ double mean_relative_error(const Renderer& r, uint64_t passes, Exact&& exact, Us
   double sum = 0.0;
   size_t n = 0;
   const FilmSettings s = r.film_settings();
-  for (size_t k = 0; k < r.eye().points.size(); ++k) {
-    const MeasurementPoint& p = r.eye().points[k];
-    if (!use(p.position)) continue;
-    const double truth = exact(p.position);
-    const dvec3 l = r.eye().emission[p.pixel] +
-                    dvec3(p.weight) * estimate(r.states()[k], passes, s.photons_per_pass).radiance;
-    for (int c = 0; c < 3; ++c) sum += std::fabs(l[c] - truth) / truth;
-    n += 3;
+  const EyePassResult& eye = r.eye();
+  for (size_t pixel = 0; pixel + 1 < eye.pixel_begin.size(); ++pixel) {
+    for (uint32_t k = eye.pixel_begin[pixel]; k < eye.pixel_begin[pixel + 1]; ++k) {
+      const MeasurementPoint& p = eye.points[k];
+      if (!use(p.position)) continue;
+      const double truth = exact(p.position);
+      // The point's estimate carries its camera-path weight (MeasurementPoint::f).
+      const dvec3 l =
+          eye.emission[pixel] + estimate(r.states()[k], passes, s.photons_per_pass).radiance;
+      for (int c = 0; c < 3; ++c) sum += std::fabs(l[c] - truth) / truth;
+      n += 3;
+    }
   }
   return n ? sum / double(n) : INFINITY;
 }

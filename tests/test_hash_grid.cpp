@@ -159,7 +159,7 @@ TEST(HashGrid, RadiusLargerThanBuildRadiiIsExact) {
 }
 
 TEST(HashGrid, SmallTablesForceBucketCollisions) {
-  // A table has ~2n buckets, so with few photons two of a query's 8 cells often share a
+  // A table has n to 2n buckets, so with few photons two of a query's 8 cells often share a
   // bucket: it must be scanned once and each photon visited once. (n is kept above the cell
   // count so these queries take the bucket-dedupe path, not the linear scan.)
   for (size_t n : {8, 12, 16, 24, 32, 64, 128}) {

@@ -10,8 +10,10 @@
 #include "photonbound/options.h"
 
 #include <cstdint>
+#include <initializer_list>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace pb {
@@ -21,7 +23,7 @@ class StateError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-inline constexpr uint32_t kStateVersion = 1;
+inline constexpr uint32_t kStateVersion = 2;  // 2: PointState without direct_sum (160 B)
 
 // The pass loop's own progress, so that a resumed render checks its target on the same schedule.
 struct LoopState {
@@ -56,5 +58,7 @@ std::vector<std::string> differences(const SavedRender& saved, const RenderOptio
 // Writes `bytes` to `path` atomically and durably: temporary file, fsync, rename, fsync of the
 // folder. Throws StateError naming the file.
 void write_file_atomic(const std::string& path, const std::string& bytes);
+// The same for a file made of several pieces, written one after the other.
+void write_file_atomic(const std::string& path, std::initializer_list<std::string_view> pieces);
 
 }  // namespace pb

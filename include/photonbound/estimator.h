@@ -23,7 +23,8 @@ struct PointState {
   double r2 = 0.0;  // current squared radius, used by the next pass
   dvec3 tau{0.0};
   dvec3 tau_lap{0.0};
-  dvec3 direct_sum{0.0};
+  // No sum of the direct parts D_j: the radiance is mean_x, and the direct part alone, when
+  // wanted, is mean_x - photon_radiance() (the key identity of section 3).
   uint64_t photons = 0;  // all photons ever gathered (sum of M_j)
   // Bivariate streaming moments of the per-pass samples (X_j, R_j^2), ESTIMATOR.md section 4.
   dvec3 mean_x{0.0};
@@ -32,6 +33,7 @@ struct PointState {
   dvec3 c_xr{0.0};
   double c_rr = 0.0;
 };
+static_assert(sizeof(PointState) == 160, "the per-point memory budget counts on 160 bytes");
 
 struct EstimatorParams {
   double alpha = 0.7;             // PPM radius reduction, in (0, 1]
@@ -45,7 +47,7 @@ void accumulate_pass(PointState& state, const PassGather& gather, const Estimato
 
 // The point's estimate after `passes` passes.
 struct PointEstimate {
-  dvec3 radiance{0.0};  // L_i = mean_j X_j
+  dvec3 radiance{0.0};  // L_i = mean_j X_j (mean_x)
   dvec3 bias{0.0};      // B_i = 0.5 k2 Lap_i mean_j(R_j^2), signed
   dvec3 variance{0.0};  // S^2 / i: variance of the mean after the retroactive bias correction
   bool known = false;   // false until kMinPhotonsForBound photons and passes >= 2

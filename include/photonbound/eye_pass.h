@@ -14,18 +14,23 @@ struct MeasurementPoint {
   vec3 position{0.0f};
   vec3 normal{0.0f};   // geometric normal, on the side the camera path arrived from
   vec3 shading{0.0f};  // shading normal, same side
-  vec3 brdf{0.0f};     // Lambertian f = rho / pi
-  vec3 weight{0.0f};   // W_k: throughput of the camera path (Fresnel and tint factors)
-  uint32_t pixel = 0;
-  float footprint = 0.0f;  // pixel footprint at the point (camera path length x pixel angle)
+  // W_k f: the camera path's throughput W_k (Fresnel and tint factors) times the Lambertian
+  // f = rho / pi. Folding W_k into the point's estimate makes every per-point quantity (X_j, B,
+  // S^2) already weighted, so a pixel is the plain sum of its points (ESTIMATOR.md section 5
+  // with W_k moved inside), and the point needs one colour instead of two.
+  vec3 f{0.0f};
 };
+static_assert(sizeof(MeasurementPoint) == 48, "the per-point memory budget counts on 48 bytes");
 
 struct EyePassResult {
   int width = 0, height = 0;
   std::vector<MeasurementPoint> points;  // grouped by pixel, in pixel order
   std::vector<uint32_t> pixel_begin;     // points of pixel p: [pixel_begin[p], pixel_begin[p+1])
   std::vector<dvec3> emission;           // Le seen along exact specular chains, per pixel
-  uint64_t truncated_paths = 0;          // specular chains cut by the depth limit
+  // Median over the points of the pixel footprint at the point (camera path length x pixel
+  // angle): what the default initial radius is made from. 0 without points.
+  float median_footprint = 0.0f;
+  uint64_t truncated_paths = 0;  // specular chains cut by the depth limit
 };
 
 // max_depth: the most specular bounces a camera path may take before it is cut.

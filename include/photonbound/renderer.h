@@ -40,6 +40,12 @@ struct PhaseTimings {
   double trace = 0.0;   // photon tracing
   double grid = 0.0;    // hash grid builds
   double gather = 0.0;  // gathers, next-event samples and estimator updates
+  // Checkpoints: time the pass loop itself spent on them (waiting for a previous write,
+  // starting the next), and wall time of the background writes. The snapshot copy made inside
+  // the update loop is part of `gather`.
+  double checkpoint_stall = 0.0;
+  double checkpoint_write = 0.0;
+  uint64_t checkpoints = 0;
 };
 
 // The EXR channel layout of README "Output" (no metadata).
@@ -54,10 +60,15 @@ struct PassLog {
   double max_overhead = 0.03;
 };
 
-// Called between passes every `every` seconds of the run (0 = never), to write checkpoints.
+// Checkpoints every `every` seconds of the run (0 = never). `write` runs on a background
+// thread while the passes go on: it gets the report and a snapshot of the render as it stood
+// after one pass (states copied inside that pass's update loop, while they are in cache), and
+// must not touch the Renderer's mutable state (image(report, states) is safe). One checkpoint
+// is in flight at most: while one is being written, the next waits for a later pass. run()
+// waits for the last one before it returns, and rethrows what a write threw.
 struct CheckpointPolicy {
   double every = 0.0;
-  std::function<void(const RenderReport&)> write;
+  std::function<void(const RenderReport&, SavedRender&)> write;
 };
 
 class Renderer {
@@ -69,8 +80,9 @@ class Renderer {
   RenderReport run(const std::atomic<bool>* stop, std::ostream* progress,
                    const CheckpointPolicy& checkpoint = {}, const PassLog& log = {});
 
-  // Runs one more pass (pass number passes() + 1).
-  void step();
+  // Runs one more pass (pass number passes() + 1). With `copy`, also copies every point's
+  // state into it as the pass leaves it (resized to the point count first).
+  void step(std::vector<PointState>* copy = nullptr);
   uint64_t passes() const { return loop_.passes; }
 
   // Everything a state file holds (scene hash aside), and the way back. restore() throws
@@ -78,8 +90,10 @@ class Renderer {
   SavedRender snapshot() const;
   void restore(const SavedRender& saved);
 
-  // Radiance, bound channels and metadata, ready for write_exr.
-  ExrImage image(const RenderReport& report) const;
+  // Radiance, bound channels and metadata, ready for write_exr: of the current states, or of
+  // `states` (a checkpoint's snapshot; reads only what does not change after construction).
+  ExrImage image(const RenderReport& report) const { return image(report, states_); }
+  ExrImage image(const RenderReport& report, const std::vector<PointState>& states) const;
 
   const EyePassResult& eye() const { return eye_; }
   const std::vector<PointState>& states() const { return states_; }
@@ -103,7 +117,8 @@ class Renderer {
   HashGrid grid_;
   std::vector<PhotonHit> hits_;
   std::vector<vec3> hit_positions_;
-  std::vector<float> radii_;
+  std::vector<float> radii_;                   // sqrt(r2) per point, for the grid build
+  std::vector<PointState> checkpoint_states_;  // snapshot buffer, reused (checkpoints only)
   LoopState loop_;  // passes, photons, rays, seconds and check schedule so far
   double initial_radius_ = 0.0;
   PhaseTimings timings_;
