@@ -7,6 +7,8 @@
 #include "photonbound/parallel.h"
 #include "photonbound/renderer.h"
 
+#include <unistd.h>
+
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
@@ -129,6 +131,105 @@ void big_render(const std::string& path, const Config& c) {
   goal("bytes per point incl. grid (1080p)", fmt("%.1f", per_point), "<= 256", per_point <= 256.0);
   goal("grid rebuild / pass (1080p, 1M/pass)", fmt("%.1f%%", 100.0 * t.grid / 2 / pass), "<= 10%",
        t.grid / 2 <= 0.1 * pass);
+}
+
+// Checkpoint cost at the renderer's default settings (512 wide, 100k photons per pass): what
+// the pass loop pays (the snapshot copy inside the update loop), what the background write
+// costs (develop, EXR, state), and the whole loop checkpointing continuously against not at all.
+void checkpoint_cost(const std::string& path, int passes) {
+  std::printf("\n== checkpoints of %s at the default settings (pb::Renderer, all threads)\n",
+              path.c_str());
+  const pb::Scene scene = pb::load_gltf(path);
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("photonbound-bench-" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  pb::RenderOptions o;
+  o.scene = path;
+  o.output = (dir / "out.exr").string();
+  o.progress = pb::ProgressMode::Never;
+  pb::Renderer r(scene, o);
+  for (int k = 0; k < 3; ++k) r.step();  // warm: grid vectors at size, pages touched
+
+  // Alternate plain and snapshot passes so drift in machine load hits both alike.
+  std::vector<pb::PointState> copy;
+  r.step(&copy);  // first touch of the snapshot buffer (the renderer keeps its buffer too)
+  std::vector<double> plain, snap;
+  for (int k = 0; k < passes; ++k) {
+    double t = now();
+    r.step();
+    plain.push_back(seconds_since(t));
+    t = now();
+    r.step(&copy);
+    snap.push_back(seconds_since(t));
+  }
+  const double pass = median(plain), snap_pass = median(snap);
+
+  // The background job, timed here in the foreground, each part a median of 3.
+  pb::RenderReport report;
+  report.passes = r.passes();
+  pb::SavedRender saved = r.snapshot();
+  std::vector<double> develop, exr, state;
+  for (int k = 0; k < 3; ++k) {
+    double t = now();
+    const pb::ExrImage image = r.image(report, saved.states);
+    develop.push_back(seconds_since(t));
+    t = now();
+    pb::write_exr(o.output, image, pb::ExrCompression::None);
+    exr.push_back(seconds_since(t));
+    t = now();
+    pb::save_state((dir / "out.pbstate").string(), saved);
+    state.push_back(seconds_since(t));
+  }
+  const double job = median(develop) + median(exr) + median(state);
+  const double state_mb = double(std::filesystem::file_size(dir / "out.pbstate")) / 1e6;
+  const double exr_mb = double(std::filesystem::file_size(o.output)) / 1e6;
+
+  // The whole loop: a checkpoint whenever the writer is idle, against none, same pass count.
+  auto loop_seconds = [&](bool checkpoints, pb::PhaseTimings* timings) {
+    pb::RenderOptions lo = o;
+    lo.passes = uint64_t(4 * passes);
+    pb::Renderer lr(scene, lo);
+    pb::CheckpointPolicy policy;
+    if (checkpoints) {
+      policy.every = 1e-9;
+      policy.write = [&](const pb::RenderReport& rep, pb::SavedRender& s) {
+        pb::write_exr(lo.output, lr.image(rep, s.states), pb::ExrCompression::None);
+        pb::save_state((dir / "loop.pbstate").string(), s);
+      };
+    }
+    const double t = now();
+    lr.run(nullptr, nullptr, policy);
+    const double seconds = seconds_since(t);
+    if (timings) *timings = lr.timings();
+    return seconds;
+  };
+  pb::PhaseTimings with;
+  const double off = loop_seconds(false, nullptr), on = loop_seconds(true, &with);
+  std::filesystem::remove_all(dir);
+
+  std::printf("  measurement points       %zu; state %.1f MB (%zu B per point), EXR %.1f MB\n",
+              r.states().size(), state_mb, sizeof(pb::PointState), exr_mb);
+  std::printf("  pass                     %.4f s; with the snapshot copy %.4f s (+%.1f%%)\n", pass,
+              snap_pass, 100.0 * (snap_pass / pass - 1.0));
+  std::printf(
+      "  background write         %.3f s = develop %.3f + EXR %.3f + state %.3f (fsynced); "
+      "%.1f passes' worth of one core\n",
+      job, median(develop), median(exr), median(state), job / pass);
+  std::printf(
+      "  %d passes, checkpointing continuously: %.2f s vs %.2f s without (%+.1f%%); %llu "
+      "checkpoints, loop stalled %.4f s in all\n",
+      4 * passes, on, off, 100.0 * (on / off - 1.0), (unsigned long long)with.checkpoints,
+      with.checkpoint_stall);
+  // A checkpoint a minute costs the snapshot pass once and the job's CPU time once a minute.
+  const double per_minute =
+      (snap_pass - pass + with.checkpoint_stall / std::max<double>(1.0, double(with.checkpoints))) /
+      60.0;
+  std::printf(
+      "  --checkpoint-every 60    pass loop stalled %.3f%% of the time; write %.2f%% of one core\n",
+      100.0 * per_minute, 100.0 * job / 60.0);
+  goal("checkpoint: pass-loop cost (snapshot pass)",
+       fmt("%.1f%% of a pass", 100.0 * (snap_pass / pass - 1.0)), "few %",
+       snap_pass - pass <= 0.05 * pass);
 }
 
 void run_scene(const std::string& path, const Config& c, int all) {
@@ -261,10 +362,13 @@ int run(int argc, char** argv) {
   Config c;
   std::vector<std::string> scenes;
   std::string phase;
+  bool only_checkpoint = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--profile" && i + 1 < argc) {
       phase = argv[++i];
+    } else if (a == "--checkpoint") {
+      only_checkpoint = true;
     } else if (a == "--quick") {
       c.photons = 100000;
       c.raw_rays = size_t(1) << 18;
@@ -272,7 +376,8 @@ int run(int argc, char** argv) {
       c.big_render = false;
     } else if (a == "--help" || a == "-h") {
       std::printf(
-          "usage: photonbound-bench [--quick] [--profile raw|trace|pass|grid] [SCENE ...]\n");
+          "usage: photonbound-bench [--quick] [--checkpoint] [--profile raw|trace|pass|grid] "
+          "[SCENE ...]\n");
       return 0;
     } else if (!a.empty() && a[0] == '-') {
       std::fprintf(stderr, "photonbound-bench: unknown option %s\n", a.c_str());
@@ -283,6 +388,13 @@ int run(int argc, char** argv) {
   }
   const std::string cornell = std::string(PHOTONBOUND_SOURCE_DIR) + "/scenes/cornell.gltf";
   if (!phase.empty()) return profile(phase, scenes.empty() ? cornell : scenes[0], c);
+  if (only_checkpoint) {
+    checkpoint_cost(scenes.empty() ? cornell : scenes[0], c.loop_passes + 2);
+    for (const Goal& g : goals)
+      std::printf("%-52s %-12s %-11s %s\n", g.what.c_str(), g.measured.c_str(), g.goal.c_str(),
+                  g.met ? "yes" : "NO");
+    return 0;
+  }
   if (scenes.empty()) scenes = {cornell, heavy_scene()};
   const int all = pb::ThreadLimit(0).threads();
   std::printf(
@@ -290,6 +402,7 @@ int run(int argc, char** argv) {
       "repeated runs; load average %s\n",
       all, double(c.photons) / 1e3, load_average().c_str());
   if (c.big_render) big_render(cornell, c);
+  checkpoint_cost(cornell, c.loop_passes + 2);
   for (const std::string& s : scenes) run_scene(s, c, all);
 
   std::printf(

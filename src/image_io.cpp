@@ -82,12 +82,12 @@ void check_writable(const std::string& path) {
   std::remove(tmp.c_str());
 }
 
-void write_exr(const std::string& path, const ExrImage& image) {
+void write_exr(const std::string& path, const ExrImage& image, ExrCompression compression) {
   OIIO::ImageSpec spec(image.width, image.height, int(image.channels.size()),
                        OIIO::TypeDesc::FLOAT);
   spec.channelnames = image.channels;
   spec.alpha_channel = -1;
-  spec.attribute("compression", "zip");
+  spec.attribute("compression", compression == ExrCompression::Zip ? "zip" : "none");
   for (const auto& [key, value] : image.metadata) spec.attribute("photonbound:" + key, value);
   write_atomic(path, spec, image.pixels.data(), OIIO::TypeDesc::FLOAT);
 }

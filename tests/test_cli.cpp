@@ -41,6 +41,19 @@ TEST_F(Cli, RendersAndWritesOnlyTheImage) {
   EXPECT_EQ(std::distance(fs::directory_iterator(dir_), fs::directory_iterator()), 1);
 }
 
+TEST_F(Cli, WarnsWhenTheStartingRadiusIsOfTheSceneSize) {
+  // The Cornell box is about 3.5 units across: 1 is ~29% of it, 0.01 well below the 5% limit.
+  const std::string base = "render " + quote(scene("cornell.gltf")) + " -o " + quote(out()) +
+                           " --passes 2 --resolution 8x8 --photons-per-pass 1000 --quiet";
+  Outcome r = run(base + " --radius 1");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: --radius 1 is"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("% of the scene size"), std::string::npos) << r.err;
+  r = run(base + " --radius 0.01");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+}
+
 TEST_F(Cli, BadOptionValuesExitWithUsageError) {
   const std::string base =
       "render " + quote(scene("cornell.gltf")) + " -o " + quote(out()) + " --passes 1 ";
