@@ -362,13 +362,15 @@ int run(int argc, char** argv) {
   Config c;
   std::vector<std::string> scenes;
   std::string phase;
-  bool only_checkpoint = false;
+  bool only_checkpoint = false, only_memory = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--profile" && i + 1 < argc) {
       phase = argv[++i];
     } else if (a == "--checkpoint") {
       only_checkpoint = true;
+    } else if (a == "--memory") {
+      only_memory = true;
     } else if (a == "--quick") {
       c.photons = 100000;
       c.raw_rays = size_t(1) << 18;
@@ -376,7 +378,8 @@ int run(int argc, char** argv) {
       c.big_render = false;
     } else if (a == "--help" || a == "-h") {
       std::printf(
-          "usage: photonbound-bench [--quick] [--checkpoint] [--profile raw|trace|pass|grid] "
+          "usage: photonbound-bench [--quick] [--memory] [--checkpoint] [--profile "
+          "raw|trace|pass|grid] "
           "[SCENE ...]\n");
       return 0;
     } else if (!a.empty() && a[0] == '-') {
@@ -388,8 +391,9 @@ int run(int argc, char** argv) {
   }
   const std::string cornell = std::string(PHOTONBOUND_SOURCE_DIR) + "/scenes/cornell.gltf";
   if (!phase.empty()) return profile(phase, scenes.empty() ? cornell : scenes[0], c);
-  if (only_checkpoint) {
-    checkpoint_cost(scenes.empty() ? cornell : scenes[0], c.loop_passes + 2);
+  if (only_checkpoint || only_memory) {
+    if (only_memory) big_render(scenes.empty() ? cornell : scenes[0], c);
+    if (only_checkpoint) checkpoint_cost(scenes.empty() ? cornell : scenes[0], c.loop_passes + 2);
     for (const Goal& g : goals)
       std::printf("%-52s %-12s %-11s %s\n", g.what.c_str(), g.measured.c_str(), g.goal.c_str(),
                   g.met ? "yes" : "NO");
