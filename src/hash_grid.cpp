@@ -186,6 +186,9 @@ void HashGrid::build(std::span<const vec3> positions, std::span<const float> rad
   for (int k = top - 1; k >= 0; --k)
     if (level_map_[size_t(k)] < 0) level_map_[size_t(k)] = level_map_[size_t(k) + 1];
   if (levels_.size() < size_t(level_count_)) levels_.resize(size_t(level_count_));
+  // Slots beyond this build's levels give their memory back: a render that once used more
+  // levels (radii spread wider) must not keep a photon array per level it no longer has.
+  for (size_t i = size_t(level_count_); i < levels_.size(); ++i) levels_[i] = Level{};
 
   const int bits = table_bits(n);
   buckets_.resize(n);

@@ -231,9 +231,19 @@ TEST(HashGrid, DeterministicAcrossRebuilds) {
   EXPECT_NE(visit_sequence(g1, qs), first);
   g1.build(a, radii);
   EXPECT_EQ(visit_sequence(g1, qs), first);
-  EXPECT_EQ(g1.memory_bytes(), bigger);  // capacity kept, not freed
+  EXPECT_GT(bigger, 0u);
+  const size_t back = g1.memory_bytes();
+  g1.build(a, radii);
+  EXPECT_EQ(g1.memory_bytes(), back);  // warm again: no allocation
   g2.build(a, radii);
   EXPECT_EQ(visit_sequence(g2, qs), first);
+
+  // One radius after many levels: the other levels' photon arrays are freed.
+  const size_t many_levels = g1.memory_bytes();
+  ASSERT_GT(g1.level_count(), 2);
+  g1.build(a, std::vector<float>{0.05f});
+  EXPECT_EQ(g1.level_count(), 1);
+  EXPECT_LT(g1.memory_bytes(), many_levels - size_t(g1.level_count() + 1) * a.size() * 16);
 }
 
 TEST(HashGrid, InvalidInputThrows) {

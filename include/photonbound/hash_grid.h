@@ -33,8 +33,9 @@ class HashGrid {
   // duplicates are fine). Throws std::invalid_argument when a radius is not finite and > 0 or a
   // position is not finite; std::length_error beyond 2^31 photons. On a throw the grid is
   // unchanged. Empty positions, or empty radii (no queries expected, e.g. no measurement
-  // points), give a grid whose queries visit nothing. Vectors are reused across builds
-  // (cleared, never freed), so once warm a rebuild of the same size does not allocate.
+  // points), give a grid whose queries visit nothing. Vectors are reused across builds, so
+  // once warm a rebuild of the same size does not allocate; only the levels a build no longer
+  // uses are freed.
   void build(std::span<const vec3> positions, std::span<const float> radii);
 
   // Calls visit(uint32_t photon_index, float dist2) once for every photon with
@@ -119,7 +120,7 @@ class HashGrid {
   // Hashes and sorts every photon into one level (hash_grid.cpp).
   void build_level(Level& lv, std::span<const vec3> positions, int bits);
 
-  std::vector<Level> levels_;      // [0, level_count_) in use; the rest kept for reuse
+  std::vector<Level> levels_;      // [0, level_count_) in use; the rest empty
   std::vector<int> level_map_;     // level k (0..L-1) -> slot of the smallest built level >= k
   std::vector<uint8_t> used_;      // build scratch: level k is used by some radius
   std::vector<uint32_t> buckets_;  // build scratch: bucket of each photon
