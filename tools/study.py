@@ -90,14 +90,18 @@ def make_reference(name, cfg, resolution, folder):
     return path
 
 
-def reference_bound(path):
+def reference_quality(path):
+    """The reference's mean bound (0 when exact), its confidence, and the mean absolute error
+    its noise alone is expected to have, sqrt(2/pi) x mean sd (normal noise)."""
     ref = pbtools.read_exr(path)
-    bound = ref.rgb("ErrorBound.") if "ErrorBound.R" in ref.planes else None
-    if bound is None:
-        return 0.0, None
-    finite = bound[np.isfinite(bound)]
-    conf = ref.meta("photonbound:confidence")
-    return float(finite.mean()) if finite.size else float("inf"), conf
+    if "ErrorBound.R" not in ref.planes:
+        return 0.0, None, 0.0
+    bound = ref.rgb("ErrorBound.")
+    known = np.isfinite(bound) & (bound > 0)
+    if not known.any():
+        return 0.0, None, 0.0
+    noise = float(np.mean(np.sqrt(2.0 / np.pi * ref.rgb("Variance.")[known])))
+    return float(np.mean(bound[np.isfinite(bound)])), ref.meta("photonbound:confidence"), noise
 
 
 def run_one(exe, name, cfg, resolution, confidence, target, ref, runs, limit):
@@ -159,11 +163,12 @@ def table_document(rows, refs, argv, total, version):
            "run uses seed 1.", ""]
     for s in scenes:
         r0 = next(r for r in rows if r["scene"] == s)
-        path, bound, conf = refs[s]
+        path, bound, conf, noise = refs[s]
         smallest = min(r["actual"] for r in rows if r["scene"] == s)
         ref_text = ("exact answer" if bound == 0.0 else
-                    f"{os.path.basename(path)}, mean bound {bound:.3g} at {conf} confidence, "
-                    f"{smallest / bound:.1f}x below the smallest actual error here")
+                    f"`{os.path.basename(path)}`, mean bound {bound:.3g} at {float(conf):.0%} "
+                    f"confidence ({smallest / bound:.1f}x below the smallest actual error here), "
+                    f"expected noise error {noise:.2g}")
         out.append(f"- {s}: {r0['resolution']}, --direct {r0['direct']}; reference: {ref_text}")
     return "\n".join(out) + "\n"
 
@@ -243,7 +248,7 @@ def main():
         cfg = SCENES[name]
         res = args.resolution or cfg["resolution"]
         path = make_reference(name, cfg, res, ref_dir)
-        refs[name] = (path, *reference_bound(path))
+        refs[name] = (path, *reference_quality(path))
 
     rows, exrs, logs = [], [], []
     for name in names:

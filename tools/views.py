@@ -131,9 +131,7 @@ def noise_bias_view(plt, exr, path, label):
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(known, bias / noise, 1.0)
     ratio = np.clip(np.nan_to_num(ratio, nan=1.0, posinf=1e6), 1e-6, 1e6)
-    span = 10.0**max(1.0, math.ceil(np.log10(np.max(np.abs(
-        [ratio[known].max(), 1.0 / ratio[known].min()])) if known.any() else 10.0)))
-    span = min(span, 1e3)
+    span = 100.0  # ratios beyond 1:100 either way are shown at the ends of the bar
     norm = mcolors.LogNorm(vmin=1.0 / span, vmax=span)
     cmap = plt.get_cmap("RdBu_r")
     colours = paint(cmap(norm(ratio)), exact, unknown)
