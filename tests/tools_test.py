@@ -16,6 +16,8 @@ import subprocess
 import sys
 import tempfile
 
+import numpy as np
+
 TOOLS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tools")
 sys.path.insert(0, TOOLS)
 import pbtools  # noqa: E402
@@ -121,7 +123,7 @@ def bad_input(exe, tmp):
     missing = os.path.join(tmp, "missing.exr")
     expect_failure("views of a missing file", run_tool("views.py", missing, "-o", tmp), missing)
     rgb_only = os.path.join(tmp, "rgb_only.exr")
-    z = pbtools.np.zeros((4, 4), pbtools.np.float32)
+    z = np.zeros((4, 4), np.float32)
     pbtools.write_exr(rgb_only, {"R": z, "G": z, "B": z}, {})
     expect_failure("views of an EXR without bounds", run_tool("views.py", rgb_only, "-o", tmp),
                    "has no channel ErrorBound.R")

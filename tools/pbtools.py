@@ -36,7 +36,8 @@ def run_main(tool, main):
         print(f"{tool}: {e}", file=sys.stderr)
         sys.exit(1)
     except OSError as e:
-        print(f"{tool}: {e.filename or ''}: {e.strerror}", file=sys.stderr)
+        print(f"{tool}: {e.filename}: {e.strerror}" if e.filename else f"{tool}: {e}",
+              file=sys.stderr)
         sys.exit(1)
     except KeyboardInterrupt:
         print(f"{tool}: interrupted", file=sys.stderr)
@@ -80,6 +81,8 @@ class Exr:
 
 def read_exr(path):
     _need_oiio()
+    if os.path.isdir(path):
+        raise ToolError(f"{path}: is a folder, not an image")
     if not os.path.isfile(path):
         raise ToolError(f"{path}: no such file")
     inp = oiio.ImageInput.open(path)
@@ -103,8 +106,11 @@ def temp_beside(path, suffix):
     """A fresh temporary file name in path's folder (so a rename over path is atomic), with
     the permissions a newly created file gets (mkstemp's are owner-only)."""
     folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=suffix,
-                               dir=folder)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=suffix,
+                                   dir=folder)
+    except OSError as e:
+        raise ToolError(f"{path}: cannot write ({e.strerror})") from None
     os.close(fd)
     mask = os.umask(0)
     os.umask(mask)
