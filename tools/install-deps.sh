@@ -8,7 +8,8 @@ packages=(
   cmake ninja-build g++ pkg-config
   libembree-dev libopenimageio-dev libopenexr-dev libglm-dev libtinygltf-dev
   libtbb-dev libboost-dev libgtest-dev
-  python3 python3-numpy python3-matplotlib python3-openimageio
+  python3-numpy python3-matplotlib python3-openimageio
+  python3
 )
 
 missing=()
