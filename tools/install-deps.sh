@@ -9,6 +9,7 @@ packages=(
   cmake ninja-build g++ pkg-config
   libembree-dev libopenimageio-dev libopenexr-dev libglm-dev libtinygltf-dev
   libtbb-dev libboost-dev libgtest-dev
+  python3-numpy python3-matplotlib python3-openimageio
   python3
   "$@"
 )

@@ -1,0 +1,276 @@
+#!/usr/bin/python3
+"""The speed-accuracy study: renders to a sweep of target errors, measured against references.
+
+  tools/study.py OUTDIR [--scenes plane,box,cornell] [--confidences 0.5,0.9]
+                 [--targets T1,T2,...] [--resolution WxH] [--run-time-limit S]
+                 [--photonbound EXE]
+
+For each scene, each confidence and each target (four halving targets per scene by default),
+`photonbound render` runs to --target-error with --log and --reference (seed 1). Each final
+image is then measured with `photonbound compare --json` against the scene's reference: the
+exact answer for the analytic plane and closed box (tools/reference.py exact), the committed
+long render tools/study/cornell_64x64_reference.exr for the Cornell box. OUTDIR gets:
+
+  table.md            scene, confidence, target, actual mean error, specified / actual, passes,
+                      photons, seconds, coverage, stop reason (and how it was made)
+  results.json        the same rows, with every number of `photonbound compare --json`
+  convergence_time.png, convergence_passes.png   mean bound and actual error of each scene's
+                      tightest run at each confidence, log-log (tools/plot_logs.py)
+  convergence_sweep.png  specified against actual error
+  views/              radiance, relative bound, noise/bias and bounded maps of each scene's
+                      tightest run at each confidence (tools/views.py)
+  runs/, references/  the EXRs and logs
+
+--scenes, --targets and --resolution shrink the study (the smoke test runs one scene, two
+targets, a tiny image); --targets and --resolution apply to every scene chosen.
+"""
+
+import argparse
+import datetime
+import json
+import os
+import platform
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import pbtools  # noqa: E402
+import plot_logs  # noqa: E402
+import reference  # noqa: E402
+import views  # noqa: E402
+from pbtools import ToolError  # noqa: E402
+
+SEED = 1
+CORNELL_REFERENCE = os.path.join(pbtools.REPO, "tools", "study", "cornell_64x64_reference.exr")
+
+# Targets halve in turn. They are chosen so that the tightest run at 90% takes one to three
+# minutes on 2 cores, and (Cornell box) so that the reference is much tighter than the errors.
+SCENES = {
+    "plane": {"file": "plane_point.gltf", "resolution": "64x64", "direct": "photons",
+              "reference": "exact", "targets": [0.08, 0.04, 0.02, 0.01]},
+    "box": {"file": "closed_box.gltf", "resolution": "64x64", "direct": "nee",
+            "reference": "exact", "targets": [0.16, 0.08, 0.04, 0.02]},
+    "cornell": {"file": "cornell.gltf", "resolution": "64x64", "direct": "nee",
+                "reference": CORNELL_REFERENCE, "targets": [0.016, 0.008, 0.004, 0.002]},
+}
+
+COLUMNS = ["scene", "confidence", "target", "actual mean error", "specified / actual", "passes",
+           "photons", "seconds", "coverage", "stop"]
+
+
+def float_list(text, what):
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise ToolError(f"{what} {text}: expected comma-separated numbers") from None
+    if not values or any(not (v > 0) for v in values):
+        raise ToolError(f"{what} {text}: expected positive numbers")
+    return values
+
+
+def make_reference(name, cfg, resolution, folder):
+    """Path of the scene's reference EXR at `resolution`, generated when it is exact."""
+    if cfg["reference"] == "exact":
+        path = os.path.join(folder, f"{name}_{resolution}_exact.exr")
+        w, h = pbtools.parse_resolution(resolution)
+        gltf = pbtools.Gltf(os.path.join(pbtools.REPO, "scenes", cfg["file"]))
+        exact = reference.exact_plane if name == "plane" else reference.exact_box
+        reference.write_reference(path, exact(gltf, w, h),
+                                  {"photonbound:reference": f"exact {name}"})
+        return path
+    path = cfg["reference"]
+    ref = pbtools.read_exr(path)
+    h, w = ref.shape
+    if f"{w}x{h}" != resolution:
+        raise ToolError(f"{name}: the reference {path} is {w}x{h}, not {resolution}: render one "
+                        "with tools/reference.py render (see README)")
+    return path
+
+
+def reference_quality(path):
+    """The reference's mean bound (0 when exact), its confidence, and the mean absolute error
+    its noise alone is expected to have, sqrt(2/pi) x mean sd (normal noise)."""
+    ref = pbtools.read_exr(path)
+    if "ErrorBound.R" not in ref.planes:
+        return 0.0, None, 0.0
+    bound = ref.rgb("ErrorBound.")
+    known = np.isfinite(bound) & (bound > 0)
+    if not known.any():
+        return 0.0, None, 0.0
+    noise = float(np.mean(np.sqrt(2.0 / np.pi * ref.rgb("Variance.")[known])))
+    return float(np.mean(bound[np.isfinite(bound)])), ref.meta("photonbound:confidence"), noise
+
+
+def run_one(exe, name, cfg, resolution, confidence, target, ref, runs, limit):
+    stem = f"{name}_c{round(100 * confidence)}_t{target:g}"
+    exr, log = os.path.join(runs, stem + ".exr"), os.path.join(runs, stem + ".jsonl")
+    cmd = [exe, "render", os.path.join(pbtools.REPO, "scenes", cfg["file"]), "-o", exr,
+           "--resolution", resolution, "--direct", cfg["direct"], "--confidence",
+           f"{confidence:g}", "--target-error", f"{target:g}", "--time", f"{limit:g}", "--seed",
+           str(SEED), "--log", log, "--reference", ref, "--quiet"]
+    start = time.monotonic()
+    p = subprocess.run(cmd, capture_output=True, text=True)
+    wall = time.monotonic() - start
+    if p.returncode != 0:
+        raise ToolError(f"{stem}: photonbound render failed: {p.stderr.strip()}")
+    meta = pbtools.read_exr(exr).metadata
+    c = pbtools.compare_json(exe, exr, ref)
+    row = {
+        "scene": name, "confidence": confidence, "target": target,
+        "actual": c["mean_abs_error"], "coverage": c["coverage"],
+        "specified_over_actual": target / c["mean_abs_error"] if c["mean_abs_error"] > 0 else None,
+        "passes": int(meta["photonbound:passes_done"]),
+        "photons": int(meta["photonbound:photons_emitted"]),
+        "seconds": float(meta["photonbound:seconds"]),
+        "wall_seconds": wall,
+        "stop": meta["photonbound:stop_reason"],
+        "mean_bound": float(meta["photonbound:mean_error_bound"]),
+        "resolution": resolution, "direct": cfg["direct"], "exr": os.path.relpath(exr, runs),
+        "log": os.path.relpath(log, runs), "compare": c,
+    }
+    print(f"study: {stem}: {row['passes']} passes, {row['seconds']:.1f} s, actual "
+          f"{row['actual']:.4g}, coverage {row['coverage']:.3f}, stop {row['stop']}", flush=True)
+    return row, exr, log
+
+
+def format_row(r):
+    ratio = r["specified_over_actual"]
+    return [r["scene"], f"{100 * r['confidence']:g}%", f"{r['target']:g}", f"{r['actual']:.4g}",
+            f"{ratio:.2f}" if ratio is not None else "-", str(r["passes"]),
+            f"{r['photons']:.3g}", f"{r['seconds']:.1f}", f"{r['coverage']:.3f}", r["stop"]]
+
+
+def markdown_table(rows):
+    lines = ["| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+    lines += ["| " + " | ".join(format_row(r)) + " |" for r in rows]
+    return "\n".join(lines) + "\n"
+
+
+def table_document(rows, refs, argv, total, version):
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    out = ["# photonbound speed-accuracy study", "",
+           f"`{' '.join(argv)}`: {total / 60:.1f} minutes on {os.cpu_count()} cores "
+           f"({platform.machine()}), {version}, "
+           f"{datetime.datetime.now().strftime('%Y-%m-%d %H:%M')}.", "",
+           markdown_table(rows),
+           "Actual mean error and coverage are `photonbound compare --json` of the final image "
+           "against the reference: the mean of |L - L_ref| over all pixels and RGB channels, and "
+           "the fraction of bounded pixel-channels with |L - L_ref| <= ErrorBound. Passes, "
+           "photons, seconds (render loop only) and stop come from the EXR's metadata. Every "
+           "run uses seed 1.", ""]
+    for s in scenes:
+        r0 = next(r for r in rows if r["scene"] == s)
+        path, bound, conf, noise = refs[s]
+        smallest = min(r["actual"] for r in rows if r["scene"] == s)
+        ref_text = ("exact answer" if bound == 0.0 else
+                    f"`{os.path.basename(path)}`, mean bound {bound:.3g} at {float(conf):.0%} "
+                    f"confidence ({smallest / bound:.1f}x below the smallest actual error here), "
+                    f"expected noise error {noise:.2g}")
+        out.append(f"- {s}: {r0['resolution']}, --direct {r0['direct']}; reference: {ref_text}")
+    return "\n".join(out) + "\n"
+
+
+def write_plots(rows, logs, outdir):
+    plt = pbtools.use_agg()
+    tightest = {}
+    for r, log in zip(rows, logs):
+        key = (r["scene"], r["confidence"])
+        if key not in tightest or r["target"] < tightest[key][0]:
+            tightest[key] = (r["target"], log)
+    chosen = [(scene, f"{100 * c:g}%", pbtools.read_log(log))
+              for (scene, c), (_, log) in sorted(tightest.items(),
+                                                 key=lambda kv: (list(SCENES).index(kv[0][0])
+                                                                 if kv[0][0] in SCENES else 99,
+                                                                 kv[0][1]))]
+    plot_logs.convergence_plot(plt, chosen, "seconds", "seconds",
+                               os.path.join(outdir, "convergence_time.png"))
+    plot_logs.convergence_plot(plt, chosen, "pass", "passes",
+                               os.path.join(outdir, "convergence_passes.png"))
+    plot_logs.sweep_plot(plt, rows, os.path.join(outdir, "convergence_sweep.png"))
+    return plt
+
+
+def write_views(plt, rows, exrs, refs, outdir):
+    folder = os.path.join(outdir, "views")
+    os.makedirs(folder, exist_ok=True)
+    tightest = {}
+    for r, exr in zip(rows, exrs):
+        key = (r["scene"], r["confidence"])
+        if key not in tightest or r["target"] < tightest[key][0]:
+            tightest[key] = (r["target"], exr)
+    for (scene, conf), (target, exr) in tightest.items():
+        img, ref = pbtools.read_exr(exr), pbtools.read_exr(refs[scene][0])
+        name = os.path.splitext(os.path.basename(exr))[0]
+        label = f"{scene}, target {target:g} at {100 * conf:g}%"
+        out = lambda kind: os.path.join(folder, f"{name}_{kind}.png")  # noqa: E731
+        views.radiance_view(plt, img, out("radiance"), 0.0)
+        views.bound_view(plt, img, out("bound"), label)
+        views.noise_bias_view(plt, img, out("noise_bias"), label)
+        views.bounded_view(plt, img, ref, out("bounded"), label)
+
+
+def main():
+    ap = argparse.ArgumentParser(prog="study.py", description=__doc__.split("\n\n")[0])
+    ap.add_argument("outdir")
+    ap.add_argument("--scenes", default=",".join(SCENES))
+    ap.add_argument("--confidences", default="0.5,0.9")
+    ap.add_argument("--targets", help="comma-separated targets for every scene chosen")
+    ap.add_argument("--resolution", help="WxH for every scene chosen")
+    ap.add_argument("--run-time-limit", type=float, default=600.0,
+                    help="--time of each render, a safety net (default 600 s)")
+    ap.add_argument("--photonbound", default=pbtools.default_photonbound())
+    args = ap.parse_args()
+    start = time.monotonic()
+    exe = pbtools.check_photonbound(args.photonbound)
+    names = [s.strip() for s in args.scenes.split(",") if s.strip()]
+    unknown = [s for s in names if s not in SCENES]
+    if unknown or not names:
+        raise ToolError(f"--scenes {args.scenes}: choose from {', '.join(SCENES)}")
+    confidences = float_list(args.confidences, "--confidences")
+    if any(c >= 1 for c in confidences):
+        raise ToolError(f"--confidences {args.confidences}: each must be in (0, 1)")
+    targets = float_list(args.targets, "--targets") if args.targets else None
+    if args.resolution:
+        pbtools.parse_resolution(args.resolution)
+    if not args.run_time_limit > 0:
+        raise ToolError("--run-time-limit must be positive")
+    version = subprocess.run([exe, "--version"], capture_output=True, text=True).stdout.strip()
+
+    outdir = args.outdir
+    runs, ref_dir = os.path.join(outdir, "runs"), os.path.join(outdir, "references")
+    os.makedirs(runs, exist_ok=True)
+    os.makedirs(ref_dir, exist_ok=True)
+    refs = {}
+    for name in names:  # all references first: a missing one fails before any render
+        cfg = SCENES[name]
+        res = args.resolution or cfg["resolution"]
+        path = make_reference(name, cfg, res, ref_dir)
+        refs[name] = (path, *reference_quality(path))
+
+    rows, exrs, logs = [], [], []
+    for name in names:
+        cfg = SCENES[name]
+        for conf in confidences:
+            for target in sorted(targets or cfg["targets"], reverse=True):
+                row, exr, log = run_one(exe, name, cfg, args.resolution or cfg["resolution"],
+                                        conf, target, refs[name][0], runs, args.run_time_limit)
+                rows.append(row)
+                exrs.append(exr)
+                logs.append(log)
+    pbtools.write_text(os.path.join(outdir, "results.json"), json.dumps(rows, indent=1) + "\n")
+    plt = write_plots(rows, logs, outdir)
+    write_views(plt, rows, exrs, refs, outdir)
+    total = time.monotonic() - start
+    argv = ["tools/study.py"] + sys.argv[1:]
+    doc = table_document(rows, refs, argv, total, version)
+    pbtools.write_text(os.path.join(outdir, "table.md"), doc)
+    print(doc)
+    print(f"study: wrote {outdir}/table.md, results.json, convergence_*.png and views/ in "
+          f"{total:.0f} s")
+
+
+if __name__ == "__main__":
+    pbtools.run_main("study", main)
