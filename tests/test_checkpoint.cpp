@@ -17,7 +17,9 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <mutex>
 #include <thread>
+#include <vector>
 
 extern char** environ;
 
@@ -64,6 +66,65 @@ TEST_F(Checkpoints, ResumeIsBitIdentical) {
             0);
   const ExrImage a = straight.image(full), b = resumed.image(rest);
   EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(float)), 0);
+}
+
+// Checkpoints written on the background thread: each snapshot is the render exactly as one pass
+// left it (its states equal a render stepped to that pass), checkpointing does not change the
+// render, and resuming from any snapshot finishes bit-identical to the uninterrupted render.
+TEST_F(Checkpoints, BackgroundSnapshotsAreExactAndResumeBitIdentical) {
+  RenderOptions o = small_options();
+  o.passes = 10;
+  const Scene scene = load_gltf(o.scene);
+  Renderer straight(scene, o);
+  straight.run(nullptr, nullptr);
+  const size_t bytes = straight.states().size() * sizeof(PointState);
+
+  std::mutex m;
+  std::vector<SavedRender> snaps;
+  CheckpointPolicy policy;
+  policy.every = 1e-9;  // whenever the writer is idle
+  policy.write = [&](const RenderReport& report, SavedRender& s) {
+    EXPECT_EQ(report.passes, s.loop.passes);
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // passes go on meanwhile
+    std::lock_guard<std::mutex> lock(m);
+    snaps.push_back(s);
+  };
+  Renderer checkpointed(scene, o);
+  checkpointed.run(nullptr, nullptr, policy);
+  EXPECT_EQ(std::memcmp(checkpointed.states().data(), straight.states().data(), bytes), 0);
+  ASSERT_GE(snaps.size(), 2u);
+  EXPECT_EQ(checkpointed.timings().checkpoints, snaps.size());
+
+  for (const SavedRender& s : snaps) {
+    SCOPED_TRACE("snapshot after pass " + std::to_string(s.loop.passes));
+    ASSERT_LT(s.loop.passes, *o.passes);  // the last pass is the caller's to write
+    Renderer stepped(scene, o);
+    while (stepped.passes() < s.loop.passes) stepped.step();
+    EXPECT_EQ(std::memcmp(s.states.data(), stepped.states().data(), bytes), 0);
+    Renderer resumed(scene, o);
+    resumed.restore(s);
+    resumed.run(nullptr, nullptr);
+    EXPECT_EQ(std::memcmp(resumed.states().data(), straight.states().data(), bytes), 0);
+  }
+}
+
+// A write that fails is reported by run(), not lost on the background thread.
+TEST_F(Checkpoints, FailedBackgroundWriteIsRethrown) {
+  RenderOptions o = small_options();
+  o.passes = 6;
+  const Scene scene = load_gltf(o.scene);
+  CheckpointPolicy policy;
+  policy.every = 1e-9;
+  policy.write = [](const RenderReport&, SavedRender&) {
+    throw StateError("out.pbstate: cannot write (No space left on device)");
+  };
+  Renderer r(scene, o);
+  try {
+    r.run(nullptr, nullptr, policy);
+    ADD_FAILURE() << "run() returned";
+  } catch (const StateError& e) {
+    EXPECT_NE(std::string(e.what()).find("No space left"), std::string::npos);
+  }
 }
 
 TEST_F(Checkpoints, StateRoundTripsExactly) {
