@@ -3,6 +3,7 @@
 // figure and holds this machine's output. Timings are printed, never asserted.
 #include "bench.h"
 
+#include "photonbound/gather.h"
 #include "photonbound/gltf_loader.h"
 #include "photonbound/parallel.h"
 #include "photonbound/renderer.h"
@@ -105,7 +106,7 @@ void big_render(const std::string& path, const Config& c) {
   std::vector<pb::vec3> positions(hits.size());
   for (size_t k = 0; k < hits.size(); ++k) positions[k] = hits[k].position;
   std::vector<float> radii(points);
-  for (size_t k = 0; k < points; ++k) radii[k] = float(std::sqrt(r.states()[k].r2));
+  for (size_t k = 0; k < points; ++k) radii[k] = pb::search_radius(r.states()[k].r2);
   pb::HashGrid grid;
   grid.build(positions, radii);
   const double fixed = double(sizeof(pb::MeasurementPoint) + sizeof(pb::PointState) + 4);

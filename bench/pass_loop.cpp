@@ -107,7 +107,7 @@ PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photo
     t0 = now();
     positions.resize(hits.size());
     for (size_t k = 0; k < hits.size(); ++k) positions[k] = hits[k].position;
-    for (size_t k = 0; k < n; ++k) radii[k] = float(std::sqrt(on[k].r2));
+    for (size_t k = 0; k < n; ++k) radii[k] = pb::search_radius(on[k].r2);
     prep.add(t0);
     t0 = now();
     grid.build(positions, radii);
@@ -162,7 +162,7 @@ PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photo
   r.grid_bytes = grid.memory_bytes();
   for (size_t k = 0; k < n; ++k) {
     on[k].r2 = std::max(on[k].r2 * 1e-4, params.min_r2);
-    radii[k] = float(std::sqrt(on[k].r2));
+    radii[k] = pb::search_radius(on[k].r2);
   }
   Phase sbuild, sgather;
   for (int rep = 0; rep < build_reps; ++rep) {

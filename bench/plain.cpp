@@ -1,5 +1,6 @@
 #include "plain.h"
 
+#include "photonbound/gather.h"
 #include "photonbound/kernel.h"
 
 #include <algorithm>
@@ -9,7 +10,7 @@ namespace bench {
 
 void gather_plain(const pb::MeasurementPoint& point, double r2, const pb::HashGrid& grid,
                   const std::vector<pb::PhotonHit>& hits, pb::dvec3& phi_out, uint64_t& count_out) {
-  const float radius = float(std::sqrt(r2));
+  const float radius = pb::search_radius(r2);
   const double inv_r2 = 1.0 / r2;
   pb::dvec3 phi(0.0);
   uint64_t count = 0;

@@ -203,11 +203,16 @@ RenderOptions read_options(Reader& r) {
 
 std::string errno_text() { return std::strerror(errno); }
 
-}  // namespace
-
-void write_file_atomic(const std::string& path, const std::string& bytes) {
-  write_file_atomic(path, {std::string_view(bytes)});
+// The whole file; StateError "<path>: cannot open (...)" when it cannot be read.
+std::string read_bytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) throw StateError(path + ": cannot open (" + errno_text() + ")");
+  std::ostringstream buf;
+  buf << f.rdbuf();
+  return buf.str();
 }
+
+}  // namespace
 
 void write_file_atomic(const std::string& path, std::initializer_list<std::string_view> pieces) {
   const std::filesystem::path p(path);
@@ -277,11 +282,7 @@ void save_state(const std::string& path, const SavedRender& s) {
 }
 
 SavedRender load_state(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw StateError(path + ": cannot open (" + errno_text() + ")");
-  std::ostringstream buf;
-  buf << f.rdbuf();
-  const std::string bytes = buf.str();
+  const std::string bytes = read_bytes(path);
   if (bytes.size() < 16 || std::memcmp(bytes.data(), kMagic, 8) != 0)
     throw StateError(path + ": not a photonbound state file");
   uint32_t version, record;
@@ -329,11 +330,7 @@ SavedRender load_state(const std::string& path) {
 }
 
 uint64_t hash_file(const std::string& path) {
-  std::ifstream f(path, std::ios::binary);
-  if (!f) throw StateError(path + ": cannot open (" + errno_text() + ")");
-  std::ostringstream buf;
-  buf << f.rdbuf();
-  const std::string bytes = buf.str();
+  const std::string bytes = read_bytes(path);
   return checksum(bytes.data(), bytes.size());
 }
 

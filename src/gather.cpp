@@ -8,7 +8,7 @@ namespace pb {
 
 void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& grid,
                     const std::vector<PhotonHit>& hits, PassGather& out) {
-  const float radius = float(std::sqrt(r2));
+  const float radius = search_radius(r2);
   const double inv_r2 = 1.0 / r2;
   dvec3 phi(0.0), lap(0.0);
   uint64_t count = 0;

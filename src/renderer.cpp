@@ -86,7 +86,7 @@ Renderer::Renderer(const Scene& scene, const RenderOptions& options)
   PointState initial;
   initial.r2 = r0 * r0;
   states_.assign(eye_.points.size(), initial);
-  radii_.assign(eye_.points.size(), float(std::sqrt(initial.r2)));
+  radii_.assign(eye_.points.size(), search_radius(initial.r2));
 }
 
 double Renderer::default_radius() const {
@@ -166,7 +166,7 @@ void Renderer::step(std::vector<PointState>* copy) {
         g.direct = direct_light(world_, eye_.points[k], rng);
       }
       accumulate_pass(states_[k], g, params_, pass);
-      radii_[k] = float(std::sqrt(states_[k].r2));
+      radii_[k] = search_radius(states_[k].r2);
       if (copy) stream_copy(&(*copy)[k], states_[k]);
     }
     if (copy) store_fence();  // the streamed stores are visible before the writer reads them
@@ -303,11 +303,7 @@ RenderReport Renderer::run(const std::atomic<bool>* stop, std::ostream* progress
     if (snap && report.stop_reason.empty()) {
       const auto t_submit = Clock::now();
       last_checkpoint = run_seconds;
-      SavedRender saved;
-      saved.options = options_;
-      saved.initial_radius = initial_radius_;
-      saved.loop = loop_;
-      saved.states = std::move(checkpoint_states_);
+      SavedRender saved = snapshot_with(std::move(checkpoint_states_));
       pending = std::async(std::launch::async,
                            [this, &checkpoint, report, saved = std::move(saved)]() mutable {
                              const auto t_write = Clock::now();
@@ -331,17 +327,19 @@ void Renderer::restore(const SavedRender& saved) {
                      " measurement points but this scene and camera give " +
                      std::to_string(states_.size()));
   states_ = saved.states;
-  for (size_t k = 0; k < states_.size(); ++k) radii_[k] = float(std::sqrt(states_[k].r2));
+  for (size_t k = 0; k < states_.size(); ++k) radii_[k] = search_radius(states_[k].r2);
   loop_ = saved.loop;
   initial_radius_ = saved.initial_radius;
 }
 
-SavedRender Renderer::snapshot() const {
+SavedRender Renderer::snapshot() const { return snapshot_with(states_); }
+
+SavedRender Renderer::snapshot_with(std::vector<PointState> states) const {
   SavedRender s;
   s.options = options_;
   s.initial_radius = initial_radius_;
   s.loop = loop_;
-  s.states = states_;
+  s.states = std::move(states);
   return s;
 }
 

@@ -55,10 +55,8 @@ uint64_t hash_file(const std::string& path);
 std::vector<std::string> differences(const SavedRender& saved, const RenderOptions& now,
                                      uint64_t scene_hash);
 
-// Writes `bytes` to `path` atomically and durably: temporary file, fsync, rename, fsync of the
-// folder. Throws StateError naming the file.
-void write_file_atomic(const std::string& path, const std::string& bytes);
-// The same for a file made of several pieces, written one after the other.
+// Writes the pieces, one after the other, to `path` atomically and durably: temporary file,
+// fsync, rename, fsync of the folder. Throws StateError naming the file.
 void write_file_atomic(const std::string& path, std::initializer_list<std::string_view> pieces);
 
 }  // namespace pb

@@ -9,11 +9,16 @@
 #include "photonbound/rng.h"
 #include "photonbound/world.h"
 
+#include <cmath>
 #include <vector>
 
 namespace pb {
 
-// Adds every photon within sqrt(r2) of the point that arrived on the point's side.
+// The float radius a point with squared radius r2 queries the grid with. The grid is built for
+// these same values (Renderer keeps one per point), so both must come from here.
+inline float search_radius(double r2) { return float(std::sqrt(r2)); }
+
+// Adds every photon within search_radius(r2) of the point that arrived on the point's side.
 void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& grid,
                     const std::vector<PhotonHit>& hits, PassGather& out);
 

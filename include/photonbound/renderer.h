@@ -103,6 +103,7 @@ class Renderer {
 
  private:
   double default_radius() const;
+  SavedRender snapshot_with(std::vector<PointState> states) const;  // these states, the rest now
   std::string progress_line(const RenderReport& report, double run_seconds) const;
   void write_log_line(const RenderReport& report, const PassLog& log) const;
   bool radii_fixed() const;
