@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -39,15 +40,20 @@ inline Outcome run_photonbound(const std::string& args, const std::string& dir =
   return r;
 }
 
+// A folder name under the system temporary directory that no other process uses: the process
+// id keeps two ctest runs of the same test (two checkouts, or a sanitizer build beside the
+// normal one) out of each other's files.
+inline std::filesystem::path unique_temp_path(const std::string& stem) {
+  return std::filesystem::temp_directory_path() /
+         ("pb_" + stem + "_" + std::to_string(static_cast<long>(::getpid())));
+}
+
 // A fresh, empty folder per test case, removed afterwards.
 class TempDirTest : public ::testing::Test {
  protected:
   void SetUp() override {
-    dir_ =
-        std::filesystem::temp_directory_path() /
-        ("pb_" +
-         std::string(::testing::UnitTest::GetInstance()->current_test_info()->test_suite_name()) +
-         "_" + ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir_ = unique_temp_path(std::string(info->test_suite_name()) + "_" + info->name());
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_);
   }

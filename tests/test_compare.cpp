@@ -3,6 +3,7 @@
 #include "photonbound/image_io.h"
 
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <filesystem>
@@ -78,7 +79,8 @@ TEST(ImageIo, ExrRoundTripKeepsChannelsPixelsAndMetadata) {
   ExrImage img = make_render(3, 2, 0.5f, 0.125f, -0.25f, 0.0625f);
   img.pixels[7] = INFINITY;
   img.metadata = {{"stop_reason", "target-error"}, {"passes_done", "17"}};
-  const auto path = std::filesystem::temp_directory_path() / "pb_roundtrip.exr";
+  const auto path = std::filesystem::temp_directory_path() /
+                    ("pb_roundtrip_" + std::to_string(static_cast<long>(::getpid())) + ".exr");
   write_exr(path.string(), img);
   const ExrImage back = read_exr(path.string());
   std::filesystem::remove(path);

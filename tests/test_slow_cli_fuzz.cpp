@@ -16,7 +16,7 @@ Outcome run_in(const fs::path& dir, const std::string& args) {
 }
 
 TEST(SlowCliFuzz, HostileValuesGiveUsageErrors) {
-  const fs::path dir = fs::temp_directory_path() / "pb_cli_fuzz";
+  const fs::path dir = pb::test::unique_temp_path("cli_fuzz");
   fs::remove_all(dir);
   fs::create_directories(dir);
   const std::string scene = std::string(PHOTONBOUND_SCENES) + "/plane_point.gltf";

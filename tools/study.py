@@ -47,15 +47,24 @@ SEED = 1
 CORNELL_REFERENCE = os.path.join(pbtools.REPO, "tools", "study", "cornell_64x64_reference.exr")
 
 # Targets halve in turn. They are chosen so that the tightest run at 90% takes one to three
-# minutes on 2 cores, and (Cornell box) so that the reference is much tighter than the errors.
+# minutes on 2 cores. The Cornell box needs more care: a long render is its reference, and the
+# issue asks for that reference's bound to be 10x below the errors studied. With the default
+# 100k photons per pass its 64x64 image already has a mean error of 0.005 after the first 16
+# passes, so the studied errors could not lie 10x above any reference this machine can render
+# (the bound of a long PPM render falls like passes^-0.25 to -0.5). With 250 photons per pass the
+# same sweep starts from a 10x rougher image, noise-dominated like a short render of a big scene.
 SCENES = {
     "plane": {"file": "plane_point.gltf", "resolution": "64x64", "direct": "photons",
-              "reference": "exact", "targets": [0.08, 0.04, 0.02, 0.01]},
+              "photons": 100000, "reference": "exact", "targets": [0.08, 0.04, 0.02, 0.01]},
     "box": {"file": "closed_box.gltf", "resolution": "64x64", "direct": "nee",
-            "reference": "exact", "targets": [0.16, 0.08, 0.04, 0.02]},
-    "cornell": {"file": "cornell.gltf", "resolution": "64x64", "direct": "nee",
-                "reference": CORNELL_REFERENCE, "targets": [0.016, 0.008, 0.004, 0.002]},
+            "photons": 100000, "reference": "exact", "targets": [0.16, 0.08, 0.04, 0.02]},
+    "cornell": {"file": "cornell.gltf", "resolution": "64x64", "direct": "nee", "photons": 250,
+                "reference": CORNELL_REFERENCE, "targets": [0.08, 0.04, 0.02, 0.01]},
 }
+
+# The margin the issue asks of a rendered reference: its mean bound at least this many times
+# below the smallest actual error it judges.
+REFERENCE_MARGIN = 10.0
 
 COLUMNS = ["scene", "confidence", "target", "actual mean error", "specified / actual", "passes",
            "photons", "seconds", "coverage", "stop"]
@@ -108,7 +117,8 @@ def run_one(exe, name, cfg, resolution, confidence, target, ref, runs, limit):
     stem = f"{name}_c{round(100 * confidence)}_t{target:g}"
     exr, log = os.path.join(runs, stem + ".exr"), os.path.join(runs, stem + ".jsonl")
     cmd = [exe, "render", os.path.join(pbtools.REPO, "scenes", cfg["file"]), "-o", exr,
-           "--resolution", resolution, "--direct", cfg["direct"], "--confidence",
+           "--resolution", resolution, "--direct", cfg["direct"], "--photons-per-pass",
+           str(cfg["photons"]), "--confidence",
            f"{confidence:g}", "--target-error", f"{target:g}", "--time", f"{limit:g}", "--seed",
            str(SEED), "--log", log, "--reference", ref, "--quiet"]
     start = time.monotonic()
@@ -128,7 +138,8 @@ def run_one(exe, name, cfg, resolution, confidence, target, ref, runs, limit):
         "wall_seconds": wall,
         "stop": meta["photonbound:stop_reason"],
         "mean_bound": float(meta["photonbound:mean_error_bound"]),
-        "resolution": resolution, "direct": cfg["direct"], "exr": os.path.relpath(exr, runs),
+        "resolution": resolution, "direct": cfg["direct"], "photons_per_pass": cfg["photons"],
+        "exr": os.path.relpath(exr, runs),
         "log": os.path.relpath(log, runs), "compare": c,
     }
     print(f"study: {stem}: {row['passes']} passes, {row['seconds']:.1f} s, actual "
@@ -169,8 +180,21 @@ def table_document(rows, refs, argv, total, version):
                     f"`{os.path.basename(path)}`, mean bound {bound:.3g} at {float(conf):.0%} "
                     f"confidence ({smallest / bound:.1f}x below the smallest actual error here), "
                     f"expected noise error {noise:.2g}")
-        out.append(f"- {s}: {r0['resolution']}, --direct {r0['direct']}; reference: {ref_text}")
+        out.append(f"- {s}: {r0['resolution']}, --direct {r0['direct']}, --photons-per-pass "
+                   f"{r0['photons_per_pass']}; reference: {ref_text}")
+        warning = reference_warning(s, bound, smallest)
+        if warning:
+            out.append(f"  **{warning}**")
     return "\n".join(out) + "\n"
+
+
+def reference_warning(scene, bound, smallest):
+    """Text when a rendered reference is too loose to judge the errors studied, else None."""
+    if bound > 0.0 and smallest < REFERENCE_MARGIN * bound:
+        return (f"{scene}: the reference's mean bound {bound:.3g} is not {REFERENCE_MARGIN:g}x "
+                f"below the smallest actual error {smallest:.3g}: its own error is part of the "
+                "measured errors; render a longer reference (tools/reference.py render)")
+    return None
 
 
 def write_plots(rows, logs, outdir):
@@ -268,6 +292,11 @@ def main():
     doc = table_document(rows, refs, argv, total, version)
     pbtools.write_text(os.path.join(outdir, "table.md"), doc)
     print(doc)
+    for name in names:
+        warning = reference_warning(name, refs[name][1],
+                                    min(r["actual"] for r in rows if r["scene"] == name))
+        if warning:
+            print(f"study: warning: {warning}", file=sys.stderr)
     print(f"study: wrote {outdir}/table.md, results.json, convergence_*.png and views/ in "
           f"{total:.0f} s")
 
