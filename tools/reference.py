@@ -13,7 +13,12 @@ camera, light, reflectance and emission read from the glTF file. The bound chann
 its mean bound, so you can check that it is at least 10x below the errors you study. It uses
 seed 1000003 unless told otherwise: a reference must not share its random numbers with the
 renders it judges (the study uses seed 1). Options after `--` go to `photonbound render`
-(e.g. --radius, --photons-per-pass, --checkpoint-every).
+(e.g. --radius, --photons-per-pass, --alpha, --checkpoint-every).
+
+For a long reference, start from a radius of a fraction of a pixel and keep alpha near 1
+(README "Pictures, plots and references"): the render is then noise-dominated and its bound
+falls like passes^-0.5, where the default radius and alpha give about passes^-0.25 in the
+Cornell box, because the bias at edges shrinks only as fast as the radius.
 """
 
 import argparse
