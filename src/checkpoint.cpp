@@ -158,7 +158,10 @@ class Reader {
 // Every option is stored (the stop conditions too, so `resume` without new ones carries on with
 // the old plan); read_options reads them back in the same order.
 void write_options(Writer& w, const RenderOptions& o) {
-  w.str(o.scene);
+  // The scene as an absolute path: `resume` may run from another working directory.
+  std::error_code ec;
+  const std::filesystem::path scene = std::filesystem::absolute(o.scene, ec);
+  w.str(ec ? o.scene : scene.lexically_normal().string());
   w.str(o.output);
   w.opt_u64(o.passes);
   w.opt_f64(o.time_seconds);

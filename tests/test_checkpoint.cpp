@@ -319,5 +319,23 @@ TEST_F(Checkpoints, SecondSignalLeavesAtOnceAndKeepsTheLastFiles) {
   EXPECT_NO_THROW(read_exr(out));
 }
 
+// A render started with a relative scene path resumes from another working directory: the
+// state keeps the scene's absolute path.
+TEST_F(Checkpoints, ResumeFromAnotherFolderFindsTheScene) {
+  fs::create_directories(dir_ / "a");
+  fs::copy_file(test::scene_path("cornell.gltf"), dir_ / "a" / "cornell.gltf");
+  const test::Outcome first = test::run_photonbound(
+      "render cornell.gltf -o ../r.exr --passes 3 --resolution 16x16 --photons-per-pass 1000 "
+      "--checkpoint-every 1000 --quiet",
+      (dir_ / "a").string());
+  ASSERT_EQ(first.code, 0) << first.err;
+  const SavedRender s = load_state(path("r.pbstate"));
+  EXPECT_TRUE(fs::path(s.options.scene).is_absolute()) << s.options.scene;
+  const test::Outcome second =
+      test::run_photonbound("resume r.pbstate -o r2.exr --passes 5 --quiet", dir_.string());
+  ASSERT_EQ(second.code, 0) << second.err;
+  EXPECT_EQ(meta(read_exr(path("r2.exr")), "passes_done"), "5");
+}
+
 }  // namespace
 }  // namespace pb
