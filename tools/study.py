@@ -52,7 +52,7 @@ CORNELL_REFERENCE = os.path.join(pbtools.REPO, "tools", "study", "cornell_64x64_
 # 100k photons per pass its 64x64 image already has a mean error of 0.005 after the first 16
 # passes, so the studied errors could not lie 10x above any reference this machine can render
 # (the bound of a long PPM render falls like passes^-0.25 to -0.5). With 250 photons per pass the
-# same sweep starts from a 10x rougher image, noise-dominated like a short render of a big scene.
+# same sweep starts from a 5x rougher image, noise-dominated like a short render of a big scene.
 SCENES = {
     "plane": {"file": "plane_point.gltf", "resolution": "64x64", "direct": "photons",
               "photons": 100000, "reference": "exact", "targets": [0.08, 0.04, 0.02, 0.01]},
