@@ -50,8 +50,9 @@ CORNELL_REFERENCE = os.path.join(pbtools.REPO, "tools", "study", "cornell_64x64_
 # minutes on 2 cores. The Cornell box needs more care: a long render is its reference, and the
 # issue asks for that reference's bound to be 10x below the errors studied. With the default
 # 100k photons per pass its 64x64 image already has a mean error of 0.005 after the first 16
-# passes, so the studied errors could not lie 10x above any reference this machine can render
-# (the bound of a long PPM render falls like passes^-0.25 to -0.5). With 250 photons per pass the
+# passes, so a sweep of distinct runs would need a reference hours longer than the 105-minute
+# one shipped (the bound of a long PPM render falls like passes^-0.25 to -0.5; README "The
+# study"). With 250 photons per pass the
 # same sweep starts from a 5x rougher image, noise-dominated like a short render of a big scene.
 SCENES = {
     "plane": {"file": "plane_point.gltf", "resolution": "64x64", "direct": "photons",
