@@ -89,12 +89,15 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
 
   // A checkpoint is the image and the state, each written atomically; the state goes last, so
   // a state file never refers to passes the image does not show.
+  auto save = [&](pb::SavedRender& s) {
+    s.scene_hash = scene_hash;
+    pb::save_state(state_path, s);
+  };
   auto write_outputs = [&](const pb::RenderReport& report, bool with_state) {
     pb::write_exr(options.output, renderer.image(report));
     if (with_state) {
       pb::SavedRender s = renderer.snapshot();
-      s.scene_hash = scene_hash;
-      pb::save_state(state_path, s);
+      save(s);
     }
   };
   pb::CheckpointPolicy checkpoint;
@@ -103,8 +106,7 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
     // On the background thread, from the snapshot (CheckpointPolicy).
     checkpoint.write = [&](const pb::RenderReport& r, pb::SavedRender& saved) {
       pb::write_exr(options.output, renderer.image(r, saved.states), pb::ExrCompression::None);
-      saved.scene_hash = scene_hash;
-      pb::save_state(state_path, saved);
+      save(saved);
     };
   }
 

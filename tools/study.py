@@ -161,7 +161,22 @@ def markdown_table(rows):
     return "\n".join(lines) + "\n"
 
 
-def table_document(rows, refs, argv, total, version):
+def smallest_actual(rows, scene):
+    return min(r["actual"] for r in rows if r["scene"] == scene)
+
+
+def tightest_runs(rows, items):
+    """{(scene, confidence): (target, item)} for each scene's smallest target at each
+    confidence; `items` runs parallel to `rows` (the runs' logs or EXRs)."""
+    tightest = {}
+    for r, item in zip(rows, items):
+        key = (r["scene"], r["confidence"])
+        if key not in tightest or r["target"] < tightest[key][0]:
+            tightest[key] = (r["target"], item)
+    return tightest
+
+
+def table_document(rows, refs, warnings, argv, total, version):
     scenes = list(dict.fromkeys(r["scene"] for r in rows))
     out = ["# photonbound speed-accuracy study", "",
            f"`{' '.join(argv)}`: {total / 60:.1f} minutes on {os.cpu_count()} cores "
@@ -176,16 +191,15 @@ def table_document(rows, refs, argv, total, version):
     for s in scenes:
         r0 = next(r for r in rows if r["scene"] == s)
         path, bound, conf, noise = refs[s]
-        smallest = min(r["actual"] for r in rows if r["scene"] == s)
+        smallest = smallest_actual(rows, s)
         ref_text = ("exact answer" if bound == 0.0 else
                     f"`{os.path.basename(path)}`, mean bound {bound:.3g} at {float(conf):.0%} "
                     f"confidence ({smallest / bound:.1f}x below the smallest actual error here), "
                     f"expected noise error {noise:.2g}")
         out.append(f"- {s}: {r0['resolution']}, --direct {r0['direct']}, --photons-per-pass "
                    f"{r0['photons_per_pass']}; reference: {ref_text}")
-        warning = reference_warning(s, bound, smallest)
-        if warning:
-            out.append(f"  **{warning}**")
+        if warnings.get(s):
+            out.append(f"  **{warnings[s]}**")
     return "\n".join(out) + "\n"
 
 
@@ -200,11 +214,7 @@ def reference_warning(scene, bound, smallest):
 
 def write_plots(rows, logs, outdir):
     plt = pbtools.use_agg()
-    tightest = {}
-    for r, log in zip(rows, logs):
-        key = (r["scene"], r["confidence"])
-        if key not in tightest or r["target"] < tightest[key][0]:
-            tightest[key] = (r["target"], log)
+    tightest = tightest_runs(rows, logs)
     chosen = [(scene, f"{100 * c:g}%", pbtools.read_log(log))
               for (scene, c), (_, log) in sorted(tightest.items(),
                                                  key=lambda kv: (list(SCENES).index(kv[0][0])
@@ -221,12 +231,7 @@ def write_plots(rows, logs, outdir):
 def write_views(plt, rows, exrs, refs, outdir):
     folder = os.path.join(outdir, "views")
     os.makedirs(folder, exist_ok=True)
-    tightest = {}
-    for r, exr in zip(rows, exrs):
-        key = (r["scene"], r["confidence"])
-        if key not in tightest or r["target"] < tightest[key][0]:
-            tightest[key] = (r["target"], exr)
-    for (scene, conf), (target, exr) in tightest.items():
+    for (scene, conf), (target, exr) in tightest_runs(rows, exrs).items():
         img, ref = pbtools.read_exr(exr), pbtools.read_exr(refs[scene][0])
         name = os.path.splitext(os.path.basename(exr))[0]
         label = f"{scene}, target {target:g} at {100 * conf:g}%"
@@ -290,14 +295,13 @@ def main():
     write_views(plt, rows, exrs, refs, outdir)
     total = time.monotonic() - start
     argv = ["tools/study.py"] + sys.argv[1:]
-    doc = table_document(rows, refs, argv, total, version)
+    warnings = {name: reference_warning(name, refs[name][1], smallest_actual(rows, name))
+                for name in names}
+    doc = table_document(rows, refs, warnings, argv, total, version)
     pbtools.write_text(os.path.join(outdir, "table.md"), doc)
     print(doc)
-    for name in names:
-        warning = reference_warning(name, refs[name][1],
-                                    min(r["actual"] for r in rows if r["scene"] == name))
-        if warning:
-            print(f"study: warning: {warning}", file=sys.stderr)
+    for warning in filter(None, warnings.values()):
+        print(f"study: warning: {warning}", file=sys.stderr)
     print(f"study: wrote {outdir}/table.md, results.json, convergence_*.png and views/ in "
           f"{total:.0f} s")
 
