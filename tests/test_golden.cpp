@@ -1,0 +1,64 @@
+// Golden images: every channel of a few small renders, hashed, against checksums stored when
+// the image-forming code last changed on purpose. A refactor must leave them bit for bit; a
+// change of method must say so by updating the checksum here, with the reason in its commit.
+#include "render_fixture.h"
+
+#include <gtest/gtest.h>
+
+
+namespace pb {
+namespace {
+
+struct Golden {
+  const char* name;
+  const char* scene;
+  int size;
+  uint64_t passes;
+  uint64_t photons;
+  DirectMode direct;
+  double alpha;
+  uint64_t checksum;
+};
+
+// Rendered before the architecture change (issue 12), on the code of commit 45c8a0b.
+const Golden kGolden[] = {
+    {"cornell_nee", "cornell.gltf", 24, 5, 4000, DirectMode::NextEvent, 0.7, 0x5ac5b1728eb3f768ULL},
+    {"cornell_photons", "cornell.gltf", 20, 4, 3000, DirectMode::Photons, 0.8, 0x4d430f8daa26a20aULL},
+    {"glass_slab", "glass_slab.gltf", 20, 4, 3000, DirectMode::Photons, 0.7, 0x0a28d536620ea04dULL},
+    {"spot", "spot.gltf", 16, 3, 2000, DirectMode::NextEvent, 0.7, 0xbee0566f1b8f602eULL},
+    {"closed_box", "closed_box.gltf", 16, 4, 2000, DirectMode::NextEvent, 0.9, 0x423fa80618498e40ULL},
+    {"plane", "plane_point.gltf", 16, 4, 2000, DirectMode::Photons, 0.7, 0x9513915a75e21423ULL},
+};
+
+uint64_t checksum_of(const Golden& g) {
+  RenderOptions o = test::quick_options(g.scene, g.size, g.passes);
+  o.photons_per_pass = g.photons;
+  o.direct = g.direct;
+  o.alpha = g.alpha;
+  const Scene scene = load_gltf(o.scene);
+  Renderer r(scene, o);
+  for (uint64_t p = 0; p < g.passes; ++p) r.step();
+  RenderReport report;
+  report.passes = r.passes();
+  const ExrImage img = r.image(report);
+  // FNV-1a 64 over the channel names and every float of every pixel: the test's own hash, so
+  // that no change to the project's checksums can move it.
+  uint64_t h = 0xcbf29ce484222325ULL;
+  auto add = [&](const void* p, size_t n) {
+    const unsigned char* b = static_cast<const unsigned char*>(p);
+    for (size_t i = 0; i < n; ++i) h = (h ^ b[i]) * 0x100000001b3ULL;
+  };
+  for (const std::string& c : img.channels) add(c.data(), c.size() + 1);
+  add(img.pixels.data(), img.pixels.size() * sizeof(float));
+  return h;
+}
+
+TEST(Golden, ImagesAreBitIdenticalToTheStoredChecksums) {
+  for (const Golden& g : kGolden) {
+    const uint64_t h = checksum_of(g);
+    EXPECT_EQ(h, g.checksum) << g.name;
+  }
+}
+
+}  // namespace
+}  // namespace pb
