@@ -1,5 +1,7 @@
 #include "photonbound/compare.h"
 
+#include "photonbound/channels.h"
+
 #include <cmath>
 #include <sstream>
 
@@ -21,14 +23,13 @@ CompareResult compare_images(const ExrImage& a, const ExrImage& ref, const std::
     throw ImageError(a_name + " is " + std::to_string(a.width) + "x" + std::to_string(a.height) +
                      " but " + ref_name + " is " + std::to_string(ref.width) + "x" +
                      std::to_string(ref.height) + ": images of different sizes cannot be compared");
-  const char* rgb[3] = {"R", "G", "B"};
   int l[3], lr[3], eb[3], bias[3], noise[3];
   for (int c = 0; c < 3; ++c) {
-    l[c] = require(a, rgb[c], a_name);
-    lr[c] = require(ref, rgb[c], ref_name);
-    eb[c] = require(a, std::string("ErrorBound.") + rgb[c], a_name);
-    bias[c] = require(a, std::string("Bias.") + rgb[c], a_name);
-    noise[c] = require(a, std::string("Noise.") + rgb[c], a_name);
+    l[c] = require(a, channel_name(Channel::Radiance, c), a_name);
+    lr[c] = require(ref, channel_name(Channel::Radiance, c), ref_name);
+    eb[c] = require(a, channel_name(Channel::ErrorBound, c), a_name);
+    bias[c] = require(a, channel_name(Channel::Bias, c), a_name);
+    noise[c] = require(a, channel_name(Channel::Noise, c), a_name);
   }
   CompareResult r;
   r.width = a.width;

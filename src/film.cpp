@@ -38,6 +38,26 @@ PixelResult combine(const EyePassResult& eye, const std::vector<PointState>& sta
 
 }  // namespace
 
+const std::vector<float>& FilmImage::plane(Channel id) const {
+  switch (id) {
+    case Channel::Radiance:
+      return radiance;
+    case Channel::ErrorBound:
+      return bound;
+    case Channel::Bias:
+      return bias;
+    case Channel::Noise:
+      return noise;
+    case Channel::Variance:
+      return variance;
+    case Channel::Photons:
+      return photons;
+    case Channel::Radius:
+      return radius;
+  }
+  return radiance;
+}
+
 FilmSummary develop(const EyePassResult& eye, const std::vector<PointState>& states,
                     uint64_t passes, const FilmSettings& s, FilmImage* image) {
   const size_t pixels = size_t(eye.width) * size_t(eye.height);

@@ -1,5 +1,6 @@
 // photonbound command-line entry point. The only catch-all: maps failures to exit codes
 // (0 done, 1 runtime failure or bad input file, 2 bad usage).
+#include "photonbound/channels.h"
 #include "photonbound/checkpoint.h"
 #include "photonbound/compare.h"
 #include "photonbound/gltf_loader.h"
@@ -163,7 +164,9 @@ int compare(const pb::CompareOptions& o) {
 // sRGB-encoded PNG of the radiance channels, for quick looks and the README.
 int preview(const pb::PreviewOptions& o) {
   const pb::ExrImage in = pb::read_exr(o.input);
-  const int r = in.channel_index("R"), g = in.channel_index("G"), b = in.channel_index("B");
+  const int r = in.channel_index(pb::channel_name(pb::Channel::Radiance, 0));
+  const int g = in.channel_index(pb::channel_name(pb::Channel::Radiance, 1));
+  const int b = in.channel_index(pb::channel_name(pb::Channel::Radiance, 2));
   if (r < 0 || g < 0 || b < 0) throw pb::ImageError(o.input + ": has no R, G, B channels");
   const double scale = std::exp2(o.exposure);
   const size_t pixels = size_t(in.width) * size_t(in.height), nc = in.channels.size();

@@ -1,34 +1,25 @@
 // Renderer::image: the EXR layout (README "Output") and its metadata.
 #include "photonbound/renderer.h"
 
+#include "photonbound/channels.h"
+
 namespace pb {
 
 ExrImage pack_channels(const FilmImage& film) {
   ExrImage out;
   out.width = film.width;
   out.height = film.height;
-  // Each RGB quantity becomes three channels "<Name>.R/G/B"; radiance is plain R, G, B.
-  const std::vector<std::pair<std::string, const std::vector<float>*>> rgb = {
-      {"", &film.radiance},
-      {"ErrorBound.", &film.bound},
-      {"Bias.", &film.bias},
-      {"Noise.", &film.noise},
-      {"Variance.", &film.variance}};
-  for (const auto& [prefix, data] : rgb)
-    for (const char* c : {"R", "G", "B"}) out.channels.push_back(prefix + c);
-  out.channels.push_back("Photons");
-  out.channels.push_back("Radius");
-
+  out.channels = channel_names();
   const size_t pixels = size_t(film.width) * size_t(film.height);
   const size_t nc = out.channels.size();
   out.pixels.resize(pixels * nc);
-  for (size_t p = 0; p < pixels; ++p) {
-    float* dst = &out.pixels[p * nc];
-    size_t c = 0;
-    for (const auto& entry : rgb)
-      for (int k = 0; k < 3; ++k) dst[c++] = (*entry.second)[3 * p + k];
-    dst[c++] = film.photons[p];
-    dst[c++] = film.radius[p];
+  size_t first = 0;  // first channel of the group
+  for (const ChannelGroup& g : kChannelGroups) {
+    const std::vector<float>& plane = film.plane(g.id);
+    const size_t n = g.kind == ChannelKind::RGB ? 3 : 1;
+    for (size_t p = 0; p < pixels; ++p)
+      for (size_t k = 0; k < n; ++k) out.pixels[p * nc + first + k] = plane[n * p + k];
+    first += n;
   }
   return out;
 }

@@ -5,7 +5,6 @@
 
 #include <gtest/gtest.h>
 
-
 namespace pb {
 namespace {
 
@@ -23,10 +22,12 @@ struct Golden {
 // Rendered before the architecture change (issue 12), on the code of commit 45c8a0b.
 const Golden kGolden[] = {
     {"cornell_nee", "cornell.gltf", 24, 5, 4000, DirectMode::NextEvent, 0.7, 0x5ac5b1728eb3f768ULL},
-    {"cornell_photons", "cornell.gltf", 20, 4, 3000, DirectMode::Photons, 0.8, 0x4d430f8daa26a20aULL},
+    {"cornell_photons", "cornell.gltf", 20, 4, 3000, DirectMode::Photons, 0.8,
+     0x4d430f8daa26a20aULL},
     {"glass_slab", "glass_slab.gltf", 20, 4, 3000, DirectMode::Photons, 0.7, 0x0a28d536620ea04dULL},
     {"spot", "spot.gltf", 16, 3, 2000, DirectMode::NextEvent, 0.7, 0xbee0566f1b8f602eULL},
-    {"closed_box", "closed_box.gltf", 16, 4, 2000, DirectMode::NextEvent, 0.9, 0x423fa80618498e40ULL},
+    {"closed_box", "closed_box.gltf", 16, 4, 2000, DirectMode::NextEvent, 0.9,
+     0x423fa80618498e40ULL},
     {"plane", "plane_point.gltf", 16, 4, 2000, DirectMode::Photons, 0.7, 0x9513915a75e21423ULL},
 };
 

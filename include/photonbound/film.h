@@ -1,6 +1,7 @@
 // Per-pixel radiance and error bounds from the per-point statistics (ESTIMATOR.md sections 5-7).
 #pragma once
 
+#include "photonbound/channels.h"
 #include "photonbound/estimator.h"
 #include "photonbound/eye_pass.h"
 #include "photonbound/options.h"
@@ -21,6 +22,9 @@ struct FilmImage {
   std::vector<float> variance;  // Var_pix: variance of the mean
   std::vector<float> photons;   // photons gathered by the pixel's points
   std::vector<float> radius;    // current radius of the pixel's first point (0 if none)
+
+  // The plane of an EXR channel group (channels.def): 3 floats per pixel for RGB groups.
+  const std::vector<float>& plane(Channel id) const;
 };
 
 struct FilmSummary {
