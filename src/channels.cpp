@@ -12,7 +12,8 @@ std::string channel_name(Channel id, int component) {
 std::vector<std::string> channel_names() {
   std::vector<std::string> names;
   for (const ChannelGroup& g : kChannelGroups)
-    for (int c = 0; c < (g.kind == ChannelKind::RGB ? 3 : 1); ++c) names.push_back(channel_name(g.id, c));
+    for (int c = 0; c < (g.kind == ChannelKind::RGB ? 3 : 1); ++c)
+      names.push_back(channel_name(g.id, c));
   return names;
 }
 

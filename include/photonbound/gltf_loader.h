@@ -1,5 +1,5 @@
 // Loads the glTF 2.0 subset photonbound renders (README "Scenes") into plain Scene data.
-// The only file that sees tinygltf types is src/gltf_loader.cpp.
+// Only the loader's own files (src/gltf_*.cpp) see tinygltf types.
 #pragma once
 
 #include "photonbound/scene.h"

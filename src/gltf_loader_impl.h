@@ -1,0 +1,69 @@
+// The glTF loader's internals, shared by its translation units (src/gltf_loader.cpp: parsing,
+// the node walk and the final checks; src/gltf_geometry.cpp: accessors and primitives;
+// src/gltf_material.cpp: materials, lights and cameras). Only these files see tinygltf types.
+#pragma once
+
+#include "photonbound/gltf_loader.h"
+
+#include "gltf_support.h"
+
+#include <tiny_gltf.h>
+
+#include <cstdint>
+#include <initializer_list>
+#include <limits>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace pb::gltf {
+
+using glm::dmat3;
+using glm::dmat4;
+
+inline constexpr double kMaxCoordinate = 1e10;  // |world coordinate| limit
+inline constexpr int kMaxDepth = 1000;          // node hierarchy depth limit
+
+inline bool fits_float(double v) {
+  return std::abs(v) <= double(std::numeric_limits<float>::max());
+}
+
+class Loader {
+ public:
+  Loader(const std::string& file, const tinygltf::Model& model) : file_(file), m_(model) {}
+  Scene run(const std::vector<std::string>& parse_warnings);
+
+ private:
+  [[noreturn]] void fail(const std::string& what) const {
+    throw SceneError(file_ + ": " + one_line(what));
+  }
+  void warn(const std::string& w) {
+    if (warned_.insert(w).second) scene_.warnings.push_back(w);
+  }
+  void check_extensions();
+  void walk(int root, const std::string& from);
+  void visit(const tinygltf::Node& n, const std::string& nl, const Xform& xf);
+  dmat4 local_matrix(const tinygltf::Node& n, const std::string& nl) const;
+  View accessor(int index, const std::string& ctx, std::initializer_list<int> components,
+                int type) const;
+  void add_primitive(size_t mesh, size_t prim, const Xform& xf);
+  uint32_t material(int index, const std::string& where);
+  Material convert_material(size_t index);
+  double ext_number(const tinygltf::ExtensionMap& ext, const std::string& owner, const char* name,
+                    const char* key, double fallback) const;
+  void add_light(const tinygltf::Node& n, const std::string& nl, const Xform& xf);
+  void add_camera(int index, const std::string& nl, const Xform& xf);
+  vec3 origin(const Xform& xf, const std::string& nl) const;
+  void finish();
+
+  const std::string& file_;
+  const tinygltf::Model& m_;
+  Scene scene_;
+  std::set<std::string> warned_;
+  std::vector<char> visited_;
+  std::vector<int64_t> material_slot_;  // glTF material -> Scene::materials index, -1 unused
+  int64_t default_material_ = -1;
+};
+
+
+}  // namespace pb::gltf
