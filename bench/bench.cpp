@@ -3,9 +3,11 @@
 // figure and holds this machine's output. Timings are printed, never asserted.
 #include "bench.h"
 
-#include "photonbound/gather.h"
+#include "photonbound/checkpoint_writer.h"
+#include "photonbound/driver.h"
 #include "photonbound/gltf_loader.h"
 #include "photonbound/parallel.h"
+#include "photonbound/pass_stages.h"
 #include "photonbound/renderer.h"
 
 #include <unistd.h>
@@ -166,13 +168,11 @@ void checkpoint_cost(const std::string& path, int passes) {
   const double pass = median(plain), snap_pass = median(snap);
 
   // The background job, timed here in the foreground, each part a median of 3.
-  pb::RenderReport report;
-  report.passes = r.passes();
-  pb::SavedRender saved = r.snapshot();
+  const pb::SavedRender saved{o, 0, r.snapshot(), pb::DriverState{}};
   std::vector<double> develop, exr, state;
   for (int k = 0; k < 3; ++k) {
     double t = now();
-    const pb::ExrImage image = r.image(report, saved.states);
+    const pb::ExrImage image = r.image(pb::RunInfo{}, saved.render);
     develop.push_back(seconds_since(t));
     t = now();
     pb::write_exr(o.output, image, pb::ExrCompression::None);
@@ -186,25 +186,28 @@ void checkpoint_cost(const std::string& path, int passes) {
   const double exr_mb = double(std::filesystem::file_size(o.output)) / 1e6;
 
   // The whole loop: a checkpoint whenever the writer is idle, against none, same pass count.
-  auto loop_seconds = [&](bool checkpoints, pb::PhaseTimings* timings) {
+  struct CheckpointStats {
+    uint64_t checkpoints = 0;
+    double checkpoint_stall = 0.0;
+  };
+  auto loop_seconds = [&](bool checkpoints, CheckpointStats* stats) {
     pb::RenderOptions lo = o;
     lo.passes = uint64_t(4 * passes);
     pb::Renderer lr(scene, lo);
-    pb::CheckpointPolicy policy;
-    if (checkpoints) {
-      policy.every = 1e-9;
-      policy.write = [&](const pb::RenderReport& rep, pb::SavedRender& s) {
-        pb::write_exr(lo.output, lr.image(rep, s.states), pb::ExrCompression::None);
-        pb::save_state((dir / "loop.pbstate").string(), s);
-      };
-    }
+    pb::CheckpointWriter writer(1e-9, lo, 0, [&](const pb::SavedRender& s) {
+      pb::write_exr(lo.output, lr.image({s.schedule.seconds, ""}, s.render),
+                    pb::ExrCompression::None);
+      pb::save_state((dir / "loop.pbstate").string(), s);
+    });
+    std::vector<pb::PassObserver*> observers;
+    if (checkpoints) observers.push_back(&writer);
     const double t = now();
-    lr.run(nullptr, nullptr, policy);
+    pb::Driver(lr).run(nullptr, observers);
     const double seconds = seconds_since(t);
-    if (timings) *timings = lr.timings();
+    if (stats) *stats = {writer.checkpoints(), writer.stall_seconds()};
     return seconds;
   };
-  pb::PhaseTimings with;
+  CheckpointStats with;
   const double off = loop_seconds(false, nullptr), on = loop_seconds(true, &with);
   std::filesystem::remove_all(dir);
 

@@ -4,8 +4,8 @@
 #include "plain.h"
 
 #include "photonbound/camera.h"
-#include "photonbound/gather.h"
 #include "photonbound/parallel.h"
+#include "photonbound/pass_stages.h"
 #include "photonbound/rng.h"
 
 #include <algorithm>

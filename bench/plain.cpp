@@ -1,7 +1,7 @@
 #include "plain.h"
 
-#include "photonbound/gather.h"
 #include "photonbound/kernel.h"
+#include "photonbound/pass_stages.h"
 
 #include <algorithm>
 #include <cmath>

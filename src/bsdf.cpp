@@ -57,12 +57,6 @@ float adjoint_shading_factor(const vec3& wo, const vec3& wi, const vec3& ng, con
   return std::fabs(glm::dot(wo, ns)) * std::fabs(glm::dot(wi, ng)) / den;
 }
 
-}  // namespace pb
-
-#include "photonbound/surface.h"
-
-namespace pb {
-
 namespace {
 
 // Shading normals make tessellated spheres look smooth, but a direction computed from ns can
@@ -74,16 +68,70 @@ vec3 reflect_checked(const vec3& wo, const vec3& ns, const vec3& ng) {
 
 }  // namespace
 
-int specular_branches(const Material& m, const Surface& s, const vec3& wo, Transport mode,
-                      SpecularBranch out[2]) {
-  const bool front = glm::dot(wo, s.ng) > 0.0f;
-  const vec3 ng = front ? s.ng : -s.ng;  // normals on wo's side
-  const vec3 ns = front ? s.ns : -s.ns;
-  if (m.model == Reflection::Mirror) {
-    out[0] = {reflect_checked(wo, ns, ng), m.base_color};
+Bsdf::Bsdf(const Material& m, const vec3& ng, const vec3& ns)
+    : model_(m.model), color_(m.base_color), ior_(m.ior), ng_(ng), ns_(ns) {}
+
+vec3 Bsdf::eval(const vec3& wo, const vec3& wi) const {
+  if (is_delta()) return vec3(0.0f);
+  // Both directions on one side of the true surface: reflection only.
+  if (glm::dot(wo, ng_) * glm::dot(wi, ng_) <= 0.0f) return vec3(0.0f);
+  return diffuse_f();
+}
+
+float Bsdf::pdf(const vec3& wo, const vec3& wi) const {
+  if (is_delta()) return 0.0f;
+  const vec3 ns = glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_;
+  if (glm::dot(wo, ng_) * glm::dot(wi, ng_) <= 0.0f) return 0.0f;
+  return std::max(0.0f, glm::dot(wi, ns)) / kPi;  // cosine-weighted about the shading normal
+}
+
+bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const {
+  const bool front = glm::dot(wo, ng_) > 0.0f;
+  const vec3 ng = front ? ng_ : -ng_;
+  const vec3 ns = front ? ns_ : -ns_;
+  if (!is_delta()) {
+    // Drawn in this order: the arguments of an earlier call, which GCC evaluated right to left
+    // (images stay bit-identical; the order is now explicit for every compiler).
+    const float u2 = rng.next_float(), u1 = rng.next_float();
+    out.wi = sample_cosine_hemisphere(ns, u1, u2);
+    if (glm::dot(out.wi, ng) <= 0.0f) return false;  // below the true surface: absorbed
+    // Cosine sampling cancels f cos / pdf to rho.
+    out.weight = color_;
+    out.pdf = glm::dot(out.wi, ns) / kPi;
+    out.delta = false;
+    return true;
+  }
+  SpecularBranch b[2];
+  const int n = delta_branches(wo, mode, b);
+  int pick = 0;
+  float p = 1.0f;
+  if (n == 2) {
+    // Reflection or refraction in proportion to their throughput.
+    const float a0 = average(b[0].weight), a1 = average(b[1].weight);
+    p = a0 / (a0 + a1);
+    if (rng.next_float() >= p) {
+      pick = 1;
+      p = 1.0f - p;
+    }
+  }
+  if (!(p > 0.0f)) return false;
+  out.wi = b[pick].dir;
+  out.weight = b[pick].weight / p;
+  out.pdf = 0.0f;
+  out.delta = true;
+  return true;
+}
+
+int Bsdf::delta_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) const {
+  const bool front = glm::dot(wo, ng_) > 0.0f;
+  const vec3 ng = front ? ng_ : -ng_;  // normals on wo's side
+  const vec3 ns = front ? ns_ : -ns_;
+  if (model_ == Reflection::Mirror) {
+    out[0] = {reflect_checked(wo, ns, ng), color_};
     return 1;
   }
-  const float eta = front ? m.ior : 1.0f / m.ior;  // eta_t / eta_i
+  if (model_ != Reflection::Dielectric) return 0;
+  const float eta = front ? ior_ : 1.0f / ior_;  // eta_t / eta_i
   const float cos_i = std::fabs(glm::dot(wo, ns));
   const float f = fresnel_dielectric(cos_i, eta);
   out[0] = {reflect_checked(wo, ns, ng), vec3(f)};
@@ -97,7 +145,7 @@ int specular_branches(const Material& m, const Surface& s, const vec3& wo, Trans
     }
   }
   const float scale = mode == Transport::Radiance ? 1.0f / (eta * eta) : 1.0f;
-  out[1] = {wt, m.base_color * ((1.0f - f) * scale)};
+  out[1] = {wt, color_ * ((1.0f - f) * scale)};
   return 2;
 }
 

@@ -4,7 +4,6 @@
 #include "photonbound/parallel.h"
 
 #include <algorithm>
-#include <atomic>
 
 namespace pb {
 
@@ -21,7 +20,6 @@ struct PixelOutput {
   std::vector<MeasurementPoint> points;
   std::vector<float> footprints;  // one per point
   dvec3 emission{0.0};
-  uint64_t truncated = 0;
 };
 
 // Follows every branch of one pixel's camera path. The tree has at most 2^max_depth leaves;
@@ -43,25 +41,22 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
     // Emission seen along the chain is exact for this ray (one-sided: front side only).
     if (m.emits() && glm::dot(wo, s.ng) > 0.0f) out.emission += dvec3(v.weight * m.emission);
     const float length = v.length + hit.t;
-    if (m.model == Reflection::Lambertian) {
+    if (!s.bsdf.is_delta()) {
       const bool front = glm::dot(wo, s.ng) > 0.0f;
       MeasurementPoint p;
       p.position = s.position;
       p.normal = front ? s.ng : -s.ng;
       p.shading = front ? s.ns : -s.ns;
-      p.f = v.weight * lambertian(m.base_color);
+      p.f = v.weight * s.bsdf.diffuse_f();
       if (max_component(p.f) > 0.0f) {
         out.points.push_back(p);
         out.footprints.push_back(length * camera.pixel_angle());
       }
       continue;
     }
-    if (v.depth >= max_depth) {
-      ++out.truncated;
-      continue;
-    }
+    if (v.depth >= max_depth) continue;  // the chain is cut
     SpecularBranch branches[2];
-    const int n = specular_branches(m, s, wo, Transport::Radiance, branches);
+    const int n = s.bsdf.delta_branches(wo, Transport::Radiance, branches);
     for (int k = 0; k < n; ++k) {
       const vec3 w = v.weight * branches[k].weight;
       if (max_component(w) <= 0.0f || top >= 64) continue;
@@ -83,7 +78,6 @@ EyePassResult run_eye_pass(const World& world, const PinholeCamera& camera, int 
   std::vector<std::vector<MeasurementPoint>> rows(size_t(r.height));
   std::vector<std::vector<float>> row_footprints(size_t(r.height));
   r.pixel_begin.assign(pixels + 1, 0);
-  std::atomic<uint64_t> truncated{0};
   parallel_for(size_t(r.height), 1, [&](size_t begin, size_t end) {
     PixelOutput out;
     for (size_t y = begin; y < end; ++y) {
@@ -100,9 +94,7 @@ EyePassResult run_eye_pass(const World& world, const PinholeCamera& camera, int 
       rows[y] = out.points;
       row_footprints[y] = out.footprints;
     }
-    truncated += out.truncated;
   });
-  r.truncated_paths = truncated.load();
 
   size_t total = 0;
   for (const auto& row : rows) total += row.size();

@@ -22,6 +22,9 @@
 //  named "default" with base_color 0.8 (one warning).
 #include "gltf_loader_impl.h"
 
+#include "photonbound/file_io.h"
+#include "photonbound/lights.h"
+
 #include <algorithm>
 #include <climits>
 #include <cstring>
@@ -187,22 +190,9 @@ void Loader::finish() {
   for (const PunctualLight& l : scene_.lights) lit |= max_component(l.intensity) > 0.0f;
   for (const Mesh& m : scene_.meshes) lit |= scene_.materials[m.material].emits();
   if (!lit) fail("no light: the scene has no punctual light and no emissive triangles");
-  // Photon flux is carried in float: the total emitted power (4 pi I per point light, an upper
-  // bound for a spot; pi A Le per emissive triangle, summed over the channels) must fit, or the
-  // light distribution overflows later with no file to name.
-  double power = 0.0;
-  for (const PunctualLight& l : scene_.lights)
-    power += 4.0 * kPiD * (double(l.intensity.x) + l.intensity.y + l.intensity.z);
-  for (const Mesh& m : scene_.meshes) {
-    const vec3 le = scene_.materials[m.material].emission;
-    if (!scene_.materials[m.material].emits()) continue;
-    for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
-      const dvec3 p0(m.positions[m.indices[t]]);
-      const double area = 0.5 * glm::length(glm::cross(dvec3(m.positions[m.indices[t + 1]]) - p0,
-                                                       dvec3(m.positions[m.indices[t + 2]]) - p0));
-      power += kPiD * area * (double(le.x) + le.y + le.z);
-    }
-  }
+  // Photon flux is carried in float: the total emitted power must fit, or the light
+  // distribution overflows later with no file to name.
+  const double power = total_emitted_power(scene_);
   if (!(power <= double(std::numeric_limits<float>::max())))
     fail("the lights emit " + num(power) +
          " W in total, beyond the float range (3.4e+38) photon power is carried in");
@@ -218,7 +208,14 @@ Scene load_gltf(const std::string& path) { return load_gltf_bytes(path, gltf::re
 Scene load_gltf_bytes(const std::string& path, const std::vector<unsigned char>& bytes) {
   std::vector<std::string> warnings;
   const tinygltf::Model model = gltf::parse(path, bytes, warnings);
-  return gltf::Loader(path, model).run(warnings);
+  Scene scene = gltf::Loader(path, model).run(warnings);
+  uint64_t total = bytes.size();
+  for (const tinygltf::Buffer& b : model.buffers) total += b.data.size();
+  Checksum hash(total);
+  hash.add(bytes.data(), bytes.size());
+  for (const tinygltf::Buffer& b : model.buffers) hash.add(b.data.data(), b.data.size());
+  scene.content_hash = hash.finish();
+  return scene;
 }
 
 }  // namespace pb

@@ -65,5 +65,4 @@ class Loader {
   int64_t default_material_ = -1;
 };
 
-
 }  // namespace pb::gltf

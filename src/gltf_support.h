@@ -4,6 +4,7 @@
 #pragma once
 
 #include "photonbound/math.h"
+#include "photonbound/text.h"
 
 #include <cstdint>
 #include <cstring>
@@ -12,10 +13,7 @@
 
 namespace pb::gltf {
 
-// Trimmed lines; control characters and invalid UTF-8 (quoted from a hostile file) become ?.
-std::vector<std::string> nonempty_lines(const std::string& s);
-std::string one_line(const std::string& s);  // folds the lines of s into "a; b"
-std::string num(double v);                   // shortest readable form: 1.5, 1e+12
+std::string num(double v);  // shortest readable form: 1.5, 1e+12
 // "mesh 'name'" when named, "mesh 3" otherwise.
 std::string label(const char* kind, const std::string& name, size_t index);
 // "<kind> <index>, which does not exist (the file has <count> <kind>s)"

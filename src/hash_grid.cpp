@@ -12,6 +12,7 @@
 // photon, kept for the next build.
 #include "photonbound/hash_grid.h"
 
+#include "photonbound/counting_sort.h"
 #include "photonbound/parallel.h"
 
 #include <limits>
@@ -35,7 +36,7 @@ int table_bits(size_t n) {
 }
 
 constexpr int kSuperBits = 8;         // round 1 fans out into at most 2^8 super-buckets
-constexpr size_t kBlocks = 16;        // round 1's fixed input blocks (thread-count independent)
+constexpr size_t kBlocks = 16;        // fixed blocks of the validation scans
 constexpr size_t kHashGrain = 16384;  // photons per parallel hashing task
 
 }  // namespace
@@ -55,39 +56,15 @@ void HashGrid::build_level(Level& lv, std::span<const vec3> positions, int bits)
   const int super_bits = std::min(kSuperBits, bits);
   const int super_shift = bits - super_bits;
   const size_t supers = size_t(1) << super_bits;
-  const size_t block = (n + kBlocks - 1) / kBlocks;
-  histogram_.assign(kBlocks * supers, 0);
-  parallel_for(kBlocks, 1, [&](size_t b0, size_t b1) {
-    for (size_t b = b0; b < b1; ++b) {
-      uint32_t* h = histogram_.data() + b * supers;
-      for (size_t i = b * block; i < std::min(n, (b + 1) * block); ++i)
-        ++h[buckets_[i] >> super_shift];
-    }
-  });
-  super_start_.resize(supers + 1);
-  uint32_t sum = 0;
-  for (size_t s = 0; s < supers; ++s) {
-    super_start_[s] = sum;
-    for (size_t b = 0; b < kBlocks; ++b) {
-      uint32_t& c = histogram_[b * supers + s];
-      const uint32_t count = c;
-      c = sum;
-      sum += count;
-    }
-  }
-  super_start_[supers] = sum;
   staged_.resize(n);
   staged_buckets_.resize(n);
-  parallel_for(kBlocks, 1, [&](size_t b0, size_t b1) {
-    for (size_t b = b0; b < b1; ++b) {
-      uint32_t* h = histogram_.data() + b * supers;
-      for (size_t i = b * block; i < std::min(n, (b + 1) * block); ++i) {
-        const uint32_t slot = h[buckets_[i] >> super_shift]++;
+  stable_counting_sort(
+      n, supers, [&](size_t i) { return size_t(buckets_[i] >> super_shift); },
+      [&](size_t i, uint32_t slot) {
         staged_[slot] = Entry{positions[i], uint32_t(i)};
         staged_buckets_[slot] = buckets_[i];
-      }
-    }
-  });
+      },
+      histogram_, &super_start_);
 
   // Round 2: per super-bucket, a counting sort over its slice of the table: count, inclusive
   // prefix (start[h] = end of bucket h), then scatter in descending photon index with --start[h],

@@ -18,6 +18,12 @@ float spot_attenuation(const PunctualLight& l, float cos_angle) {
   return t * t;
 }
 
+// Receivers closer to a triangle's centroid than this many times its longest edge from vertex 0
+// (squared) sample it by solid angle.
+constexpr float kNearFactor2 = 4.0f * 4.0f;
+
+}  // namespace
+
 // Power of a punctual light: integral of intensity times attenuation over the sphere.
 // Spot: 2 pi I (integral over cos from cos_outer to 1 of the attenuation)
 //     = 2 pi I ((cos_inner - cos_outer) / 3 + (1 - cos_inner)) for the squared linear ramp.
@@ -27,11 +33,26 @@ vec3 punctual_power(const PunctualLight& l) {
   return 2.0f * kPi * l.intensity * (span / 3.0f + (1.0f - l.cos_inner));
 }
 
-// Receivers closer to a triangle's centroid than this many times its longest edge from vertex 0
-// (squared) sample it by solid angle.
-constexpr float kNearFactor2 = 4.0f * 4.0f;
-
-}  // namespace
+double total_emitted_power(const Scene& scene) {
+  double power = 0.0;
+  for (const PunctualLight& l : scene.lights) {
+    const vec3 p = punctual_power(l);
+    power += double(p.x) + p.y + p.z;
+  }
+  for (const Mesh& m : scene.meshes) {
+    const Material& mat = scene.materials[m.material];
+    if (!mat.emits()) continue;
+    const dvec3 le(mat.emission);
+    for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
+      const dvec3 p0(m.positions[m.indices[t]]);
+      const double area = 0.5 * glm::length(glm::cross(dvec3(m.positions[m.indices[t + 1]]) - p0,
+                                                       dvec3(m.positions[m.indices[t + 2]]) - p0));
+      const dvec3 p = lambertian_emitter_power(area, le);
+      power += p.x + p.y + p.z;
+    }
+  }
+  return power;
+}
 
 bool sample_spherical_triangle(const vec3& v0, const vec3& v1, const vec3& v2, const vec3& p,
                                float u0, float u1, vec3& dir, float& solid_angle) {
@@ -103,8 +124,7 @@ Lights::Lights(const Scene& scene) : punctual_(scene.lights) {
     weights.push_back(double(power.x) + power.y + power.z);
   };
   for (const PunctualLight& l : punctual_) add(punctual_power(l));
-  // A one-sided Lambertian emitter of radiance Le and area A emits pi A Le.
-  for (const Triangle& t : triangles_) add(kPi * t.area * t.radiance);
+  for (const Triangle& t : triangles_) add(lambertian_emitter_power(t.area, t.radiance));
 
   double sum = 0.0;
   for (double w : weights) sum += w;
@@ -158,7 +178,10 @@ EmittedPhoton Lights::sample_photon(Rng& rng) const {
   const float b1 = 1.0f - s, b2 = u2 * s;
   ph.origin = t.p0 + b1 * t.e1 + b2 * t.e2;
   ph.normal = t.normal;
-  ph.dir = sample_cosine_hemisphere(t.normal, rng.next_float(), rng.next_float());
+  // Drawn in this order: the arguments of an earlier call, which GCC evaluated right to left
+  // (images stay bit-identical; the order is now explicit for every compiler).
+  const float v2 = rng.next_float(), v1 = rng.next_float();
+  ph.dir = sample_cosine_hemisphere(t.normal, v1, v2);
   // Cosine-weighted direction and uniform area: flux = Le cos / (pdf_A pdf_w) = pi A Le.
   ph.flux = t.radiance * (kPi * t.area) / p_pick;
   return ph;

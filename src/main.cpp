@@ -2,11 +2,15 @@
 // (0 done, 1 runtime failure or bad input file, 2 bad usage).
 #include "photonbound/channels.h"
 #include "photonbound/checkpoint.h"
+#include "photonbound/checkpoint_writer.h"
 #include "photonbound/compare.h"
+#include "photonbound/driver.h"
+#include "photonbound/file_io.h"
 #include "photonbound/gltf_loader.h"
 #include "photonbound/image_io.h"
 #include "photonbound/options.h"
 #include "photonbound/parallel.h"
+#include "photonbound/progress.h"
 #include "photonbound/renderer.h"
 
 #include <unistd.h>
@@ -39,10 +43,10 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   pb::check_writable(options.output);  // fail before hours of rendering, not after
   const bool keep_state = options.checkpoint_every || !options.state_path.empty();
   const std::string state_path = pb::state_path_for(options);
-  const pb::Scene scene = pb::load_gltf(options.scene);
+  pb::Scene scene = pb::load_gltf(options.scene);
   for (const std::string& w : scene.warnings)
     std::cerr << "photonbound: warning: " << options.scene << ": " << w << "\n";
-  const uint64_t scene_hash = pb::hash_file(options.scene);
+  const uint64_t scene_hash = scene.content_hash;
   if (saved) {
     const std::vector<std::string> diff = pb::differences(*saved, options, scene_hash);
     if (!diff.empty()) {
@@ -67,8 +71,8 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
               << " is at or below 2/3: the Laplacian (bias) estimate does not converge and the "
                  "error bounds are unreliable\n";
   pb::ThreadLimit threads(options.threads);
-  pb::Renderer renderer(scene, options);
-  if (saved) renderer.restore(*saved);
+  pb::Renderer renderer(std::move(scene), options);
+  if (saved) renderer.restore(saved->render);
   // The bias term models the radiance as smooth (second order) within the radius. A radius of
   // the scene's size breaks that (the extremes suite measured a bound of 0.128 against an error
   // of ~1 at R = scene size), so say so rather than report a bound that cannot be trusted.
@@ -84,46 +88,38 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
                          std::to_string(reference.height) + " but the render is " +
                          std::to_string(renderer.eye().width) + "x" +
                          std::to_string(renderer.eye().height));
-  pb::PassLog log;
-  if (log_file.is_open()) log.out = &log_file;
-  if (!options.reference_path.empty()) log.reference = &reference;
 
   // A checkpoint is the image and the state, each written atomically; the state goes last, so
   // a state file never refers to passes the image does not show.
-  auto save = [&](pb::SavedRender& s) {
-    s.scene_hash = scene_hash;
-    pb::save_state(state_path, s);
-  };
-  auto write_outputs = [&](const pb::RenderReport& report, bool with_state) {
-    pb::write_exr(options.output, renderer.image(report));
-    if (with_state) {
-      pb::SavedRender s = renderer.snapshot();
-      save(s);
-    }
-  };
-  pb::CheckpointPolicy checkpoint;
-  if (options.checkpoint_every) {
-    checkpoint.every = *options.checkpoint_every;
-    // On the background thread, from the snapshot (CheckpointPolicy).
-    checkpoint.write = [&](const pb::RenderReport& r, pb::SavedRender& saved) {
-      pb::write_exr(options.output, renderer.image(r, saved.states), pb::ExrCompression::None);
-      save(saved);
-    };
-  }
-
   const bool show = options.progress == pb::ProgressMode::Always ||
                     (options.progress == pb::ProgressMode::Auto && isatty(STDERR_FILENO));
+  std::vector<pb::PassObserver*> observers;
+  pb::ProgressPrinter progress(std::cerr);
+  if (show) observers.push_back(&progress);
+  pb::PassLogger logger(log_file, options.reference_path.empty() ? nullptr : &reference);
+  if (log_file.is_open()) observers.push_back(&logger);
+  pb::CheckpointWriter checkpoints(
+      options.checkpoint_every.value_or(0.0), options, scene_hash, [&](const pb::SavedRender& s) {
+        // On the background thread, from the snapshot (CheckpointWriter).
+        pb::write_exr(options.output, renderer.image({s.schedule.seconds, ""}, s.render),
+                      pb::ExrCompression::None);
+        pb::save_state(state_path, s);
+      });
+  if (options.checkpoint_every) observers.push_back(&checkpoints);
+
   if (show)
     std::cerr << "photonbound: " << renderer.eye().points.size() << " measurement points, "
               << threads.threads() << " threads" << (saved ? ", resumed" : "") << "\n";
-  const pb::RenderReport report =
-      renderer.run(&g_stop, show ? &std::cerr : nullptr, checkpoint, log);
+  pb::Driver driver(renderer, saved ? saved->schedule : pb::DriverState{});
+  const pb::RenderReport report = driver.run(&g_stop, observers);
   // Ctrl-C keeps the work: the state is written then too.
-  write_outputs(report, keep_state || report.stop_reason == "interrupted");
-  if (show || report.stop_reason != "passes")
-    std::cerr << "photonbound: stopped (" << report.stop_reason << ") after " << report.passes
-              << " passes, " << report.seconds << " s; mean bound " << report.summary.mean_bound
-              << "; wrote " << options.output << "\n";
+  pb::write_exr(options.output, renderer.image(report.run()));
+  if (keep_state || report.stop == pb::StopReason::Interrupted)
+    pb::save_state(state_path, {options, scene_hash, renderer.snapshot(), driver.state()});
+  if (options.progress != pb::ProgressMode::Never)
+    std::cerr << "photonbound: stopped (" << pb::stop_text(report.stop) << ") after "
+              << report.work.passes << " passes, " << report.seconds << " s; mean bound "
+              << report.summary.mean_bound << "; wrote " << options.output << "\n";
   return 0;
 }
 
@@ -135,23 +131,7 @@ int render(const pb::RenderOptions& options) {
 
 int resume(const pb::ResumeOptions& r) {
   const pb::SavedRender saved = pb::load_state(r.state);
-  pb::RenderOptions o = saved.options;
-  const pb::RenderOptions& n = r.overrides;
-  o.output = n.output;
-  if (r.new_stop) {
-    o.passes = n.passes;
-    o.time_seconds = n.time_seconds;
-    o.target_error = n.target_error;
-  }
-  o.checkpoint_every = n.checkpoint_every;
-  o.state_path = n.state_path;
-  o.threads = n.threads;
-  o.progress = n.progress;
-  o.log_path = n.log_path;
-  o.reference_path = n.reference_path;
-  o.resume_from = r.state;
-  o.command_line = n.command_line;
-  return render(o, &saved);
+  return render(pb::resumed_options(saved.options, r), &saved);
 }
 
 int compare(const pb::CompareOptions& o) {

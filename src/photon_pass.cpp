@@ -1,6 +1,7 @@
 #include "photonbound/photon_pass.h"
 
 #include "photonbound/bsdf.h"
+#include "photonbound/counting_sort.h"
 #include "photonbound/parallel.h"
 #include "photonbound/rng.h"
 
@@ -16,12 +17,11 @@ namespace {
 constexpr size_t kChunk = 2048;
 
 // Spatial order of the hits: a Morton code on a 2^10 lattice per axis (30 bits), sorted by an
-// LSD radix sort of three 10-bit digits. The sort runs over a fixed number of blocks, so its
-// scatter offsets, and the order, do not depend on the thread count.
+// LSD radix sort of three 10-bit digits (counting_sort.h: the order does not depend on the
+// thread count).
 constexpr int kLatticeBits = 10;
 constexpr int kDigitBits = 10;
 constexpr int kDigits = 3;
-constexpr size_t kSortBlocks = 16;
 
 // Bit i of the 10-bit x moves to bit 3i ("magic bits" Morton spreading).
 uint32_t spread_bits(uint32_t x) {
@@ -58,37 +58,17 @@ void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, std::vect
                            : world_.accel().intersect(origin, dir, 0.0f, INFINITY, hit);
     if (!found) return;
     const Surface s = world_.surface(hit);
-    const Material& m = *s.material;
     const vec3 wo = -dir;
     const bool front = glm::dot(wo, s.ng) > 0.0f;
     const vec3 ng = front ? s.ng : -s.ng;
     const vec3 ns = front ? s.ns : -s.ns;
-
-    vec3 next, factor;
-    if (m.model == Reflection::Lambertian) {
-      if (bounce >= 1 || deposit_first_hit_) out.push_back({s.position, wo, ng, flux});
-      next = sample_cosine_hemisphere(ns, rng.next_float(), rng.next_float());
-      if (glm::dot(next, ng) <= 0.0f) return;  // below the true surface: absorbed
-      // Cosine sampling cancels f cos / pdf to rho; the shading-normal correction remains.
-      factor = m.base_color * adjoint_shading_factor(wo, next, ng, ns);
-    } else {
-      SpecularBranch b[2];
-      const int n = specular_branches(m, s, wo, Transport::Importance, b);
-      int pick = 0;
-      float p = 1.0f;
-      if (n == 2) {
-        // Choose reflection or refraction in proportion to their throughput.
-        const float a0 = average(b[0].weight), a1 = average(b[1].weight);
-        p = a0 / (a0 + a1);
-        if (rng.next_float() >= p) {
-          pick = 1;
-          p = 1.0f - p;
-        }
-      }
-      if (!(p > 0.0f)) return;
-      next = b[pick].dir;
-      factor = b[pick].weight / p * adjoint_shading_factor(wo, next, ng, ns);
-    }
+    if (!s.bsdf.is_delta() && (bounce >= 1 || deposit_first_hit_))
+      out.push_back({s.position, wo, ng, flux});
+    BsdfSample b;
+    if (!s.bsdf.sample(wo, rng, Transport::Importance, b)) return;
+    const vec3 next = b.wi;
+    // The shading-normal correction of adjoint transport (bsdf.h).
+    const vec3 factor = b.weight * adjoint_shading_factor(wo, next, ng, ns);
     // Russian roulette keeps the carried power roughly constant (survival = max throughput).
     const float q = std::min(1.0f, max_component(factor));
     if (!(q > 0.0f) || rng.next_float() >= q) return;
@@ -168,38 +148,15 @@ void PhotonTracer::order_hits(std::vector<PhotonHit>& hits) {
     }
   });
 
-  // LSD radix sort, one 10-bit digit per round: per-block histograms, offsets in (digit, block)
-  // order, then every block scatters its keys in order (stable).
+  // LSD radix sort, one 10-bit digit per round (stable, so ties stay in photon order).
   constexpr size_t kRadix = size_t(1) << kDigitBits;
-  const size_t block = (n + kSortBlocks - 1) / kSortBlocks;
-  histogram_.resize(kSortBlocks * kRadix);
   uint64_t* src = keys_.data();
   uint64_t* dst = keys_scratch_.data();
   for (int d = 0; d < kDigits; ++d) {
     const int shift = 32 + d * kDigitBits;
-    std::fill(histogram_.begin(), histogram_.end(), 0u);
-    parallel_for(kSortBlocks, 1, [&](size_t b0, size_t b1) {
-      for (size_t b = b0; b < b1; ++b) {
-        uint32_t* h = histogram_.data() + b * kRadix;
-        for (size_t i = b * block; i < std::min(n, (b + 1) * block); ++i)
-          ++h[(src[i] >> shift) & (kRadix - 1)];
-      }
-    });
-    uint32_t sum = 0;
-    for (size_t digit = 0; digit < kRadix; ++digit)
-      for (size_t b = 0; b < kSortBlocks; ++b) {
-        uint32_t& c = histogram_[b * kRadix + digit];
-        const uint32_t count = c;
-        c = sum;
-        sum += count;
-      }
-    parallel_for(kSortBlocks, 1, [&](size_t b0, size_t b1) {
-      for (size_t b = b0; b < b1; ++b) {
-        uint32_t* h = histogram_.data() + b * kRadix;
-        for (size_t i = b * block; i < std::min(n, (b + 1) * block); ++i)
-          dst[h[(src[i] >> shift) & (kRadix - 1)]++] = src[i];
-      }
-    });
+    stable_counting_sort(
+        n, kRadix, [&](size_t i) { return size_t(src[i] >> shift) & (kRadix - 1); },
+        [&](size_t i, uint32_t slot) { dst[slot] = src[i]; }, histogram_);
     std::swap(src, dst);
   }
 

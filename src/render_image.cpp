@@ -1,4 +1,4 @@
-// Renderer::image: the EXR layout (README "Output") and its metadata.
+// Renderer::image: the EXR layout (channels.def) and its metadata.
 #include "photonbound/renderer.h"
 
 #include "photonbound/channels.h"
@@ -24,20 +24,29 @@ ExrImage pack_channels(const FilmImage& film) {
   return out;
 }
 
-ExrImage Renderer::image(const RenderReport& report, const std::vector<PointState>& states) const {
+ExrImage Renderer::image(const RunInfo& run) const {
+  return image(run, work_, initial_radius_, states_);
+}
+
+ExrImage Renderer::image(const RunInfo& run, const RenderState& state) const {
+  return image(run, state.work, state.initial_radius, state.states);
+}
+
+ExrImage Renderer::image(const RunInfo& run, const WorkCounters& work, double initial_radius,
+                         const std::vector<PointState>& states) const {
   FilmImage film;
-  const FilmSummary summary = develop(eye_, states, report.passes, film_settings(), &film);
+  const FilmSummary summary = pb::develop(eye_, states, work.passes, film_settings(), &film);
   ExrImage out = pack_channels(film);
   out.metadata = describe(options_);
   out.metadata.insert(out.metadata.end(),
                       {
                           {"version", PHOTONBOUND_VERSION},
                           {"command_line", options_.command_line},
-                          {"passes_done", std::to_string(report.passes)},
-                          {"photons_emitted", std::to_string(report.photons)},
-                          {"seconds", number_text(report.seconds)},
-                          {"stop_reason", report.stop_reason},
-                          {"initial_radius", number_text(report.initial_radius)},
+                          {"passes_done", std::to_string(work.passes)},
+                          {"photons_emitted", std::to_string(work.photons)},
+                          {"seconds", number_text(run.seconds)},
+                          {"stop_reason", run.stop_reason},
+                          {"initial_radius", number_text(initial_radius)},
                           {"mean_error_bound", number_text(summary.mean_bound)},
                           {"unknown_pixels", std::to_string(summary.unknown_pixels)},
                           {"measurement_points", std::to_string(eye_.points.size())},

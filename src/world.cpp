@@ -2,19 +2,19 @@
 
 namespace pb {
 
-World::World(const Scene& scene)
-    : scene_(scene),
-      accel_(scene),
-      lights_(scene),
-      scene_size_(std::max(scene.bounds.diagonal(), 1e-30f)),
+World::World(Scene scene)
+    : scene_(std::move(scene)),
+      accel_(scene_),
+      lights_(scene_),
+      scene_size_(std::max(scene_.bounds.diagonal(), 1e-30f)),
       // Offsets of 1e-5 of the scene keep rays off their own surface without skipping
       // neighbouring geometry; the |p| term in offset() covers float spacing far from 0.
       epsilon_(1e-5f * scene_size_) {
   size_t triangles = 0;
-  for (const Mesh& m : scene.meshes) triangles += m.indices.size() / 3;
+  for (const Mesh& m : scene_.meshes) triangles += m.indices.size() / 3;
   face_normals_.resize(triangles);
   size_t first = 0;
-  for (const Mesh& m : scene.meshes) {
+  for (const Mesh& m : scene_.meshes) {
     const size_t n = m.indices.size() / 3;
     for (size_t t = 0; t < n; ++t) {
       const vec3& p0 = m.positions[m.indices[3 * t]];
@@ -24,7 +24,7 @@ World::World(const Scene& scene)
     }
     meshes_.push_back({m.positions.data(), m.normals.empty() ? nullptr : m.normals.data(),
                        m.indices.data(), face_normals_.data() + first,
-                       &scene.materials[m.material]});
+                       &scene_.materials[m.material]});
     first += n;
   }
 }

@@ -2,9 +2,11 @@
 // pixels and bounds against them. Shared by the tests and the bounds study tool.
 #pragma once
 
+#include "photonbound/driver.h"
 #include "photonbound/film.h"
 #include "photonbound/gltf_loader.h"
 #include "photonbound/renderer.h"
+#include "render_fixture.h"
 
 #include <cmath>
 #include <functional>
@@ -115,14 +117,14 @@ inline TerminationRow termination_run(const std::string& name, RenderOptions o) 
   const Case sc = by_name(name);
   const pb::Scene scene = load_gltf(o.scene);
   Renderer r(scene, o);
-  const RenderReport report = r.run(nullptr, nullptr);
+  const RenderReport report = test::run_to_stop(r);
   TerminationRow row;
   row.target = o.target_error.value_or(0.0);
   row.confidence = o.confidence;
-  row.passes = report.passes;
+  row.passes = report.work.passes;
   row.seconds = report.seconds;
   row.mean_bound = report.summary.mean_bound;
-  row.stop_reason = report.stop_reason;
+  row.stop_reason = stop_text(report.stop);
   FilmImage img;
   develop(r.eye(), r.states(), r.passes(), r.film_settings(), &img);
   double sum = 0.0;

@@ -421,7 +421,7 @@ inline void single_photon_then_zeros(uint64_t j0, double t, const std::vector<ui
 // (no freeze), and that photons are counted in 64 bits.
 inline void one_photon_per_pass(uint64_t passes) {
   static_assert(std::is_same_v<decltype(PointState::photons), uint64_t>);
-  static_assert(std::is_same_v<decltype(RenderReport::photons), uint64_t>);
+  static_assert(std::is_same_v<decltype(WorkCounters::photons), uint64_t>);
   RenderOptions o = options(test::scene_path("plane_point.gltf"), 4, 1);
   o.passes = passes;
   Render run(o.scene, o);
@@ -474,10 +474,10 @@ inline void one_photon_per_pass(uint64_t passes) {
       (unsigned long long)passes, (unsigned long long)arrivals, (unsigned long long)min_photons,
       (unsigned long long)max_photons, run.r->eye().points.empty() ? 0.0 : double(report_radius),
       r_min, r_max, c.unknown, a.mean_abs_error, a.mean_bound, a.coverage);
-  EXPECT_EQ(arrivals, shrinks);                              // the floor is never reached here
-  const RenderReport report = run.r->run(nullptr, nullptr);  // passes already done: no new pass
-  EXPECT_EQ(report.passes, passes);
-  EXPECT_EQ(report.photons, passes);
+  EXPECT_EQ(arrivals, shrinks);                           // the floor is never reached here
+  const RenderReport report = test::run_to_stop(*run.r);  // passes already done: no new pass
+  EXPECT_EQ(report.work.passes, passes);
+  EXPECT_EQ(report.work.photons, passes);
 }
 
 // PHOTONBOUND_FULL_EXTREMES=1 selects the full issue-sized runs (10^6 passes).

@@ -1,6 +1,7 @@
 // Shared helpers for tests that render the shipped scenes in-process.
 #pragma once
 
+#include "photonbound/driver.h"
 #include "photonbound/gltf_loader.h"
 #include "photonbound/renderer.h"
 
@@ -10,6 +11,11 @@ namespace pb::test {
 
 inline std::string scene_path(const std::string& name) {
   return std::string(PHOTONBOUND_SCENES) + "/" + name;
+}
+
+// Runs the render to its stop conditions, as photonbound does (Driver, no observers).
+inline RenderReport run_to_stop(Renderer& r, const DriverState& state = {}) {
+  return Driver(r, state).run();
 }
 
 inline RenderOptions quick_options(const std::string& scene, int size, uint64_t passes) {

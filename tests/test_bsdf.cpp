@@ -394,6 +394,7 @@ Surface make_surface(const Material& m, vec3 ng, vec3 ns) {
   s.ng = ng;
   s.ns = ns;
   s.material = &m;
+  s.bsdf = Bsdf(m, ng, ns);
   return s;
 }
 
@@ -412,7 +413,7 @@ TEST(SpecularBranches, MirrorReflectsWithBaseColor) {
   for (const vec3& wo : {unit(0.3f, 0.2f, 0.9f), unit(-0.9f, 0.1f, 0.1f), vec3(0, 0, 1)}) {
     for (Transport mode : {Transport::Radiance, Transport::Importance}) {
       SpecularBranch br[2];
-      ASSERT_EQ(specular_branches(m, s, wo, mode, br), 1);
+      ASSERT_EQ(s.bsdf.delta_branches(wo, mode, br), 1);
       EXPECT_EQ(br[0].weight, m.base_color);
       expect_mirror_image(wo, br[0].dir, n, "mirror");
       EXPECT_GT(glm::dot(br[0].dir, n), 0.0f);
@@ -421,7 +422,7 @@ TEST(SpecularBranches, MirrorReflectsWithBaseColor) {
   // From the back side the mirror reflects about -ng.
   SpecularBranch br[2];
   const vec3 wo = unit(0.2f, 0.1f, -0.8f);
-  ASSERT_EQ(specular_branches(m, s, wo, Transport::Radiance, br), 1);
+  ASSERT_EQ(s.bsdf.delta_branches(wo, Transport::Radiance, br), 1);
   expect_mirror_image(wo, br[0].dir, -n, "mirror back");
   EXPECT_LT(br[0].dir.z, 0.0f);
 }
@@ -440,9 +441,9 @@ TEST(SpecularBranches, DielectricFromOutsideSplitsByFresnel) {
     const vec3 wo(float(std::sin(th)), 0.0f, float(std::cos(th)));
     const double F = fresnel_reference(double(wo.z), 1.0, 1.5);
     SpecularBranch imp[2], rad[2], tr[2];
-    ASSERT_EQ(specular_branches(white, sw, wo, Transport::Importance, imp), 2) << k;
-    ASSERT_EQ(specular_branches(white, sw, wo, Transport::Radiance, rad), 2) << k;
-    ASSERT_EQ(specular_branches(tinted, st, wo, Transport::Radiance, tr), 2) << k;
+    ASSERT_EQ(sw.bsdf.delta_branches(wo, Transport::Importance, imp), 2) << k;
+    ASSERT_EQ(sw.bsdf.delta_branches(wo, Transport::Radiance, rad), 2) << k;
+    ASSERT_EQ(st.bsdf.delta_branches(wo, Transport::Radiance, tr), 2) << k;
     for (int c = 0; c < 3; ++c) {
       EXPECT_NEAR(imp[0].weight[c], F, 2e-5) << "theta=" << k;
       EXPECT_NEAR(imp[0].weight[c] + imp[1].weight[c], 1.0f, 2e-6f) << "theta=" << k;
@@ -473,8 +474,8 @@ TEST(SpecularBranches, DielectricFromInside) {
     if (std::fabs(th - theta_c) < 1e-3) continue;
     const vec3 wo(float(std::sin(th)), 0.0f, -float(std::cos(th)));
     SpecularBranch imp[2], rad[2];
-    const int ni = specular_branches(glass, s, wo, Transport::Importance, imp);
-    const int nr = specular_branches(glass, s, wo, Transport::Radiance, rad);
+    const int ni = s.bsdf.delta_branches(wo, Transport::Importance, imp);
+    const int nr = s.bsdf.delta_branches(wo, Transport::Radiance, rad);
     expect_mirror_image(wo, imp[0].dir, -n, "inside reflection");
     EXPECT_LT(imp[0].dir.z, 0.0f);
     if (th > theta_c) {
@@ -513,7 +514,7 @@ TEST(SpecularBranches, WhiteDielectricConservesPhotonEnergyWithShadingNormals) {
   {
     const Surface s = make_surface(glass, ng, ns);
     SpecularBranch br[2];
-    const int nb = specular_branches(glass, s, wo, Transport::Importance, br);
+    const int nb = s.bsdf.delta_branches(wo, Transport::Importance, br);
     float sum = br[0].weight.x;
     if (nb == 2) sum += br[1].weight.x;
     EXPECT_NEAR(sum, 1.0f, 1e-5f) << nb << " branch(es), reflection weight " << br[0].weight.x;
@@ -529,7 +530,7 @@ TEST(SpecularBranches, WhiteDielectricConservesPhotonEnergyWithShadingNormals) {
     if (std::fabs(glm::dot(w, ng)) < 1e-3f) continue;
     const Surface s = make_surface(glass, ng, nsr);
     SpecularBranch br[2];
-    const int nb = specular_branches(glass, s, w, Transport::Importance, br);
+    const int nb = s.bsdf.delta_branches(w, Transport::Importance, br);
     float sum = br[0].weight.x;
     if (nb == 2) sum += br[1].weight.x;
     ++tested;
@@ -555,7 +556,7 @@ TEST(SpecularBranches, TiltedShadingNormalKeepsDirectionsOnCorrectSide) {
     const Material m = make_material(model, vec3(1.0f), 1.5f);
     const Surface s = make_surface(m, ng, ns30);
     SpecularBranch br[2];
-    const int nb = specular_branches(m, s, wo, Transport::Radiance, br);
+    const int nb = s.bsdf.delta_branches(wo, Transport::Radiance, br);
     ASSERT_GE(nb, 1);
     EXPECT_GT(glm::dot(br[0].dir, ng), 0.0f);
     EXPECT_NEAR(glm::length(br[0].dir), 1.0f, 1e-5f);
@@ -572,7 +573,7 @@ TEST(SpecularBranches, TiltedShadingNormalKeepsDirectionsOnCorrectSide) {
       const Material m = make_material(model, vec3(1.0f), 1.5f);
       const Surface s = make_surface(m, ng, glm::dot(nsr, ng) > 0.0f ? nsr : -nsr);
       SpecularBranch br[2];
-      const int nb = specular_branches(m, s, w, Transport::Importance, br);
+      const int nb = s.bsdf.delta_branches(w, Transport::Importance, br);
       ASSERT_GE(nb, 1);
       ASSERT_LE(nb, 2);
       EXPECT_GT(side * glm::dot(br[0].dir, ng), 0.0f) << "reflection on the wrong side, k=" << k;

@@ -3,6 +3,7 @@
 #include "render_fixture.h"
 
 #include "photonbound/checkpoint.h"
+#include "photonbound/checkpoint_writer.h"
 #include "photonbound/image_io.h"
 
 #include <gtest/gtest.h>
@@ -40,9 +41,7 @@ SavedRender saved_after(const RenderOptions& o, uint64_t passes) {
   const Scene scene = load_gltf(o.scene);
   Renderer r(scene, o);
   while (r.passes() < passes) r.step();
-  SavedRender s = r.snapshot();
-  s.scene_hash = hash_file(o.scene);
-  return s;
+  return {o, scene.content_hash, r.snapshot(), DriverState{}};
 }
 
 // Continuing from a state file gives the image of an uninterrupted render, bit for bit.
@@ -50,21 +49,21 @@ TEST_F(Checkpoints, ResumeIsBitIdentical) {
   const RenderOptions o = small_options();
   const Scene scene = load_gltf(o.scene);
   Renderer straight(scene, o);
-  const RenderReport full = straight.run(nullptr, nullptr);
+  const RenderReport full = test::run_to_stop(straight);
 
   save_state(path("half.pbstate"), saved_after(o, 3));
   const SavedRender loaded = load_state(path("half.pbstate"));
   Renderer resumed(scene, o);
-  resumed.restore(loaded);
+  resumed.restore(loaded.render);
   EXPECT_EQ(resumed.passes(), 3u);
-  const RenderReport rest = resumed.run(nullptr, nullptr);
-  EXPECT_EQ(rest.passes, full.passes);
-  EXPECT_EQ(rest.photons, full.photons);
+  const RenderReport rest = test::run_to_stop(resumed, loaded.schedule);
+  EXPECT_EQ(rest.work.passes, full.work.passes);
+  EXPECT_EQ(rest.work.photons, full.work.photons);
   ASSERT_EQ(resumed.states().size(), straight.states().size());
   EXPECT_EQ(std::memcmp(resumed.states().data(), straight.states().data(),
                         straight.states().size() * sizeof(PointState)),
             0);
-  const ExrImage a = straight.image(full), b = resumed.image(rest);
+  const ExrImage a = straight.image(full.run()), b = resumed.image(rest.run());
   EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(float)), 0);
 }
 
@@ -76,36 +75,36 @@ TEST_F(Checkpoints, BackgroundSnapshotsAreExactAndResumeBitIdentical) {
   o.passes = 10;
   const Scene scene = load_gltf(o.scene);
   Renderer straight(scene, o);
-  straight.run(nullptr, nullptr);
+  test::run_to_stop(straight);
   const size_t bytes = straight.states().size() * sizeof(PointState);
 
   std::mutex m;
   std::vector<SavedRender> snaps;
-  CheckpointPolicy policy;
-  policy.every = 1e-9;  // whenever the writer is idle
-  policy.write = [&](const RenderReport& report, SavedRender& s) {
-    EXPECT_EQ(report.passes, s.loop.passes);
+  // Every 1e-9 s: whenever the writer is idle.
+  CheckpointWriter writer(1e-9, o, 0, [&](const SavedRender& s) {
     std::lock_guard<std::mutex> lock(m);
     snaps.push_back(s);
-  };
+  });
   Renderer checkpointed(scene, o);
-  checkpointed.run(nullptr, nullptr, policy);
+  PassObserver* observers[] = {&writer};
+  Driver(checkpointed).run(nullptr, observers);
   EXPECT_EQ(std::memcmp(checkpointed.states().data(), straight.states().data(), bytes), 0);
   // The writer is idle at pass 1, so there is at least that snapshot; how many more depends on
   // scheduling, and each is checked the same way.
   ASSERT_GE(snaps.size(), 1u);
-  EXPECT_EQ(snaps.front().loop.passes, 1u);
-  EXPECT_EQ(checkpointed.timings().checkpoints, snaps.size());
+  EXPECT_EQ(snaps.front().render.work.passes, 1u);
+  EXPECT_EQ(writer.checkpoints(), snaps.size());
 
   for (const SavedRender& s : snaps) {
-    SCOPED_TRACE("snapshot after pass " + std::to_string(s.loop.passes));
-    ASSERT_LT(s.loop.passes, *o.passes);  // the last pass is the caller's to write
+    SCOPED_TRACE("snapshot after pass " + std::to_string(s.render.work.passes));
+    ASSERT_LT(s.render.work.passes, *o.passes);      // the last pass is the caller's to write
+    EXPECT_EQ(s.schedule.next_check, o.min_passes);  // the driver's schedule is saved too
     Renderer stepped(scene, o);
-    while (stepped.passes() < s.loop.passes) stepped.step();
-    EXPECT_EQ(std::memcmp(s.states.data(), stepped.states().data(), bytes), 0);
+    while (stepped.passes() < s.render.work.passes) stepped.step();
+    EXPECT_EQ(std::memcmp(s.render.states.data(), stepped.states().data(), bytes), 0);
     Renderer resumed(scene, o);
-    resumed.restore(s);
-    resumed.run(nullptr, nullptr);
+    resumed.restore(s.render);
+    test::run_to_stop(resumed, s.schedule);
     EXPECT_EQ(std::memcmp(resumed.states().data(), straight.states().data(), bytes), 0);
   }
 }
@@ -115,14 +114,13 @@ TEST_F(Checkpoints, FailedBackgroundWriteIsRethrown) {
   RenderOptions o = small_options();
   o.passes = 6;
   const Scene scene = load_gltf(o.scene);
-  CheckpointPolicy policy;
-  policy.every = 1e-9;
-  policy.write = [](const RenderReport&, SavedRender&) {
+  CheckpointWriter writer(1e-9, o, 0, [](const SavedRender&) {
     throw StateError("out.pbstate: cannot write (No space left on device)");
-  };
+  });
   Renderer r(scene, o);
+  PassObserver* observers[] = {&writer};
   try {
-    r.run(nullptr, nullptr, policy);
+    Driver(r).run(nullptr, observers);
     ADD_FAILURE() << "run() returned";
   } catch (const StateError& e) {
     EXPECT_NE(std::string(e.what()).find("No space left"), std::string::npos);
@@ -133,12 +131,14 @@ TEST_F(Checkpoints, StateRoundTripsExactly) {
   const SavedRender s = saved_after(small_options(), 2);
   save_state(path("s.pbstate"), s);
   const SavedRender t = load_state(path("s.pbstate"));
-  EXPECT_EQ(t.loop.passes, 2u);
+  EXPECT_EQ(t.render.work.passes, 2u);
   EXPECT_EQ(t.scene_hash, s.scene_hash);
   EXPECT_EQ(t.options.seed, s.options.seed);
   EXPECT_EQ(t.options.width, s.options.width);
-  ASSERT_EQ(t.states.size(), s.states.size());
-  EXPECT_EQ(std::memcmp(t.states.data(), s.states.data(), s.states.size() * sizeof(PointState)), 0);
+  ASSERT_EQ(t.render.states.size(), s.render.states.size());
+  EXPECT_EQ(std::memcmp(t.render.states.data(), s.render.states.data(),
+                        s.render.states.size() * sizeof(PointState)),
+            0);
 }
 
 std::string error_of(const std::function<void()>& f) {
@@ -207,7 +207,7 @@ TEST_F(Checkpoints, MismatchedSceneAndOptionsAreNamed) {
   other.height = 16;
   const Scene sc = load_gltf(o.scene);
   Renderer r(sc, other);
-  EXPECT_THROW(r.restore(s), StateError);
+  EXPECT_THROW(r.restore(s.render), StateError);
 }
 
 // ---- The executable under signals -------------------------------------------------------
@@ -279,8 +279,8 @@ TEST_F(Checkpoints, KillNineLeavesLoadableFiles) {
     waitpid(pid, &status, 0);
     const SavedRender s = load_state(state);
     const ExrImage img = read_exr(out);
-    EXPECT_GE(std::stoull(meta(img, "passes_done")), s.loop.passes) << "trial " << trial;
-    EXPECT_GT(s.loop.passes, 0u);
+    EXPECT_GE(std::stoull(meta(img, "passes_done")), s.render.work.passes) << "trial " << trial;
+    EXPECT_GT(s.render.work.passes, 0u);
   }
 }
 
@@ -297,7 +297,7 @@ TEST_F(Checkpoints, CtrlCWritesImageAndStateAndExitsZero) {
   const ExrImage img = read_exr(out);
   EXPECT_EQ(meta(img, "stop_reason"), "interrupted");
   const SavedRender s = load_state(state);
-  EXPECT_EQ(std::to_string(s.loop.passes), meta(img, "passes_done"));
+  EXPECT_EQ(std::to_string(s.render.work.passes), meta(img, "passes_done"));
 }
 
 TEST_F(Checkpoints, SecondSignalLeavesAtOnceAndKeepsTheLastFiles) {

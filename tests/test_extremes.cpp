@@ -359,8 +359,9 @@ TEST(Extremes, TinyInitialRadiusStartsAtTheFloor) {
   std::printf("radius 1e-9 x scene: floor R = %.4g, %zu of %zu pixels unknown, mean bound %g\n",
               std::sqrt(floor), c.unknown, c.with_points, summary.mean_bound);
   EXPECT_GT(c.unknown, c.with_points * 9 / 10);
-  const RenderReport report = run.r->run(nullptr, nullptr);
-  EXPECT_DOUBLE_EQ(report.initial_radius, std::sqrt(floor));
+  const RenderReport report = test::run_to_stop(*run.r);
+  (void)report;
+  EXPECT_DOUBLE_EQ(run.r->initial_radius(), std::sqrt(floor));
 }
 
 // 1e3 x the scene size: every photon on the plane lands in every point's disc. The radius
@@ -580,8 +581,8 @@ TEST(Extremes, LightNoPointCanSee) {
     o.target_error = 1e-3;
     Render run(path, o);
     const double r0 = run.r->states()[0].r2;
-    const RenderReport report = run.r->run(nullptr, nullptr);
-    EXPECT_EQ(report.stop_reason, "passes");
+    const RenderReport report = test::run_to_stop(*run.r);
+    EXPECT_EQ(stop_text(report.stop), "passes");
     EXPECT_EQ(report.summary.unknown_pixels, 64u);
     EXPECT_EQ(report.summary.mean_bound, INFINITY);
     check_states(run);
@@ -676,9 +677,9 @@ TEST(Extremes, CameraSeesOnlyBackground) {
   o.target_error = 1e-9;
   Render run(path, o);
   EXPECT_TRUE(run.r->eye().points.empty());
-  const RenderReport report = run.r->run(nullptr, nullptr);
-  EXPECT_EQ(report.stop_reason, "target-error");
-  EXPECT_EQ(report.passes, o.min_passes);
+  const RenderReport report = test::run_to_stop(*run.r);
+  EXPECT_EQ(stop_text(report.stop), "target-error");
+  EXPECT_EQ(report.work.passes, o.min_passes);
   EXPECT_EQ(report.summary.unknown_pixels, 0u);
   EXPECT_EQ(report.summary.mean_bound, 0.0);
   FilmImage img;
@@ -687,7 +688,7 @@ TEST(Extremes, CameraSeesOnlyBackground) {
   for (float v : img.bound) EXPECT_EQ(v, 0.0f);
   for (float v : img.radiance) EXPECT_EQ(v, 0.0f);
   // The EXR as written: the same channels, metadata says no unknown pixel.
-  const ExrImage exr = run.r->image(report);
+  const ExrImage exr = run.r->image(report.run());
   bool found = false;
   for (const auto& [k, v] : exr.metadata)
     if (k == "unknown_pixels") found = v == "0";

@@ -15,8 +15,8 @@ ExrImage render_image(RenderOptions o, int threads) {
   ThreadLimit limit(threads);
   const Scene scene = load_gltf(o.scene);
   Renderer r(scene, o);
-  const RenderReport report = r.run(nullptr, nullptr);
-  ExrImage img = r.image(report);
+  const RenderReport report = test::run_to_stop(r);
+  ExrImage img = r.image(report.run());
   return img;
 }
 
@@ -152,9 +152,9 @@ TEST(Render, UnreachableTargetIsDetected) {
   o.target_error = 1e-4;
   const Scene scene = load_gltf(o.scene);
   Renderer r(scene, o);
-  const RenderReport report = r.run(nullptr, nullptr);
-  EXPECT_EQ(report.stop_reason.rfind("unreachable", 0), 0u) << report.stop_reason;
-  EXPECT_LT(report.passes, 100u);
+  const RenderReport report = test::run_to_stop(r);
+  EXPECT_EQ(stop_text(report.stop).rfind("unreachable", 0), 0u) << stop_text(report.stop);
+  EXPECT_LT(report.work.passes, 100u);
 }
 
 }  // namespace

@@ -1,8 +1,11 @@
-// The three reflection models (scene.h Reflection) as pure functions of directions in world
-// space. Directions point away from the surface; n is the side the incoming direction is on.
+// The three reflection models (scene.h Reflection): the Bsdf every stage asks, and the pure
+// functions it is made of, of directions in world space. Directions point away from the
+// surface; n is the side the incoming direction is on.
 #pragma once
 
 #include "photonbound/math.h"
+#include "photonbound/rng.h"
+#include "photonbound/scene.h"
 
 namespace pb {
 
@@ -36,9 +39,6 @@ vec3 sample_uniform_cone(const vec3& axis, float cos_max, float u1, float u2);
 // Without it, interpolated normals create or destroy energy in photon paths.
 float adjoint_shading_factor(const vec3& wo, const vec3& wi, const vec3& ng, const vec3& ns);
 
-struct Material;
-struct Surface;
-
 // How a transport quantity is carried: radiance (camera paths) picks up the (eta_i/eta_t)^2
 // factor at refraction; photons carry flux and do not (Veach thesis section 5.2).
 enum class Transport : uint8_t { Radiance, Importance };
@@ -48,11 +48,48 @@ struct SpecularBranch {
   vec3 weight{0.0f};  // throughput factor of the branch (Fresnel term included)
 };
 
-// The deterministic branches of a mirror (one) or a smooth dielectric (reflection and, unless
-// totally internally reflected, refraction), for a path arriving from direction wo (pointing
-// away from the surface). Dielectrics are closed meshes in vacuum: the side of ng tells whether
-// the path enters (eta = ior) or leaves (eta = 1/ior). Returns the number of branches.
-int specular_branches(const Material& material, const Surface& surface, const vec3& wo,
-                      Transport mode, SpecularBranch out[2]);
+struct BsdfSample {
+  vec3 wi{0.0f};      // the new direction, unit
+  vec3 weight{0.0f};  // f |cos| / pdf; for a delta lobe, the branch weight over its probability
+  float pdf = 0.0f;   // solid-angle pdf; 0 for a delta lobe
+  bool delta = false;
+};
+
+// A material's scattering at one surface point, as World::surface() makes it: the one thing
+// the eye pass, the photon pass, next-event estimation and the gather ask about a surface.
+// Directions point away from the surface; either side may be hit (the normals are flipped to
+// the side of wo where that matters).
+class Bsdf {
+ public:
+  Bsdf() = default;
+  Bsdf(const Material& material, const vec3& ng, const vec3& ns);
+
+  // Mirrors and smooth dielectrics scatter into isolated directions: no eval, only branches.
+  bool is_delta() const { return model_ != Reflection::Lambertian; }
+  // The Lambertian fast path: f is the constant diffuse_f() for every pair of directions on the
+  // same side, so a gather may sum photon powers first and multiply once (bit for bit what
+  // PPM did before this interface).
+  bool is_lambertian() const { return model_ == Reflection::Lambertian; }
+  vec3 diffuse_f() const { return lambertian(color_); }
+
+  // f(wo, wi) without the cosine; 0 for delta lobes and for wi on the other side of ng.
+  vec3 eval(const vec3& wo, const vec3& wi) const;
+  // Solid-angle pdf of sample(); 0 for delta lobes.
+  float pdf(const vec3& wo, const vec3& wi) const;
+  // Draws wi (random numbers from rng, as many as the lobe needs); false when the sample is
+  // absorbed (below the true surface) or carries nothing. Delta lobes choose one branch in
+  // proportion to its average throughput.
+  bool sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const;
+  // The deterministic branches of a mirror (one) or a smooth dielectric (reflection and, unless
+  // totally internally reflected, refraction). Dielectrics are closed meshes in vacuum: the side
+  // of ng tells whether the path enters (eta = ior) or leaves (eta = 1/ior). Returns the count.
+  int delta_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) const;
+
+ private:
+  Reflection model_ = Reflection::Lambertian;
+  vec3 color_{0.0f};  // reflectance (Lambertian, Mirror) or transmission tint (Dielectric)
+  float ior_ = 1.5f;
+  vec3 ng_{0.0f}, ns_{0.0f};
+};
 
 }  // namespace pb

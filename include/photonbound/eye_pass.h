@@ -30,7 +30,6 @@ struct EyePassResult {
   // Median over the points of the pixel footprint at the point (camera path length x pixel
   // angle): what the default initial radius is made from. 0 without points.
   float median_footprint = 0.0f;
-  uint64_t truncated_paths = 0;  // specular chains cut by the depth limit
 };
 
 // max_depth: the most specular bounces a camera path may take before it is cut.

@@ -27,8 +27,8 @@ struct ExrImage {
 // rewritten every few seconds to minutes, are written uncompressed; the final image uses ZIP.
 enum class ExrCompression { Zip, None };
 
-// Writes float32 EXR to a temporary file beside `path`, then renames it over `path`, so a
-// reader never sees a partial image. Throws ImageError naming the file.
+// Writes float32 EXR atomically (file_io.h write_atomically): a reader never sees a partial
+// image. Throws ImageError naming the file.
 void write_exr(const std::string& path, const ExrImage& image,
                ExrCompression compression = ExrCompression::Zip);
 
@@ -37,8 +37,5 @@ ExrImage read_exr(const std::string& path);
 // Writes an 8-bit RGB PNG (rgb: 3 bytes per pixel, row-major), atomically like write_exr.
 void write_png(const std::string& path, int width, int height,
                const std::vector<unsigned char>& rgb);
-
-// Fails early (ImageError) when `path` cannot be created, before any rendering starts.
-void check_writable(const std::string& path);
 
 }  // namespace pb

@@ -28,6 +28,16 @@ struct DirectSample {
 bool sample_spherical_triangle(const vec3& v0, const vec3& v1, const vec3& v2, const vec3& p,
                                float u0, float u1, vec3& dir, float& solid_angle);
 
+// The power formulas the light sampler and the loader's range check share (W per channel).
+// A one-sided Lambertian emitter of radiance Le and area A emits pi A Le.
+template <class S, class V>
+V lambertian_emitter_power(S area, const V& radiance) {
+  return S(kPiD) * area * radiance;
+}
+vec3 punctual_power(const PunctualLight& light);
+// Every emitter of the scene, summed over channels, in double (so that a float overflow shows).
+double total_emitted_power(const Scene& scene);
+
 class Lights {
  public:
   explicit Lights(const Scene& scene);

@@ -1,12 +1,16 @@
-// The one options struct: filled by the command-line parser, validated once, passed explicitly
-// and written into the EXR metadata. Every option's range and default is documented here and in
-// README "Options".
+// The one options struct, filled by the command-line parser, validated once, passed explicitly.
+// Every option is described once, in the table of option_table.cpp (flag, member, range,
+// default, help, and what resume may change); parsing, validation, --help, the EXR metadata, the
+// state file's options block and resume's list of differences are all made from that table.
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <string_view>
+#include <utility>
 #include <vector>
 
 namespace pb {
@@ -21,35 +25,72 @@ enum class DirectMode { NextEvent, Photons };
 enum class ErrorMetric { Absolute, Relative };
 enum class ProgressMode { Auto, Always, Never };
 
+// Members only: ranges, defaults and help live in the option table.
 struct RenderOptions {
-  std::string scene;   // glTF file
-  std::string output;  // EXR file
+  std::string scene;   // glTF file (the positional argument, not an option)
+  std::string output;  // -o
   // Stop conditions: whichever comes first; at least one is required.
-  std::optional<uint64_t> passes;      // --passes, 1 .. 1e12
-  std::optional<double> time_seconds;  // --time, (0, 1e9] wall-clock seconds
-  std::optional<double> target_error;  // --target-error, (0, inf): image mean of the bound
-  uint64_t photons_per_pass = 100000;  // --photons-per-pass, 1 .. 1e9 (M_e)
-  double alpha = 0.7;                  // --alpha, (0, 1]
-  std::optional<double> radius;        // --radius, (0, inf) world units; default from footprint
-  int max_depth = 8;                   // --max-depth, 0 .. 32 specular bounces of camera paths
-  std::optional<int> width, height;    // --resolution WxH, 1 .. 16384 each
-  std::string camera;                  // --camera NAME; empty = first perspective camera
-  int threads = 0;                     // --threads, 0 (all) .. 1024
-  uint64_t seed = 1;                   // --seed, 0 .. 2^64-1
-  DirectMode direct = DirectMode::NextEvent;   // --direct nee|photons
-  double confidence = 0.9;                     // --confidence, (0, 1): 1 - beta
-  uint64_t min_passes = 16;                    // --min-passes, 2 .. 1e12
-  ErrorMetric metric = ErrorMetric::Absolute;  // --error-metric absolute|relative
-  ProgressMode progress = ProgressMode::Auto;  // --progress / --quiet
-  std::string command_line;                    // as typed, for the metadata
-  // Checkpoints (README "Checkpoints"): none of these changes the image.
-  std::optional<double> checkpoint_every;  // --checkpoint-every, (0, 1e9] seconds
-  std::string state_path;                  // --state FILE; default OUT with .pbstate
-  std::string resume_from;                 // --resume STATE: continue that render
-  // Per-pass log (README "Measuring the trade"): none of these changes the image.
-  std::string log_path;        // --log FILE.jsonl
-  std::string reference_path;  // --reference REF.exr: adds actual error and coverage to the log
+  std::optional<uint64_t> passes;
+  std::optional<double> time_seconds;
+  std::optional<double> target_error;
+  uint64_t photons_per_pass = 100000;  // M_e
+  double alpha = 0.7;
+  std::optional<double> radius;  // world units; default from the pixel footprint
+  int max_depth = 8;
+  std::optional<int> width, height;
+  std::string camera;  // empty = first perspective camera
+  int threads = 0;
+  uint64_t seed = 1;
+  DirectMode direct = DirectMode::NextEvent;
+  double confidence = 0.9;  // 1 - beta
+  uint64_t min_passes = 16;
+  ErrorMetric metric = ErrorMetric::Absolute;
+  ProgressMode progress = ProgressMode::Auto;
+  std::optional<double> checkpoint_every;
+  std::string state_path;
+  std::string resume_from;
+  std::string log_path;
+  std::string reference_path;
+  std::string command_line;  // as typed, for the metadata (not an option)
 };
+
+// What `resume` may do with an option (README "Checkpoints").
+enum class OptionKind {
+  Image,   // shapes the render state: a continued render must have the saved value
+  Stop,    // a stop condition: given on resume, the three replace the saved ones together
+  Adjust,  // how the render is stopped or reported: kept from the state unless given again
+  Run,     // this run only (output, threads, progress, checkpoints, log): never carried over
+};
+
+struct OptionSpec {
+  std::string_view flag;     // "--alpha"
+  std::string_view key;      // "alpha": EXR metadata and state file
+  std::string_view metavar;  // "A"; empty for a switch
+  std::string_view help;     // one line
+  std::string_view group;    // --help section
+  OptionKind kind = OptionKind::Image;
+  std::string range;  // "(0, 1]" as README and --help print it; empty when not numeric
+  std::string unset;  // how an unset optional reads: "none", "auto", "first"
+  // Value-less flags and the value each stands for (--progress = always, --quiet = never).
+  std::vector<std::pair<std::string_view, std::string_view>> switches;
+  // Text -> member, range-checked; throws UsageError "<flag>: ...".
+  std::function<void(RenderOptions&, const std::string&)> parse;
+  // Member -> text that parse() reads back to the same value; "" when unset.
+  std::function<std::string(const RenderOptions&)> format;
+  // Range check of a value set in process; throws the same UsageError as parse().
+  std::function<void(const RenderOptions&)> check;
+  // Sets the member back to its default.
+  std::function<void(RenderOptions&)> reset;
+  // For the table's own test: texts at and just beyond the documented bounds.
+  std::vector<std::string> accepted, rejected;
+
+  std::string display(const RenderOptions& o) const;  // format(), or `unset`
+  std::string default_text() const { return display(RenderOptions{}); }
+};
+
+const std::vector<OptionSpec>& option_table();
+const OptionSpec* find_option(std::string_view flag_or_switch);  // null when unknown
+const OptionSpec& option(std::string_view key);                  // by key; throws when unknown
 
 // The state file a render writes: --state, or the output path with its extension replaced by
 // ".pbstate".
@@ -67,14 +108,11 @@ struct CompareOptions {
   bool json = false;
 };
 
-// photonbound resume STATE -o OUT.exr [--passes N] [--time S] [--target-error E]
-//   [--checkpoint-every S] [--state FILE] [--threads T] [--progress | --quiet]
-// Every other option comes from the state. New stop conditions replace the saved ones; without
-// any, the saved ones apply (passes and target count the whole render, time this run).
+// photonbound resume STATE -o OUT.exr [options of kind Stop, Adjust and Run]
 struct ResumeOptions {
   std::string state;
-  RenderOptions overrides;  // output, stop conditions, checkpoints, threads, progress
-  bool new_stop = false;    // at least one stop condition was given
+  std::vector<std::pair<const OptionSpec*, std::string>> given;  // as typed, in order
+  std::string command_line;
 };
 
 struct Command {
@@ -89,16 +127,24 @@ struct Command {
 // values, out-of-range numbers and a render with no stop condition.
 Command parse_command_line(int argc, const char* const* argv);
 
-// Range checks of section "Options"; parse_command_line calls it, tests may call it directly.
+// The options a resumed render runs with: the saved ones, with what `given` sets applied by
+// the rules of OptionKind. Throws UsageError for an option of kind Image.
+RenderOptions resumed_options(const RenderOptions& saved, const ResumeOptions& resume);
+
+// Every range of the table and the rules across options (a stop condition, --reference only
+// with --log); parse_command_line calls it, tests may call it directly.
 void validate(const RenderOptions& options);
 
-// The --help text.
+// The --help text, made from the table.
 std::string usage_text();
 
 // Shortest text that reads back as the same double (metadata, messages).
 std::string number_text(double v);
 
-// "name=value" pairs of every option, for the EXR metadata and the progress header.
+// "key=value" pairs of the scene and every option, for the EXR metadata.
 std::vector<std::pair<std::string, std::string>> describe(const RenderOptions& options);
+
+// Options of kind Image whose values differ: "name: X in the state, Y now" each.
+std::vector<std::string> image_differences(const RenderOptions& saved, const RenderOptions& now);
 
 }  // namespace pb

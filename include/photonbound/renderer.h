@@ -1,8 +1,9 @@
-// The pass loop: eye pass once, then photon pass, grid build, gather and estimator update per
-// pass, until a stop condition (passes, time, target error, interruption) is met.
+// The render itself: state, step() and snapshot/restore, nothing else. The eye pass runs once;
+// then every pass runs the stages of pass_stages.h in turn (trace photons, build the grid,
+// gather into pass sums, fold the sums into the estimator). When to stop, what to print and
+// when to checkpoint belong to the driver (driver.h).
 #pragma once
 
-#include "photonbound/checkpoint.h"
 #include "photonbound/estimator.h"
 #include "photonbound/eye_pass.h"
 #include "photonbound/film.h"
@@ -12,27 +13,25 @@
 #include "photonbound/photon_pass.h"
 #include "photonbound/world.h"
 
-#include <atomic>
-#include <functional>
-#include <memory>
-#include <ostream>
+#include <cstdint>
 #include <string>
 #include <vector>
 
 namespace pb {
 
-struct RenderReport {
+// The work done so far, part of every state.
+struct WorkCounters {
   uint64_t passes = 0;
   uint64_t photons = 0;  // emitted, all passes
   uint64_t rays = 0;     // photon-pass rays, all passes
-  double seconds = 0.0;  // wall clock of the pass loop
-  std::string stop_reason;
-  double initial_radius = 0.0;
-  FilmSummary summary;
 };
 
-// Picks the camera (by node or camera name when given) and the image size.
-PinholeCamera choose_camera(const Scene& scene, const RenderOptions& options);
+// Everything a state file holds of the render itself.
+struct RenderState {
+  WorkCounters work;
+  double initial_radius = 0.0;
+  std::vector<PointState> states;
+};
 
 // Wall-clock seconds spent in each phase, accumulated over all passes (for the benchmark).
 struct PhaseTimings {
@@ -40,73 +39,65 @@ struct PhaseTimings {
   double trace = 0.0;   // photon tracing
   double grid = 0.0;    // hash grid builds
   double gather = 0.0;  // gathers, next-event samples and estimator updates
-  // Checkpoints: time the pass loop itself spent on them (waiting for a previous write,
-  // starting the next), and wall time of the background writes. The snapshot copy made inside
-  // the update loop is part of `gather`.
-  double checkpoint_stall = 0.0;
-  double checkpoint_write = 0.0;
-  uint64_t checkpoints = 0;
 };
 
-// The EXR channel layout of README "Output" (no metadata).
+// What the driver adds to an image's metadata.
+struct RunInfo {
+  double seconds = 0.0;  // wall clock of all runs
+  std::string stop_reason;
+};
+
+// The EXR layout of channels.def (no metadata).
 ExrImage pack_channels(const FilmImage& film);
 
-// Optional per-pass log (--log): one JSON object per logged pass. Passes are logged while the
-// time spent logging stays within `max_overhead` of the run's time, so the log never slows the
-// pass loop by more than that; the last pass is always logged.
-struct PassLog {
-  std::ostream* out = nullptr;
-  const ExrImage* reference = nullptr;  // adds the actual error and coverage when given
-  double max_overhead = 0.03;
-};
+// Picks the camera (by node or camera name when given) and the image size.
+PinholeCamera choose_camera(const Scene& scene, const RenderOptions& options);
 
-// Checkpoints every `every` seconds of the run (0 = never). `write` runs on a background
-// thread while the passes go on: it gets the report and a snapshot of the render as it stood
-// after one pass (states copied inside that pass's update loop, while they are in cache), and
-// must not touch the Renderer's mutable state (image(report, states) is safe). One checkpoint
-// is in flight at most: while one is being written, the next waits for a later pass. run()
-// waits for the last one before it returns, and rethrows what a write threw.
-struct CheckpointPolicy {
-  double every = 0.0;
-  std::function<void(const RenderReport&, SavedRender&)> write;
-};
+// The default initial radius: kFootprintsPerRadius pixel footprints (median over the points),
+// or 1% of the scene without points; never below the radius floor.
+double default_initial_radius(const EyePassResult& eye, const World& world);
+// The radius floor: R never falls below this fraction of the scene size (ESTIMATOR.md section
+// 8): far below it float positions cannot resolve the distance test anyway.
+double min_radius(const World& world);
 
 class Renderer {
  public:
-  Renderer(const Scene& scene, const RenderOptions& options);
-
-  // Runs to a stop condition. `stop` is polled after every pass (Ctrl-C); progress lines go to
-  // `progress` when it is not null.
-  RenderReport run(const std::atomic<bool>* stop, std::ostream* progress,
-                   const CheckpointPolicy& checkpoint = {}, const PassLog& log = {});
+  Renderer(Scene scene, const RenderOptions& options);
 
   // Runs one more pass (pass number passes() + 1). With `copy`, also copies every point's
   // state into it as the pass leaves it (resized to the point count first).
   void step(std::vector<PointState>* copy = nullptr);
-  uint64_t passes() const { return loop_.passes; }
+  uint64_t passes() const { return work_.passes; }
+  const WorkCounters& work() const { return work_; }
 
-  // Everything a state file holds (scene hash aside), and the way back. restore() throws
-  // StateError when the state does not fit this scene and camera.
-  SavedRender snapshot() const;
-  void restore(const SavedRender& saved);
+  // The state and the way back. restore() throws StateError when the state does not fit this
+  // scene and camera. snapshot(states) is the state with `states` in place of the current ones
+  // (a checkpoint's copy, made inside a pass).
+  RenderState snapshot() const { return snapshot(states_); }
+  RenderState snapshot(std::vector<PointState> states) const;
+  void restore(const RenderState& saved);
 
-  // Radiance, bound channels and metadata, ready for write_exr: of the current states, or of
-  // `states` (a checkpoint's snapshot; reads only what does not change after construction).
-  ExrImage image(const RenderReport& report) const { return image(report, states_); }
-  ExrImage image(const RenderReport& report, const std::vector<PointState>& states) const;
+  // True when no radius can shrink any more (alpha = 1, or every radius at its floor).
+  bool radii_fixed() const;
 
+  // Radiance and bounds of the current states, or of a snapshot's; the film when wanted.
+  FilmSummary develop(FilmImage* image = nullptr) const;
+  FilmSummary develop(const RenderState& state, FilmImage* image) const;
+  // The EXR (channels.def) with every option and the run in its metadata.
+  ExrImage image(const RunInfo& run) const;
+  ExrImage image(const RunInfo& run, const RenderState& state) const;
+
+  const RenderOptions& options() const { return options_; }
   const EyePassResult& eye() const { return eye_; }
   const std::vector<PointState>& states() const { return states_; }
   FilmSettings film_settings() const;
   const PhaseTimings& timings() const { return timings_; }
   const World& world() const { return world_; }
+  double initial_radius() const { return initial_radius_; }
 
  private:
-  double default_radius() const;
-  SavedRender snapshot_with(std::vector<PointState> states) const;  // these states, the rest now
-  std::string progress_line(const RenderReport& report, double run_seconds) const;
-  void write_log_line(const RenderReport& report, const PassLog& log) const;
-  bool radii_fixed() const;
+  ExrImage image(const RunInfo& run, const WorkCounters& work, double initial_radius,
+                 const std::vector<PointState>& states) const;
 
   const RenderOptions options_;
   World world_;
@@ -118,9 +109,9 @@ class Renderer {
   HashGrid grid_;
   std::vector<PhotonHit> hits_;
   std::vector<vec3> hit_positions_;
-  std::vector<float> radii_;                   // sqrt(r2) per point, for the grid build
-  std::vector<PointState> checkpoint_states_;  // snapshot buffer, reused (checkpoints only)
-  LoopState loop_;  // passes, photons, rays, seconds and check schedule so far
+  std::vector<float> radii_;      // search_radius(r2) per point, for the grid build
+  std::vector<PassGather> sums_;  // one fold block's pass sums (pass_stages.h)
+  WorkCounters work_;
   double initial_radius_ = 0.0;
   PhaseTimings timings_;
 };

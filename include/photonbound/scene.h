@@ -68,6 +68,9 @@ struct Scene {
   Bounds bounds;                      // of all triangle vertices
   uint64_t degenerate_triangles = 0;  // skipped at load time
   std::vector<std::string> warnings;  // each once, for the user
+  // Identity of the loaded content (the file's bytes and every buffer it loads), which resume
+  // compares: an edited external .bin must not continue a render of the old one.
+  uint64_t content_hash = 0;
 
   size_t triangle_count() const {
     size_t n = 0;

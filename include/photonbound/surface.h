@@ -1,6 +1,7 @@
-// A point on a surface as the passes see it.
+// A point on a surface as the passes see it: made in one place, World::surface().
 #pragma once
 
+#include "photonbound/bsdf.h"
 #include "photonbound/scene.h"
 
 namespace pb {
@@ -10,6 +11,7 @@ struct Surface {
   vec3 ng{0.0f};  // geometric normal from the winding (the front side), unit
   vec3 ns{0.0f};  // shading normal, unit, flipped if needed to lie on ng's side
   const Material* material = nullptr;
+  Bsdf bsdf;  // the material's scattering here
 };
 
 }  // namespace pb

@@ -11,9 +11,13 @@
 
 namespace pb {
 
+// World owns the Scene it was built from; the acceleration structure and the light sampler
+// point into it, so a World is neither copied nor moved.
 class World {
  public:
-  explicit World(const Scene& scene);
+  explicit World(Scene scene);
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
 
   const Scene& scene() const { return scene_; }
   const Accel& accel() const { return accel_; }
@@ -40,6 +44,7 @@ class World {
       }
     }
     s.material = mesh.material;
+    s.bsdf = Bsdf(*mesh.material, s.ng, s.ns);
     return s;
   }
 
@@ -73,7 +78,7 @@ class World {
     const Material* material;
   };
 
-  const Scene& scene_;
+  const Scene scene_;
   std::vector<vec3> face_normals_;  // all meshes, concatenated
   std::vector<MeshView> meshes_;
   Accel accel_;

@@ -1,0 +1,60 @@
+// The stages of one pass, each a function of plain inputs and outputs, in the order the
+// renderer runs them (the bench times the same functions):
+//   1. trace photons          PhotonTracer::run (photon_pass.h)      -> hits
+//   2. build the grid         build_photon_grid                      -> grid over the hits
+//   3. gather                 gather_pass: photons within each radius -> pass sums (phi, lap, M)
+//   4. next-event samples     next_event_pass                        -> pass sums (D)
+//   5. fold                   fold_pass: sums into the estimator     -> states, radii
+// The pass sums of a block of points exist as an array (PassGather, estimator.h) between 4 and
+// 5: a distributed render reduces exactly that array across machines before folding it.
+#pragma once
+
+#include "photonbound/estimator.h"
+#include "photonbound/eye_pass.h"
+#include "photonbound/hash_grid.h"
+#include "photonbound/photon_pass.h"
+#include "photonbound/rng.h"
+#include "photonbound/world.h"
+
+#include <cmath>
+#include <span>
+#include <vector>
+
+namespace pb {
+
+// The float radius a point with squared radius r2 queries the grid with. The grid is built for
+// these same values (Renderer keeps one per point), so both must come from here.
+inline float search_radius(double r2) { return float(std::sqrt(r2)); }
+
+// Stage 2: the grid over the hits' positions for queries of the given radii. `positions` is
+// scratch, reused across passes.
+void build_photon_grid(const std::vector<PhotonHit>& hits, std::span<const float> radii,
+                       std::vector<vec3>& positions, HashGrid& grid);
+
+// Adds every photon within search_radius(r2) of the point that arrived on the point's side
+// (ESTIMATOR.md sections 2-3).
+void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& grid,
+                    const std::vector<PhotonHit>& hits, PassGather& out);
+
+// One light sample with a shadow ray: D_j = f Li cos / pdf (ESTIMATOR.md section 4).
+dvec3 direct_light(const World& world, const MeasurementPoint& point, Rng& rng);
+
+// Stage 3: out[k] = the photons of the pass at points[k] (phi, phi_lap_r2, count; the direct
+// part is left alone). states[k].r2 is the radius of the pass.
+void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
+                 const HashGrid& grid, const std::vector<PhotonHit>& hits,
+                 std::span<PassGather> out);
+
+// Stage 4: out[k].direct = one next-event sample at points[k], drawn from
+// Rng(seed, pass, first + k, Stream::DirectLight): point first + k's own stream.
+void next_event_pass(const World& world, std::span<const MeasurementPoint> points, uint64_t seed,
+                     uint64_t pass, size_t first, std::span<PassGather> out);
+
+// Stage 5: folds sums[k] into states[k] (accumulate_pass), writes the radius the next grid is
+// built for into radii[k], and with `copy` streams each new state into copy[k] (a checkpoint's
+// snapshot, written while the state is in cache).
+void fold_pass(std::span<PointState> states, std::span<const PassGather> sums,
+               const EstimatorParams& params, uint64_t pass, std::span<float> radii,
+               PointState* copy);
+
+}  // namespace pb

@@ -1,0 +1,93 @@
+#include "photonbound/driver.h"
+
+#include <algorithm>
+#include <chrono>
+
+namespace pb {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+
+}  // namespace
+
+std::string stop_text(StopReason reason) {
+  switch (reason) {
+    case StopReason::None: return "";
+    case StopReason::Passes: return "passes";
+    case StopReason::Time: return "time";
+    case StopReason::TargetError: return "target-error";
+    case StopReason::Unreachable:
+      return "unreachable: the radius cannot shrink and the bias is above the target";
+    case StopReason::Interrupted: return "interrupted";
+  }
+  return "";
+}
+
+Driver::Driver(Renderer& renderer, DriverState state) : renderer_(renderer), state_(state) {}
+
+RenderReport Driver::run(const std::atomic<bool>* interrupt,
+                         std::span<PassObserver* const> observers) {
+  const RenderOptions& o = renderer_.options();
+  const auto t0 = Clock::now();
+  const double seconds_before = state_.seconds;
+  if (state_.next_check == 0) state_.next_check = o.min_passes;
+  RenderReport report;
+  bool developed = false;
+  // A resumed render that already did its passes does not run another one.
+  if (o.passes && renderer_.passes() >= *o.passes) report.stop = StopReason::Passes;
+
+  while (report.stop == StopReason::None) {
+    const double before = seconds_since(t0);
+    std::vector<PointState>* snapshot = nullptr;
+    for (PassObserver* obs : observers)
+      if (!snapshot) snapshot = obs->snapshot_buffer(before);
+    renderer_.step(snapshot);
+    const uint64_t pass = renderer_.passes();
+    const double run_seconds = seconds_since(t0);
+    state_.seconds = seconds_before + run_seconds;
+
+    const bool check = o.target_error && pass >= state_.next_check;
+    bool want = check;
+    for (PassObserver* obs : observers) want = obs->wants_summary(pass, run_seconds) || want;
+    developed = want;
+    if (developed) report.summary = renderer_.develop();
+    if (check) {
+      // Sparse schedule (ESTIMATOR.md section 7): checks about 10% apart in pass count, so the
+      // criterion is not retried after every pass (optional stopping).
+      state_.next_check = pass + std::max<uint64_t>(1, pass / 10);
+      if (state_.early_pass == 0 || pass >= 2 * state_.early_pass) {
+        state_.early_pass = pass;
+        state_.early_bound = report.summary.mean_bound;
+      }
+    }
+
+    if (o.passes && pass >= *o.passes) report.stop = StopReason::Passes;
+    if (o.time_seconds && run_seconds >= *o.time_seconds) report.stop = StopReason::Time;
+    if (check && report.summary.mean_bound <= *o.target_error) report.stop = StopReason::TargetError;
+    // A target below the bias cannot be reached once the radii can no longer shrink (alpha = 1,
+    // or every radius at its floor): more passes only shrink the noise.
+    if (check && report.summary.mean_bias_metric >= *o.target_error && renderer_.radii_fixed())
+      report.stop = StopReason::Unreachable;
+    if (interrupt && interrupt->load()) report.stop = StopReason::Interrupted;
+
+    if (report.stop != StopReason::None && !developed) {
+      report.summary = renderer_.develop();
+      developed = true;
+    }
+    const PassInfo info{renderer_, state_, pass, run_seconds, developed, report.summary,
+                        report.stop};
+    for (PassObserver* obs : observers) obs->after_pass(info);
+  }
+  for (PassObserver* obs : observers) obs->finish();
+  if (!developed) report.summary = renderer_.develop();
+  report.work = renderer_.work();
+  report.seconds = state_.seconds;
+  return report;
+}
+
+}  // namespace pb

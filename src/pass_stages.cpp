@@ -1,0 +1,114 @@
+#include "photonbound/pass_stages.h"
+
+#include "photonbound/parallel.h"
+
+#include "photonbound/kernel.h"
+
+#include <algorithm>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace pb {
+
+namespace {
+
+// A checkpoint snapshot is written once and read later by another thread: non-temporal stores
+// skip reading the destination's cache lines first and leave the cache to the pass's own data.
+// PointState is 160 bytes (16-byte multiple) and the vector's storage is 16-byte aligned.
+void stream_copy(PointState* dst, const PointState& src) {
+#if defined(__SSE2__)
+  static_assert(sizeof(PointState) % 16 == 0 && alignof(std::max_align_t) >= 16);
+  const __m128i* s = reinterpret_cast<const __m128i*>(&src);
+  __m128i* d = reinterpret_cast<__m128i*>(dst);
+  for (size_t i = 0; i < sizeof(PointState) / 16; ++i)
+    _mm_stream_si128(d + i, _mm_loadu_si128(s + i));
+#else
+  *dst = src;
+#endif
+}
+
+void store_fence() {
+#if defined(__SSE2__)
+  _mm_sfence();
+#endif
+}
+
+}  // namespace
+
+void build_photon_grid(const std::vector<PhotonHit>& hits, std::span<const float> radii,
+                       std::vector<vec3>& positions, HashGrid& grid) {
+  positions.resize(hits.size());
+  parallel_for(hits.size(), 16384, [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) positions[k] = hits[k].position;
+  });
+  grid.build(positions, radii);
+}
+
+void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& grid,
+                    const std::vector<PhotonHit>& hits, PassGather& out) {
+  const float radius = search_radius(r2);
+  const double inv_r2 = 1.0 / r2;
+  dvec3 phi(0.0), lap(0.0);
+  uint64_t count = 0;
+  grid.query(point.position, radius, [&](uint32_t k, float dist2) {
+    const PhotonHit& h = hits[k];
+    // Same side only (ESTIMATOR.md section 3): the photon must arrive from the half-space the
+    // point is seen from, on a surface facing the same way (not the back of a thin wall).
+    const float cos_g = glm::dot(h.wi, point.normal);
+    if (cos_g <= 0.0f || glm::dot(h.normal, point.normal) <= 0.0f) return;
+    const float cos_s = glm::dot(h.wi, point.shading);
+    ++count;  // it could contribute, so it counts toward the radius reduction
+    if (cos_s <= 0.0f) return;
+    // Photon density is flux per area of the true surface; reflected radiance integrates
+    // against the shading cosine, hence cos_s / cos_g.
+    const dvec3 flux = dvec3(h.flux) * double(cos_s / cos_g);
+    const double t = std::min(1.0, std::sqrt(double(dist2) * inv_r2));
+    phi += kernel::weight(t) * flux;
+    lap += kernel::laplacian_weight_r2(t) * flux;
+  });
+  const dvec3 f(point.f);
+  out.phi += f * phi;
+  out.phi_lap_r2 += f * lap;
+  out.count += count;
+}
+
+dvec3 direct_light(const World& world, const MeasurementPoint& point, Rng& rng) {
+  DirectSample s;
+  if (!world.lights().sample_direct(point.position, rng, s)) return dvec3(0.0);
+  const float cos_s = glm::dot(s.wi, point.shading);
+  if (cos_s <= 0.0f || glm::dot(s.wi, point.normal) <= 0.0f) return dvec3(0.0);
+  if (world.occluded(point.position, point.normal, s.wi, s.distance)) return dvec3(0.0);
+  return dvec3(point.f * s.li * cos_s);
+}
+
+void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
+                 const HashGrid& grid, const std::vector<PhotonHit>& hits,
+                 std::span<PassGather> out) {
+  for (size_t k = 0; k < points.size(); ++k) {
+    out[k] = PassGather{};
+    gather_photons(points[k], states[k].r2, grid, hits, out[k]);
+  }
+}
+
+void next_event_pass(const World& world, std::span<const MeasurementPoint> points, uint64_t seed,
+                     uint64_t pass, size_t first, std::span<PassGather> out) {
+  for (size_t k = 0; k < points.size(); ++k) {
+    Rng rng(seed, pass, first + k, Stream::DirectLight);
+    out[k].direct = direct_light(world, points[k], rng);
+  }
+}
+
+void fold_pass(std::span<PointState> states, std::span<const PassGather> sums,
+               const EstimatorParams& params, uint64_t pass, std::span<float> radii,
+               PointState* copy) {
+  for (size_t k = 0; k < states.size(); ++k) {
+    accumulate_pass(states[k], sums[k], params, pass);
+    radii[k] = search_radius(states[k].r2);
+    if (copy) stream_copy(copy + k, states[k]);
+  }
+  if (copy) store_fence();  // the streamed stores are visible before the writer reads them
+}
+
+}  // namespace pb
