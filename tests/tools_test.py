@@ -3,17 +3,25 @@
 
   tools_test.py smoke --photonbound EXE       a tiny study (plane, 16x16, two targets, both
                                              confidences): the table and plots are written and
-                                             the table agrees with `photonbound compare --json`;
-                                             then the Cornell sweep, whose shipped reference
-                                             must be 10x below its smallest actual error
-  tools_test.py bad-input --photonbound EXE  missing files, wrong channels and bad options end
-                                             with one line on stderr and a non-zero exit
+                                             the table agrees with `photonbound compare --json`,
+                                             and references and renders have the channels of
+                                             channels.def; then the Cornell sweep, whose
+                                             shipped reference must be 10x below its smallest
+                                             actual error; then the glTF reader
+                                             (tools/gltf_scene.py) on .gltf, .glb, external
+                                             buffers, a node hierarchy and interleaved data
+  tools_test.py bad-input --photonbound EXE  missing files, wrong channels, bad options and
+                                             unreadable glTF end with one line on stderr and a
+                                             non-zero exit
 """
 
 import argparse
+import base64
 import json
+import math
 import os
 import shutil
+import struct
 import subprocess
 import sys
 import tempfile
@@ -22,6 +30,7 @@ import numpy as np
 
 TOOLS = os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "tools")
 sys.path.insert(0, TOOLS)
+import gltf_scene  # noqa: E402
 import pbtools  # noqa: E402
 
 PYTHON = sys.executable
@@ -77,6 +86,9 @@ def smoke(exe, tmp):
         results = json.load(f)
     check(len(results) == len(rows), "results.json and table.md differ in rows")
     ref = os.path.join(out, "references", "plane_16x16_exact.exr")
+    layout = sorted(pbtools.channel_names())
+    check(sorted(pbtools.read_exr(ref).planes) == layout,
+          f"{ref}: channels {sorted(pbtools.read_exr(ref).planes)}, not {layout}")
     for row in rows:
         conf = int(row["confidence"].rstrip("%"))
         target = float(row["target"])
@@ -92,7 +104,9 @@ def smoke(exe, tmp):
               f"{exr}: table says coverage {row['coverage']}, compare says {c['coverage']}")
         check(abs(float(row["specified / actual"]) - target / c["mean_abs_error"]) <=
               0.005 + 1e-3 * target / c["mean_abs_error"], f"{exr}: specified / actual is off")
-        meta = pbtools.read_exr(exr).metadata
+        img = pbtools.read_exr(exr)
+        check(sorted(img.planes) == layout, f"{exr}: channels {sorted(img.planes)}, not {layout}")
+        meta = img.metadata
         passes = int(meta["photonbound:passes_done"])
         check(int(row["passes"]) == passes, f"{exr}: passes {row['passes']} vs {passes}")
         check(float(row["photons"]) == float(f"{int(meta['photonbound:photons_emitted']):.3g}"),
@@ -113,6 +127,7 @@ def smoke(exe, tmp):
     leftovers = [f for _, _, fs in os.walk(out) for f in fs if f.startswith(".")]
     check(not leftovers, f"temporary files left behind: {leftovers}")
     cornell_reference_margin(exe, tmp)
+    gltf_reading(tmp)
 
 
 def cornell_reference_margin(exe, tmp):
@@ -137,6 +152,132 @@ def cornell_reference_margin(exe, tmp):
     check(study.reference_warning("x", 0.0, 0.01) is None, "warning for an exact reference")
 
 
+def test_gltf_document():
+    """A small scene that exercises the reader: one bufferView of interleaved POSITION and
+    NORMAL (byteStride 24), UNSIGNED_SHORT indices, a mirroring "matrix" under a TRS parent,
+    a camera turned by a quaternion, spot and point lights, and materials relying on the glTF
+    defaults. Returns (JSON document, binary buffer)."""
+    verts = [((0, 0, 0), (0, 0, 1)), ((1, 0, 0), (0, 0, 1)), ((0, 1, 0), (0, 0, 1))]
+    data = b"".join(struct.pack("<6f", *p, *n) for p, n in verts)
+    data += struct.pack("<3H", 0, 1, 2) + b"\0\0"
+    h = math.sqrt(0.5)
+    doc = {
+        "asset": {"version": "2.0"}, "scene": 0, "scenes": [{"nodes": [0]}],
+        "nodes": [
+            {"translation": [0, 0, 5], "children": [1, 2, 3, 4]},
+            {"mesh": 0, "matrix": [-1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 1, 0, 0, 1]},
+            {"camera": 0, "rotation": [0, h, 0, h]},
+            {"translation": [0, 1, 0], "scale": [2, 2, 2],
+             "extensions": {"KHR_lights_punctual": {"light": 0}}},
+            {"extensions": {"KHR_lights_punctual": {"light": 1}}}],
+        "cameras": [{"type": "perspective", "perspective": {"yfov": 0.5, "aspectRatio": 1.5,
+                                                           "znear": 0.1}}],
+        "extensions": {"KHR_lights_punctual": {"lights": [
+            {"type": "spot", "intensity": 3, "spot": {"outerConeAngle": 0.5}},
+            {"type": "point", "color": [1, 0.5, 0], "intensity": 4}]}},
+        "materials": [
+            {"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 0.125, 1],
+                                      "metallicFactor": 0}, "emissiveFactor": [1, 2, 3],
+             "extensions": {"KHR_materials_emissive_strength": {"emissiveStrength": 2}}},
+            {},
+            {"extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
+                            "KHR_materials_ior": {"ior": 1.3}}}],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2,
+                                    "material": 0}]}],
+        "buffers": [{"byteLength": len(data)}],
+        "bufferViews": [{"buffer": 0, "byteOffset": 0, "byteLength": 72, "byteStride": 24},
+                        {"buffer": 0, "byteOffset": 72, "byteLength": 6}],
+        "accessors": [
+            {"bufferView": 0, "componentType": 5126, "count": 3, "type": "VEC3",
+             "min": [0, 0, 0], "max": [1, 1, 0]},
+            {"bufferView": 0, "byteOffset": 12, "componentType": 5126, "count": 3,
+             "type": "VEC3"},
+            {"bufferView": 1, "componentType": 5123, "count": 3, "type": "SCALAR"}],
+    }
+    return doc, data
+
+
+def write_glb(path, doc, data):
+    js = json.dumps(doc).encode()
+    js += b" " * (-len(js) % 4)
+    data += b"\0" * (-len(data) % 4)
+    with open(path, "wb") as f:
+        f.write(struct.pack("<III", 0x46546C67, 2, 28 + len(js) + len(data)) +
+                struct.pack("<II", len(js), 0x4E4F534A) + js +
+                struct.pack("<II", len(data), 0x004E4942) + data)
+
+
+def write_gltf(path, doc, data):
+    doc = json.loads(json.dumps(doc))
+    doc["buffers"][0]["uri"] = ("data:application/octet-stream;base64," +
+                                base64.b64encode(data).decode())
+    with open(path, "w") as f:
+        json.dump(doc, f)
+
+
+def gltf_reading(tmp):
+    """tools/gltf_scene.py: the shipped plane_point family (.gltf, .glb, external buffer, node
+    hierarchy) reads the same in world space, and a hand-made file reads as worked out here."""
+    scenes = os.path.join(pbtools.REPO, "scenes")
+    base = pbtools.Gltf(os.path.join(scenes, "plane_point.gltf"))
+    for name in ("plane_point.glb", "plane_point_external.gltf", "nested.gltf"):
+        other = pbtools.Gltf(os.path.join(scenes, name))
+        a, b = base.camera(), other.camera()
+        check(all(np.allclose(a[k], b[k], atol=1e-12) for k in a if k != "aspect"),
+              f"{name}: camera {b} differs from plane_point.gltf's {a}")
+        check(all(np.allclose(x, y, atol=1e-12) for (p, i), (q, j) in
+                  zip(base.point_lights(), other.point_lights()) for x, y in ((p, q), (i, j))),
+              f"{name}: point lights differ from plane_point.gltf's")
+        check(all(np.allclose(x, y, atol=1e-7) for (lo, hi, _), (lo2, hi2, _) in
+                  zip(base.mesh_instances(), other.mesh_instances())
+                  for x, y in ((lo, lo2), (hi, hi2))),
+              f"{name}: mesh bounds differ from plane_point.gltf's")
+    refs = []
+    for name in ("plane_point.gltf", "plane_point.glb"):  # reference.py reads both containers
+        refs.append(os.path.join(tmp, name + ".exr"))
+        p = run_tool("reference.py", "exact", "plane", "-o", refs[-1], "--resolution", "8x8",
+                     "--scene", os.path.join(scenes, name))
+        check(p.returncode == 0, f"reference.py exact plane --scene {name}: {p.stderr.strip()}")
+    if all(os.path.isfile(r) for r in refs):
+        a, b = (pbtools.read_exr(r).rgb() for r in refs)
+        check(np.array_equal(a, b), "the exact plane differs between the .gltf and the .glb")
+    doc, data = test_gltf_document()
+    near = lambda a, b: a is not None and np.allclose(a, b, atol=1e-12)  # noqa: E731
+    for name, write in (("test.glb", write_glb), ("test.gltf", write_gltf)):
+        path = os.path.join(tmp, name)
+        write(path, doc, data)
+        try:
+            s = gltf_scene.load(path)
+        except pbtools.ToolError as e:
+            check(False, f"{name}: not read: {e}")
+            continue
+        (inst,) = s.meshes
+        (prim,) = inst.primitives
+        check(inst.mirrored and prim.indices == [0, 2, 1],
+              f"{name}: mirrored mesh indices {prim.indices}, expected [0, 2, 1]")
+        check(near(prim.positions, [(1, 0, 5), (0, 0, 5), (1, 1, 5)]),
+              f"{name}: world positions {prim.positions}")
+        check(near(prim.normals, [(0, 0, 1)] * 3), f"{name}: world normals {prim.normals}")
+        m = prim.material
+        check(m.base_color == (0.5, 0.25, 0.125) and m.metallic == 0 and m.roughness == 1 and
+              m.emission == (2, 4, 6) and m.model == "lambertian",
+              f"{name}: material 0 read as {vars(m)}")
+        d, g = s.materials[1], s.materials[2]
+        check(d.base_color == (1, 1, 1) and d.metallic == 1 and d.model == "mirror" and
+              d.emission == (0, 0, 0), f"{name}: material 1 (all defaults) read as {vars(d)}")
+        check(g.model == "dielectric" and g.ior == 1.3, f"{name}: material 2 read as {vars(g)}")
+        (cam,) = s.cameras
+        check(near(cam.position, (0, 0, 5)) and near(cam.forward, (-1, 0, 0)) and
+              near(cam.up, (0, 1, 0)) and near(cam.right, (0, 0, -1)) and cam.yfov == 0.5 and
+              cam.aspect == 1.5, f"{name}: camera read as {vars(cam)}")
+        spot, point = s.lights
+        check(spot.type == "spot" and near(spot.position, (0, 1, 5)) and
+              near(spot.direction, (0, 0, -1)) and spot.intensity == (3, 3, 3) and
+              spot.inner_cone == 0 and spot.outer_cone == 0.5, f"{name}: spot read as {vars(spot)}")
+        check(point.type == "point" and near(point.position, (0, 0, 5)) and
+              point.intensity == (4, 2, 0), f"{name}: point light read as {vars(point)}")
+
+
 def expect_failure(what, p, needle):
     lines = p.stderr.strip().splitlines()
     check(p.returncode != 0, f"{what}: exit code 0")
@@ -149,9 +290,9 @@ def bad_input(exe, tmp):
     expect_failure("views of a missing file", run_tool("views.py", missing, "-o", tmp), missing)
     rgb_only = os.path.join(tmp, "rgb_only.exr")
     z = np.zeros((4, 4), np.float32)
-    pbtools.write_exr(rgb_only, {"R": z, "G": z, "B": z}, {})
+    pbtools.write_exr(rgb_only, {pbtools.channel("Radiance", c): z for c in pbtools.RGB}, {})
     expect_failure("views of an EXR without bounds", run_tool("views.py", rgb_only, "-o", tmp),
-                   "has no channel ErrorBound.R")
+                   "has no channel " + pbtools.channel("ErrorBound", "R"))
     check(not any(f.endswith(".png") for f in os.listdir(tmp)), "views wrote PNGs for bad input")
     text = os.path.join(tmp, "not_a_log.jsonl")
     with open(text, "w") as f:
@@ -176,6 +317,44 @@ def bad_input(exe, tmp):
                    "is not a horizontal plane")
     expect_failure("bad resolution", run_tool("reference.py", "exact", "box", "-o", rgb_only,
                                               "--resolution", "8by8"), "expected WxH")
+    bad_gltf(tmp, rgb_only)
+
+
+def bad_gltf(tmp, out):
+    """Files tools/gltf_scene.py cannot read: one line naming the file and what is wrong."""
+    doc, data = test_gltf_document()
+    cases = []
+    path = os.path.join(tmp, "bad_header.glb")
+    with open(path, "wb") as f:
+        f.write(b"glTF" + struct.pack("<II", 1, 20) + b"\0" * 8)
+    cases.append(("a GLB with a bad header", path, "bad GLB header"))
+    path = os.path.join(tmp, "lost_buffer.gltf")
+    lost = json.loads(json.dumps(doc))
+    lost["buffers"][0]["uri"] = "lost.bin"
+    with open(path, "w") as f:
+        json.dump(lost, f)
+    cases.append(("a glTF whose buffer is missing", path, "cannot read lost.bin"))
+    path = os.path.join(tmp, "sparse.glb")
+    sparse = json.loads(json.dumps(doc))
+    sparse["accessors"][0]["sparse"] = {"count": 1}
+    write_glb(path, sparse, data)
+    cases.append(("a sparse accessor", path, "sparse accessors are not read"))
+    path = os.path.join(tmp, "overflow.gltf")
+    over = json.loads(json.dumps(doc))
+    over["accessors"][1]["count"] = 4
+    write_gltf(path, over, data)
+    cases.append(("an accessor past its bufferView", path, "accessor 1 overflows"))
+    path = os.path.join(tmp, "cycle.gltf")
+    cycle = json.loads(json.dumps(doc))
+    cycle["nodes"][1]["children"] = [0]
+    write_gltf(path, cycle, data)
+    cases.append(("a node cycle", path, "node 0 reached twice"))
+    for what, path, needle in cases:
+        p = run_tool("reference.py", "exact", "plane", "-o", out, "--resolution", "8x8",
+                     "--scene", path)
+        expect_failure(what, p, needle)
+        check(p.stderr.startswith(f"reference: {path}: "),
+              f"{what}: the message does not name the file: {p.stderr.strip()!r}")
 
 
 def main():

@@ -2,9 +2,10 @@
 """Generates the glTF 2.0 scenes in scenes/ (run from anywhere: python3 tools/make_scenes.py).
 
 Standard library only, deterministic (identical bytes on every run). After writing, every
-file is read back and validated (JSON / GLB container, accessors, min/max, index ranges,
-winding against normals, closed glass meshes, extensions), and one summary line per scene
-is printed. Conventions: y up, metres, counter-clockwise winding = front face.
+file is read back with tools/gltf_scene.py (the tools' one glTF reader, also standard library
+only) and validated (JSON / GLB container, accessors, min/max, index ranges, winding against
+normals, closed glass meshes, extensions), and one summary line per scene is printed.
+Conventions: y up, metres, counter-clockwise winding = front face.
 
 Scenes (analytic answers are radiances in the renderer's units):
 
@@ -53,20 +54,18 @@ python3 tools/make_scenes.py --heavy DIR):
 import base64
 import json
 import math
+import os
 import struct
 import sys
 from pathlib import Path
 
-FLOAT, UINT = 5126, 5125  # glTF componentType
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import gltf_scene  # noqa: E402  (the tools' one glTF reader; standard library only)
+from gltf_scene import (EXT_IOR, EXT_LIGHTS, EXT_STRENGTH, EXT_TRANSMISSION, FLOAT,  # noqa: E402
+                        GLB_BIN, GLB_JSON, GLB_MAGIC, TRIANGLES)
+from gltf_scene import UNSIGNED_INT as UINT  # noqa: E402
+
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
-TRIANGLES = 4
-
-EXT_LIGHTS = "KHR_lights_punctual"
-EXT_TRANSMISSION = "KHR_materials_transmission"
-EXT_IOR = "KHR_materials_ior"
-EXT_STRENGTH = "KHR_materials_emissive_strength"
-
-GLB_MAGIC, GLB_JSON, GLB_BIN = 0x46546C67, 0x4E4F534A, 0x004E4942
 
 # ----------------------------------------------------------------------------- vector math
 
@@ -138,31 +137,6 @@ def matrix_columns(rotation_rows, translation):
     for c in range(3):
         cols += [rotation_rows[r][c] for r in range(3)] + [0.0]
     return [x if abs(x) > 1e-15 else 0.0 for x in cols] + list(translation) + [1.0]
-
-
-def matmul4(a, b):
-    """Product of two column-major 4x4 matrices (flat lists)."""
-    return [sum(a[k * 4 + r] * b[c * 4 + k] for k in range(4)) for c in range(4) for r in range(4)]
-
-
-def trs_matrix(node):
-    """Column-major local matrix of a glTF node (its "matrix", or T * R * S)."""
-    if "matrix" in node:
-        return list(node["matrix"])
-    x, y, z, w = node.get("rotation", [0, 0, 0, 1])
-    sx, sy, sz = node.get("scale", [1, 1, 1])
-    tx, ty, tz = node.get("translation", [0, 0, 0])
-    r = [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-         [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-         [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
-    s = (sx, sy, sz)
-    cols = [v for c in range(3) for v in (r[0][c] * s[c], r[1][c] * s[c], r[2][c] * s[c], 0.0)]
-    return cols + [tx, ty, tz, 1.0]
-
-
-def transform(m, v, w):
-    """Column-major 4x4 m applied to (v, w); w = 1 for points, 0 for directions."""
-    return tuple(m[r] * v[0] + m[4 + r] * v[1] + m[8 + r] * v[2] + m[12 + r] * w for r in range(3))
 
 
 # ----------------------------------------------------------------------------- geometry
@@ -583,56 +557,6 @@ def check(cond, msg):
         raise Invalid(msg)
 
 
-def read_document(path):
-    """(JSON document, list of buffer bytes) from a .gltf or .glb file."""
-    raw = path.read_bytes()
-    glb_bin = None
-    if path.suffix == ".glb":
-        magic, version, total = struct.unpack_from("<III", raw, 0)
-        check(magic == GLB_MAGIC and version == 2, "bad GLB header")
-        check(total == len(raw), "GLB length field != file size")
-        jlen, jtype = struct.unpack_from("<II", raw, 12)
-        check(jtype == GLB_JSON and jlen % 4 == 0, "bad GLB JSON chunk")
-        doc = json.loads(raw[20:20 + jlen].decode())
-        off = 20 + jlen
-        blen, btype = struct.unpack_from("<II", raw, off)
-        check(btype == GLB_BIN and blen % 4 == 0, "bad GLB BIN chunk")
-        check(off + 8 + blen == total, "GLB chunks do not fill the file")
-        glb_bin = raw[off + 8:off + 8 + blen]
-    else:
-        doc = json.loads(raw.decode())
-    buffers = []
-    for i, buf in enumerate(doc["buffers"]):
-        uri = buf.get("uri")
-        if uri is None:
-            check(i == 0 and glb_bin is not None, "buffer without uri outside a GLB")
-            data = glb_bin
-        elif uri.startswith("data:"):
-            check(uri.startswith("data:application/octet-stream;base64,"), "bad data URI")
-            data = base64.b64decode(uri.split(",", 1)[1])
-        else:
-            data = (path.parent / uri).read_bytes()
-        check(buf["byteLength"] <= len(data), f"buffer {i} shorter than byteLength")
-        buffers.append(data)
-    return doc, buffers
-
-
-def read_accessor(doc, buffers, index):
-    acc = doc["accessors"][index]
-    view = doc["bufferViews"][acc["bufferView"]]
-    comps = {"SCALAR": 1, "VEC3": 3}[acc["type"]]
-    fmt = {FLOAT: "f", UINT: "I"}[acc["componentType"]]
-    start = view.get("byteOffset", 0) + acc.get("byteOffset", 0)
-    size = 4 * comps * acc["count"]
-    check(acc.get("byteOffset", 0) + size <= view["byteLength"], f"accessor {index} overflows")
-    check(view.get("byteOffset", 0) + view["byteLength"] <= doc["buffers"][view["buffer"]][
-        "byteLength"], f"bufferView of accessor {index} overflows its buffer")
-    values = struct.unpack_from("<" + fmt * comps * acc["count"], buffers[view["buffer"]], start)
-    if comps == 1:
-        return acc, list(values)
-    return acc, [tuple(values[i:i + 3]) for i in range(0, len(values), 3)]
-
-
 def used_extensions(obj, found):
     if isinstance(obj, dict):
         found.update(obj.get("extensions", {}))
@@ -644,22 +568,18 @@ def used_extensions(obj, found):
     return found
 
 
-def validate_primitive(doc, buffers, prim, where):
-    check(prim.get("mode", TRIANGLES) == TRIANGLES, f"{where}: not TRIANGLES")
-    check(0 <= prim["material"] < len(doc["materials"]), f"{where}: bad material")
-    acc, pos = read_accessor(doc, buffers, prim["attributes"]["POSITION"])
-    check(acc["componentType"] == FLOAT and acc["type"] == "VEC3", f"{where}: POSITION type")
+def validate_primitive(prim, where):
+    """What the reader (tools/gltf_scene.py) accepts but these scenes must not have."""
+    acc, pos = prim.position_accessor, prim.local_positions
     for c in range(3):
         check(acc["min"][c] == min(p[c] for p in pos) and acc["max"][c] == max(p[c] for p in pos),
               f"{where}: POSITION min/max do not match the data")
-    acc, idx = read_accessor(doc, buffers, prim["indices"])
-    check(acc["componentType"] == UINT and acc["type"] == "SCALAR", f"{where}: index type")
-    check(len(idx) % 3 == 0 and len(idx) > 0, f"{where}: index count not a multiple of 3")
-    check(max(idx) < len(pos), f"{where}: index out of range")
-    nrm = None
-    if "NORMAL" in prim["attributes"]:
-        acc, nrm = read_accessor(doc, buffers, prim["attributes"]["NORMAL"])
-        check(len(nrm) == len(pos), f"{where}: NORMAL count != POSITION count")
+    acc, idx = prim.index_accessor, prim.local_indices
+    check(acc is not None and acc["componentType"] == UINT, f"{where}: index type")
+    check(len(idx) > 0, f"{where}: index count not a multiple of 3")
+    check(prim.material is not None, f"{where}: bad material")
+    nrm = prim.local_normals
+    if nrm is not None:
         check(all(abs(length(n) - 1.0) < 1e-5 for n in nrm), f"{where}: normals not unit")
     for t in range(0, len(idx), 3):
         a, b, c = idx[t:t + 3]
@@ -668,45 +588,23 @@ def validate_primitive(doc, buffers, prim, where):
         if nrm is not None:
             check(dot(g, add(add(nrm[a], nrm[b]), nrm[c])) > 0,
                   f"{where}: triangle {t // 3} winding disagrees with its normals")
-    return pos, idx
 
 
-def flatten(doc, buffers):
-    """World-space content: {"prims": [(material, [triangle]...)], "lights", "cameras"}."""
-    out = {"prims": [], "lights": [], "cameras": []}
-    lights = doc.get("extensions", {}).get(EXT_LIGHTS, {}).get("lights", [])
-    seen = set()
-
-    def visit(i, parent):
-        check(i not in seen, f"node {i} reached twice")
-        seen.add(i)
-        node = doc["nodes"][i]
-        check(not ("matrix" in node and any(k in node for k in ("translation", "rotation",
-                                                                  "scale"))),
-              f"node {i}: matrix together with TRS")
-        m = matmul4(parent, trs_matrix(node))
-        if "mesh" in node:
-            for p, prim in enumerate(doc["meshes"][node["mesh"]]["primitives"]):
-                pos, idx = validate_primitive(doc, buffers, prim, f"mesh {node['mesh']} prim {p}")
-                world = [transform(m, v, 1.0) for v in pos]
-                tris = [tuple(world[k] for k in idx[t:t + 3]) for t in range(0, len(idx), 3)]
-                out["prims"].append((doc["materials"][prim["material"]], tris))
-        if "camera" in node:
-            cam = doc["cameras"][node["camera"]]
-            check(cam["type"] == "perspective" and cam["perspective"]["yfov"] > 0, "camera")
-            out["cameras"].append((transform(m, (0, 0, 0), 1.0),
-                                   normalize(transform(m, (0, 0, -1), 0.0)),
-                                   normalize(transform(m, (0, 1, 0), 0.0)), cam["perspective"]))
-        if EXT_LIGHTS in node.get("extensions", {}):
-            light = lights[node["extensions"][EXT_LIGHTS]["light"]]
-            out["lights"].append((transform(m, (0, 0, 0), 1.0),
-                                  normalize(transform(m, (0, 0, -1), 0.0)), light))
-        for c in node.get("children", []):
-            visit(c, m)
-
-    identity = [1.0 if r == c else 0.0 for c in range(4) for r in range(4)]
-    for root in doc["scenes"][doc.get("scene", 0)]["nodes"]:
-        visit(root, identity)
+def flatten(scene):
+    """World-space content of a gltf_scene.Scene: {"prims": [(Material, [triangle]...)],
+    "lights": [Light], "cameras": [Camera]}."""
+    for node in scene.nodes:
+        check(not ("matrix" in node.json and any(k in node.json for k in ("translation",
+                                                                            "rotation", "scale"))),
+              f"node {node.index}: matrix together with TRS")
+    out = {"prims": [], "lights": list(scene.lights), "cameras": []}
+    for inst in scene.meshes:
+        for prim in inst.primitives:
+            validate_primitive(prim, f"mesh {inst.mesh} prim {prim.index}")
+            out["prims"].append((prim.material, prim.triangles))
+    for cam in scene.cameras:
+        check(cam.type == "perspective" and cam.yfov > 0, "camera")
+        out["cameras"].append(cam)
     return out
 
 
@@ -727,15 +625,6 @@ def closed_volume(tris):
     return sum(dot(t[0], cross(t[1], t[2])) for t in tris) / 6.0
 
 
-def is_glass(mat):
-    return EXT_TRANSMISSION in mat.get("extensions", {})
-
-
-def emitted_radiance(mat):
-    s = mat.get("extensions", {}).get(EXT_STRENGTH, {}).get("emissiveStrength", 1.0)
-    return [c * s for c in mat.get("emissiveFactor", [0, 0, 0])]
-
-
 def near(a, b, eps=1e-6):
     return all(abs(x - y) <= eps for x, y in zip(a, b))
 
@@ -745,30 +634,32 @@ def same_content(a, b):
     if len(a["prims"]) != len(b["prims"]) or len(a["lights"]) != len(b["lights"]):
         return False
     for (ma, ta), (mb, tb) in zip(a["prims"], b["prims"]):
-        if ma != mb or len(ta) != len(tb):
+        if ma.json != mb.json or len(ta) != len(tb):
             return False
         if not all(near(p, q) for x, y in zip(ta, tb) for p, q in zip(x, y)):
             return False
-    for (pa, da, la), (pb, db, lb) in zip(a["lights"], b["lights"]):
-        if not (near(pa, pb) and near(da, db) and la == lb):
+    for la, lb in zip(a["lights"], b["lights"]):
+        if not (near(la.position, lb.position) and near(la.direction, lb.direction) and
+                la.json == lb.json):
             return False
     return len(a["cameras"]) == len(b["cameras"]) and all(
-        near(x[0], y[0]) and near(x[1], y[1]) and near(x[2], y[2]) and x[3] == y[3]
+        near(x.position, y.position) and near(x.forward, y.forward) and near(x.up, y.up) and
+        x.json.get("perspective") == y.json.get("perspective")
         for x, y in zip(a["cameras"], b["cameras"]))
 
 
 def check_cornell(s):
     for mat, tris in s["prims"]:
-        if mat["name"] in ("white", "red", "green"):
+        if mat.name in ("white", "red", "green"):
             check(all(dot(tri_normal(t), sub((0, 1, 0), t[0])) > 0 for t in tris),
                   "Cornell walls must face into the box")
-        if mat["name"] == "light":
+        if mat.name == "light":
             check(all(near(tri_normal(t), (0, -1, 0)) for t in tris), "light must face -y")
 
 
 def check_faces_up(s):
     for mat, tris in s["prims"]:
-        if not is_glass(mat) and not any(emitted_radiance(mat)):
+        if mat.model != "dielectric" and not any(mat.emission):
             check(all(near(tri_normal(t), (0, 1, 0)) for t in tris), "floor must face +y")
 
 
@@ -778,7 +669,7 @@ def check_closed_box(s):
 
 def check_spot(s):
     check_faces_up(s)
-    check(near(s["lights"][0][1], (0, -1, 0)), "spot must point down")
+    check(near(s["lights"][0].direction, (0, -1, 0)), "spot must point down")
 
 
 SCENE_CHECKS = {"cornell.gltf": check_cornell, "cornell_heavy.glb": check_cornell,
@@ -794,30 +685,31 @@ def fmt_vec(v):
 
 def validate(path):
     """Validates one written file; returns (flattened scene, one-line summary)."""
-    doc, buffers = read_document(path)
+    scene = gltf_scene.load(path)
+    doc = scene.json
     check(doc["asset"]["version"] == "2.0", "asset.version")
     undeclared = used_extensions(doc, set()) - set(doc.get("extensionsUsed", []))
     check(not undeclared, f"extensions not in extensionsUsed: {sorted(undeclared)}")
-    s = flatten(doc, buffers)
+    s = flatten(scene)
     for mat, tris in s["prims"]:
-        pbr = mat["pbrMetallicRoughness"]
-        check("metallicFactor" in pbr, f"material {mat['name']}: metallicFactor must be explicit")
-        if is_glass(mat):
-            check(closed_volume(tris) > 0, f"glass {mat['name']}: must be closed, outward")
+        pbr = mat.json["pbrMetallicRoughness"]
+        check("metallicFactor" in pbr, f"material {mat.name}: metallicFactor must be explicit")
+        if mat.model == "dielectric":
+            check(closed_volume(tris) > 0, f"glass {mat.name}: must be closed, outward")
     check(len(s["cameras"]) == 1, "exactly one camera expected")
-    emitters = [(mat, tris) for mat, tris in s["prims"] if any(emitted_radiance(mat))]
+    emitters = [(mat, tris) for mat, tris in s["prims"] if any(mat.emission)]
     check(s["lights"] or emitters, "no light")
     SCENE_CHECKS.get(path.name, lambda _: None)(s)
 
     tris = sum(len(t) for _, t in s["prims"])
-    lights = [f"{l['type']} I={l['intensity']:g} at {fmt_vec(p)}" for p, _, l in s["lights"]]
-    lights += [f"emitter '{m['name']}' Le={max(emitted_radiance(m)):g} "
+    lights = [f"{l.type} I={l.json['intensity']:g} at {fmt_vec(l.position)}" for l in s["lights"]]
+    lights += [f"emitter '{m.name}' Le={max(m.emission):g} "
                f"area={sum(length(cross(sub(t[1], t[0]), sub(t[2], t[0]))) / 2 for t in ts):.3g}"
                for m, ts in emitters]
-    eye, fwd, _, persp = s["cameras"][0]
+    cam = s["cameras"][0]
     summary = (f"{path.name:27s} {tris:5d} tris, {len(s['prims'])} prims, "
-               f"{len(doc['materials'])} mats, {'; '.join(lights)}; camera {fmt_vec(eye)} "
-               f"-> {fmt_vec(fwd)} yfov {persp['yfov']:g}, {path.stat().st_size} bytes")
+               f"{len(doc['materials'])} mats, {'; '.join(lights)}; camera {fmt_vec(cam.position)} "
+               f"-> {fmt_vec(cam.forward)} yfov {cam.yfov:g}, {path.stat().st_size} bytes")
     return s, summary
 
 
@@ -845,6 +737,8 @@ def write_heavy(out_dir):
     write(build(), out_dir / name)
     try:
         _, summary = validate(out_dir / name)
+    except gltf_scene.GltfError as e:
+        raise SystemExit(f"make_scenes: {name}: INVALID: {e.detail}")
     except (Invalid, KeyError, ValueError, struct.error) as e:
         raise SystemExit(f"make_scenes: {name}: INVALID: {e}")
     print(summary)
@@ -864,6 +758,8 @@ def main():
     for name, _, _ in OUTPUTS:
         try:
             flat[name], summary = validate(out_dir / name)
+        except gltf_scene.GltfError as e:
+            raise SystemExit(f"make_scenes: {name}: INVALID: {e.detail}")
         except (Invalid, KeyError, ValueError, struct.error) as e:
             raise SystemExit(f"make_scenes: {name}: INVALID: {e}")
         print(summary)

@@ -1,14 +1,19 @@
 """Shared helpers of the Python tools in tools/ (views, plots, references, the study).
 
+EXR channel names come from include/photonbound/channels.def (channel(), rgb_prefix(),
+channel_names()); glTF scenes are read by tools/gltf_scene.py (Gltf wraps it in numpy).
+
 Runs with /usr/bin/python3 and the Debian packages python3-numpy, python3-matplotlib and
 python3-openimageio (tools/install-deps.sh installs them). Every failure a user can cause
 (missing file, wrong channels, bad glTF) raises ToolError with a one-line message; each tool's
 main() turns it into that line on stderr and a non-zero exit.
 """
 
+import functools
 import json
 import math
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -20,12 +25,15 @@ try:
 except ImportError:  # the tools are meant for /usr/bin/python3 with the Debian package
     oiio = None
 
-RGB = ("R", "G", "B")
-REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+TOOLS = os.path.dirname(os.path.abspath(__file__))
+if TOOLS not in sys.path:
+    sys.path.insert(0, TOOLS)
+import gltf_scene  # noqa: E402  (tools/gltf_scene.py: the glTF reader, standard library only)
+from gltf_scene import ToolError  # noqa: E402,F401  (a user-facing failure: one line)
 
-
-class ToolError(Exception):
-    """A user-facing failure: one line, no traceback."""
+REPO = os.path.dirname(TOOLS)
+RGB = ("R", "G", "B")  # the components of an RGB channel group (channels.def)
+CHANNELS_DEF = os.path.join(REPO, "include", "photonbound", "channels.def")
 
 
 def run_main(tool, main):
@@ -51,6 +59,71 @@ def _need_oiio():
 
 
 # ---------------------------------------------------------------------------------------------
+# The EXR channel layout: include/photonbound/channels.def, the table the C++ writer reads too
+
+_CHANNEL_LINE = re.compile(r'PB_CHANNEL\(\s*(\w+)\s*,\s*"([^"]*)"\s*,\s*(RGB|SCALAR)\s*,\s*'
+                           r'"((?:[^"\\]|\\.)*)"\s*\)\s*$')
+
+
+@functools.lru_cache(maxsize=None)
+def channel_groups():
+    """The channel groups in file order: (id, name, kind "RGB" or "SCALAR", meaning) each."""
+    try:
+        with open(CHANNELS_DEF, encoding="utf-8") as f:
+            lines = f.read().splitlines()
+    except OSError as e:
+        raise ToolError(f"{CHANNELS_DEF}: cannot read the channel table ({e.strerror})") from None
+    groups = []
+    for n, line in enumerate(lines, 1):
+        text = line.strip()
+        if not text or text.startswith("//"):
+            continue
+        m = _CHANNEL_LINE.match(text)
+        if m is None:
+            raise ToolError(f"{CHANNELS_DEF}:{n}: not a PB_CHANNEL(id, \"name\", RGB|SCALAR, "
+                            "\"meaning\") line")
+        groups.append(m.groups())
+    if not groups:
+        raise ToolError(f"{CHANNELS_DEF}: no PB_CHANNEL lines")
+    return tuple(groups)
+
+
+def _group(group_id):
+    for g in channel_groups():
+        if g[0] == group_id:
+            return g
+    raise ToolError(f"{CHANNELS_DEF}: no channel group {group_id}")
+
+
+def rgb_prefix(group_id):
+    """The prefix of an RGB group's channel names: "" for Radiance, "ErrorBound." ..."""
+    _, name, kind, _ = _group(group_id)
+    if kind != "RGB":
+        raise ToolError(f"{CHANNELS_DEF}: channel {group_id} is {kind}, not RGB")
+    return name + "." if name else ""
+
+
+def channel(group_id, component=None):
+    """The EXR channel name of a group, as src/channels.cpp makes it: channel("ErrorBound", "R")
+    or channel("ErrorBound", 0) is "ErrorBound.R", channel("Radiance", "G") is "G"; a SCALAR
+    group takes no component: channel("Photons") is "Photons"."""
+    _, name, kind, _ = _group(group_id)
+    if kind == "SCALAR":
+        if component is not None:
+            raise ToolError(f"{CHANNELS_DEF}: channel {group_id} is SCALAR; it has no "
+                            f"component {component}")
+        return name
+    if component not in RGB and component not in range(3):
+        raise ToolError(f"{CHANNELS_DEF}: channel {group_id} is RGB: give R, G, B or 0 .. 2")
+    return rgb_prefix(group_id) + (RGB[component] if isinstance(component, int) else component)
+
+
+def channel_names():
+    """Every channel name in file order (the layout photonbound writes)."""
+    return [channel(g[0], c) for g in channel_groups() for c in (RGB if g[2] == "RGB" else (None,))]
+
+
+# ---------------------------------------------------------------------------------------------
 # EXR images
 
 
@@ -71,9 +144,9 @@ class Exr:
             raise ToolError(f"{self.path}: has no channel {name}")
         return self.planes[name]
 
-    def rgb(self, prefix=""):
-        """(height, width, 3) array of the channels PREFIX R, G, B."""
-        return np.stack([self.channel(prefix + c) for c in RGB], axis=-1)
+    def rgb(self, group="Radiance"):
+        """(height, width, 3) array of an RGB channel group of channels.def, by its id."""
+        return np.stack([self.channel(channel(group, c)) for c in RGB], axis=-1)
 
     def meta(self, key, default=None):
         return self.metadata.get(key, default)
@@ -233,106 +306,46 @@ def parse_resolution(text):
 
 
 # ---------------------------------------------------------------------------------------------
-# glTF: just enough to find the camera, lights and mesh bounds in world space
-
-
-def _quat_matrix(q):
-    x, y, z, w = q
-    return np.array([
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ])
-
-
-def _local_matrix(node):
-    if "matrix" in node:
-        return np.array(node["matrix"], dtype=float).reshape(4, 4).T  # glTF is column-major
-    m = np.eye(4)
-    s = np.diag(node.get("scale", [1.0, 1.0, 1.0]))
-    m[:3, :3] = _quat_matrix(node.get("rotation", [0.0, 0.0, 0.0, 1.0])) @ s
-    m[:3, 3] = node.get("translation", [0.0, 0.0, 0.0])
-    return m
+# glTF: tools/gltf_scene.py reads it; these are its camera, lights and meshes as numpy arrays
 
 
 class Gltf:
-    """World transforms of a .gltf file's nodes (JSON only: .glb is not read here)."""
+    """A .gltf or .glb scene in world space (read by gltf_scene.load; .scene is that Scene)."""
 
     def __init__(self, path):
-        if not os.path.isfile(path):
-            raise ToolError(f"{path}: no such file")
-        if not path.endswith(".gltf"):
-            raise ToolError(f"{path}: only .gltf (JSON) scenes are read by this tool")
-        try:
-            with open(path, encoding="utf-8") as f:
-                self.doc = json.load(f)
-        except (json.JSONDecodeError, UnicodeDecodeError) as e:
-            raise ToolError(f"{path}: not a glTF JSON file ({e})") from None
         self.path = path
-        nodes = self.doc.get("nodes", [])
-        parent = {}
-        for i, n in enumerate(nodes):
-            for c in n.get("children", []):
-                parent[c] = i
-        self.world = []
-        for i in range(len(nodes)):
-            m, k = np.eye(4), i
-            while k is not None:
-                m = _local_matrix(nodes[k]) @ m
-                k = parent.get(k)
-            self.world.append(m)
-
-    def nodes_with(self, key):
-        return [(i, n) for i, n in enumerate(self.doc.get("nodes", [])) if key in n]
+        self.scene = gltf_scene.load(path)
 
     def camera(self):
-        """The first perspective camera: position, forward, right, up (unit), yfov."""
-        for i, n in self.nodes_with("camera"):
-            cam = self.doc["cameras"][n["camera"]]
-            if cam.get("type") != "perspective":
-                continue
-            m = self.world[i]
-            unit = lambda v: v / np.linalg.norm(v)  # noqa: E731
-            return {
-                "position": m[:3, 3].copy(),
-                "right": unit(m[:3, 0]),
-                "up": unit(m[:3, 1]),
-                "forward": unit(-m[:3, 2]),
-                "yfov": float(cam["perspective"]["yfov"]),
-            }
-        raise ToolError(f"{self.path}: has no perspective camera")
+        """The first perspective camera: position, forward, right, up (unit), yfov, aspect
+        (None when the file gives none)."""
+        cam = self.scene.perspective_camera()
+        if cam is None:
+            raise ToolError(f"{self.path}: has no perspective camera")
+        return {"position": np.array(cam.position), "forward": np.array(cam.forward),
+                "right": np.array(cam.right), "up": np.array(cam.up), "yfov": cam.yfov,
+                "aspect": cam.aspect}
 
     def point_lights(self):
         """(position, radiant intensity per channel) of every KHR_lights_punctual point light."""
-        lights = self.doc.get("extensions", {}).get("KHR_lights_punctual", {}).get("lights", [])
         out = []
-        for i, n in self.nodes_with("extensions"):
-            ref = n["extensions"].get("KHR_lights_punctual")
-            if ref is None:
-                continue
-            light = lights[ref["light"]]
-            if light.get("type") != "point":
-                raise ToolError(f"{self.path}: light {light.get('name', ref['light'])} is not "
-                                "a point light")
-            intensity = np.array(light.get("color", [1, 1, 1]), float) * light.get("intensity", 1)
-            out.append((self.world[i][:3, 3].copy(), intensity))
+        for light in self.scene.lights:
+            if light.type != "point":
+                raise ToolError(f"{self.path}: light {light.json.get('name', light.index)} is "
+                                "not a point light")
+            out.append((np.array(light.position), np.array(light.intensity)))
         return out
 
     def mesh_instances(self):
-        """(world bounds min, max, list of materials) per mesh node, from POSITION min/max."""
+        """(world bounds min, max, list of gltf_scene.Material or None) per mesh node."""
         out = []
-        for i, n in self.nodes_with("mesh"):
-            lo, hi, mats = np.full(3, np.inf), np.full(3, -np.inf), []
-            for prim in self.doc["meshes"][n["mesh"]]["primitives"]:
-                acc = self.doc["accessors"][prim["attributes"]["POSITION"]]
-                a, b = np.array(acc["min"], float), np.array(acc["max"], float)
-                for corner in range(8):
-                    p = np.array([(b if corner >> k & 1 else a)[k] for k in range(3)] + [1.0])
-                    q = (self.world[i] @ p)[:3]
-                    lo, hi = np.minimum(lo, q), np.maximum(hi, q)
-                mats.append(self.doc["materials"][prim["material"]] if "material" in prim
-                            else None)
-            out.append((lo, hi, mats))
+        for inst in self.scene.meshes:
+            points = [p for prim in inst.primitives for p in prim.positions]
+            if not points:
+                raise ToolError(f"{self.path}: mesh {inst.mesh} has no vertices")
+            points = np.array(points, float)
+            out.append((points.min(axis=0), points.max(axis=0),
+                        [prim.material for prim in inst.primitives]))
         return out
 
 

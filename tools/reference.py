@@ -7,7 +7,9 @@
 
 `exact` writes the analytic answer of scenes/plane_point.gltf ("plane") or scenes/closed_box.gltf
 ("box") at the pixel-centre measurement points photonbound uses (src/camera.cpp), with the
-camera, light, reflectance and emission read from the glTF file. The bound channels are 0.
+camera, light, reflectance and emission read from the glTF file (.gltf or .glb, through
+tools/gltf_scene.py). It has every channel of photonbound's layout
+(include/photonbound/channels.def); all but the radiance are 0.
 
 `render` runs a long photonbound render (its own error bound channels included) and prints
 its mean bound, so you can check that it is at least 10x below the errors you study. It uses
@@ -41,10 +43,9 @@ REFERENCE_SEED = 1000003
 def _lambertian(gltf, material, what):
     if material is None:
         raise ToolError(f"{gltf.path}: the {what} has no material")
-    pbr = material.get("pbrMetallicRoughness", {})
-    if pbr.get("metallicFactor", 1.0) >= 0.5 or "extensions" in material:
+    if material.model != "lambertian":
         raise ToolError(f"{gltf.path}: the {what}'s material is not plain Lambertian")
-    return np.array(pbr.get("baseColorFactor", [1, 1, 1, 1])[:3], float)
+    return np.array(material.base_color, float)
 
 
 def exact_plane(gltf, width, height):
@@ -56,7 +57,7 @@ def exact_plane(gltf, width, height):
     if hi[1] - lo[1] > 1e-9 * max(1.0, float(np.max(hi - lo))):
         raise ToolError(f"{gltf.path}: the mesh is not a horizontal plane")
     rho = _lambertian(gltf, material, "plane")
-    if "emissiveFactor" in material:
+    if any(material.emission):
         raise ToolError(f"{gltf.path}: the plane emits light")
     lights = gltf.point_lights()
     if not lights:
@@ -92,9 +93,7 @@ def exact_box(gltf, width, height):
     if any(m is not first for m in materials):
         raise ToolError(f"{gltf.path}: the walls must share one material")
     rho = _lambertian(gltf, first, "box")
-    strength = first.get("extensions", {}).get("KHR_materials_emissive_strength", {})
-    emission = np.array(first.get("emissiveFactor", [0, 0, 0]), float) * strength.get(
-        "emissiveStrength", 1.0)
+    emission = np.array(first.emission, float)
     o = gltf.camera()["position"]
     if not np.all((o > lo) & (o < hi)):
         raise ToolError(f"{gltf.path}: the camera is not inside the box")
@@ -102,11 +101,12 @@ def exact_box(gltf, width, height):
 
 
 def write_reference(path, radiance, metadata):
-    planes = {c: radiance[..., k] for k, c in enumerate(pbtools.RGB)}
+    """The full channel layout of channels.def: the radiance, and 0 in every other channel
+    (bound, bias, noise, variance, photons, radius)."""
     zero = np.zeros(radiance.shape[:2], np.float32)
-    for prefix in ("ErrorBound.", "Bias.", "Noise.", "Variance."):
-        for c in pbtools.RGB:
-            planes[prefix + c] = zero
+    planes = {name: zero for name in pbtools.channel_names()}
+    for k, c in enumerate(pbtools.RGB):
+        planes[pbtools.channel("Radiance", c)] = radiance[..., k]
     pbtools.write_exr(path, planes, metadata)
 
 
@@ -145,7 +145,7 @@ def cmd_render(args, extra):
     if subprocess.run(cmd).returncode != 0:
         raise ToolError("the reference render failed (see above)")
     ref = pbtools.read_exr(args.output)
-    bound = ref.rgb("ErrorBound.")
+    bound = ref.rgb("ErrorBound")
     finite = bound[np.isfinite(bound)]
     print(f"reference: wrote {args.output}: {ref.meta('photonbound:passes_done')} passes, "
           f"{time.monotonic() - start:.0f} s, mean bound {finite.mean():.6g} at confidence "
@@ -165,7 +165,7 @@ def main():
     ex.add_argument("kind", choices=sorted(DEFAULT_SCENES))
     ex.add_argument("-o", "--output", required=True)
     ex.add_argument("--resolution", required=True, help="WxH, as given to photonbound")
-    ex.add_argument("--scene", help="the .gltf file (default: the shipped scene)")
+    ex.add_argument("--scene", help="the .gltf or .glb file (default: the shipped scene)")
     rd = sub.add_parser("render", help="a long photonbound render of any scene")
     rd.add_argument("scene")
     rd.add_argument("-o", "--output", required=True)

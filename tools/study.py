@@ -104,13 +104,13 @@ def reference_quality(path):
     """The reference's mean bound (0 when exact), its confidence, and the mean absolute error
     its noise alone is expected to have, sqrt(2/pi) x mean sd (normal noise)."""
     ref = pbtools.read_exr(path)
-    if "ErrorBound.R" not in ref.planes:
+    if pbtools.channel("ErrorBound", "R") not in ref.planes:
         return 0.0, None, 0.0
-    bound = ref.rgb("ErrorBound.")
+    bound = ref.rgb("ErrorBound")
     known = np.isfinite(bound) & (bound > 0)
     if not known.any():
         return 0.0, None, 0.0
-    noise = float(np.mean(np.sqrt(2.0 / np.pi * ref.rgb("Variance.")[known])))
+    noise = float(np.mean(np.sqrt(2.0 / np.pi * ref.rgb("Variance")[known])))
     return float(np.mean(bound[np.isfinite(bound)])), ref.meta("photonbound:confidence"), noise
 
 

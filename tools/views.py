@@ -95,7 +95,7 @@ def radiance_view(plt, exr, path, exposure):
 
 def bound_view(plt, exr, path, label):
     import matplotlib.colors as mcolors
-    radiance, bound = exr.rgb(), exr.rgb("ErrorBound.")
+    radiance, bound = exr.rgb(), exr.rgb("ErrorBound")
     exact, unknown = pixel_classes(bound)
     floor = RELATIVE_FLOOR * float(np.mean(radiance))
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -123,10 +123,10 @@ def bound_view(plt, exr, path, label):
 
 def noise_bias_view(plt, exr, path, label):
     import matplotlib.colors as mcolors
-    bound = exr.rgb("ErrorBound.")
+    bound = exr.rgb("ErrorBound")
     exact, unknown = pixel_classes(bound)
-    bias = np.sum(np.abs(exr.rgb("Bias.")), axis=-1)
-    noise = np.sum(exr.rgb("Noise."), axis=-1)
+    bias = np.sum(np.abs(exr.rgb("Bias")), axis=-1)
+    noise = np.sum(exr.rgb("Noise"), axis=-1)
     known = ~exact & ~unknown
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(known, bias / noise, 1.0)
@@ -151,7 +151,7 @@ def bounded_view(plt, exr, ref, path, label):
     if ref.shape != exr.shape:
         raise ToolError(f"{exr.path} is {exr.shape[1]}x{exr.shape[0]} but {ref.path} is "
                         f"{ref.shape[1]}x{ref.shape[0]}")
-    bound = exr.rgb("ErrorBound.")
+    bound = exr.rgb("ErrorBound")
     err = np.abs(exr.rgb() - ref.rgb())
     exact, unknown = pixel_classes(bound)
     bounded = np.isfinite(bound) & (bound > 0)
@@ -196,8 +196,8 @@ def main():
     ap.add_argument("--label", help="title of the maps (default: the prefix)")
     args = ap.parse_args()
     exr = pbtools.read_exr(args.input)
-    for prefix in ("", "ErrorBound.", "Bias.", "Noise."):
-        exr.rgb(prefix)  # fails, naming the channel, before anything is written
+    for group in ("Radiance", "ErrorBound", "Bias", "Noise"):
+        exr.rgb(group)  # fails, naming the channel, before anything is written
     ref = pbtools.read_exr(args.reference) if args.reference else None
     if ref is not None:
         ref.rgb()
