@@ -287,15 +287,15 @@ void run_scene(const std::string& path, const Config& c, int all) {
               c.height, eye.eye.points.size());
 
   const PassLoop L = pass_loop(world, eye, c.photons, c.loop_passes);
-  const double pass = L.on_pass(), grid = L.grid_prep + L.grid_build;
+  const double pass = L.on_pass(), grid = L.grid_build;
   std::printf("  pass at %dx%d, %.0fk photons (median of %d, %d threads):\n", c.width, c.height,
               double(c.photons) / 1e3, L.passes, all);
   std::printf("    trace                  %.3f s (%.0fk stored hits)\n", L.trace,
               L.hits_per_pass / 1e3);
   std::printf(
-      "    grid rebuild           %.3f s = %.1f%% of the pass (HashGrid::build %.3f, "
-      "arrays %.3f; %d levels)\n",
-      grid, 100.0 * grid / pass, L.grid_build, L.grid_prep, L.grid_levels);
+      "    grid rebuild           %.3f s = %.1f%% of the pass (pb::build_photon_grid; %d "
+      "levels)\n",
+      grid, 100.0 * grid / pass, L.grid_levels);
   std::printf(
       "    gather+update          %.3f s (next-event samples alone %.3f; %.1f photons "
       "gathered per point)\n",
@@ -308,8 +308,8 @@ void run_scene(const std::string& path, const Config& c, int all) {
   const double overhead = pass / L.off_pass() - 1.0;
   std::printf("    error-estimation cost  %.1f%% of the bounds-off pass (%.1f%% of its gather)\n",
               100.0 * overhead, 100.0 * (L.gather_on / L.gather_off - 1.0));
-  const double spass = L.trace + L.grid_prep + L.shrunk_grid_build + L.shrunk_gather_on;
-  const double sgrid = L.grid_prep + L.shrunk_grid_build;
+  const double spass = L.trace + L.shrunk_grid_build + L.shrunk_gather_on;
+  const double sgrid = L.shrunk_grid_build;
   std::printf(
       "    radii shrunk 100x      grid %.3f s = %.1f%% of a %.3f s pass (%d levels; "
       "gather+update %.3f)\n",

@@ -66,8 +66,7 @@ struct PassLoop {
   size_t points = 0;
   double hits_per_pass = 0.0;
   double trace = 0.0;       // per pass, median
-  double grid_prep = 0.0;   // hit positions and radii arrays (Renderer::step does the same)
-  double grid_build = 0.0;  // HashGrid::build
+  double grid_build = 0.0;  // pb::build_photon_grid (hit positions and HashGrid::build)
   double gather_on = 0.0;   // gather + next-event sample + accumulate_pass
   double gather_off = 0.0;  // the same without error estimation
   double nee = 0.0;         // next-event samples alone (part of both)
@@ -79,8 +78,8 @@ struct PassLoop {
   double shrunk_grid_build = 0.0;
   double shrunk_gather_on = 0.0;
   int shrunk_grid_levels = 0;
-  double on_pass() const { return trace + grid_prep + grid_build + gather_on; }
-  double off_pass() const { return trace + grid_prep + grid_build + gather_off; }
+  double on_pass() const { return trace + grid_build + gather_on; }
+  double off_pass() const { return trace + grid_build + gather_off; }
 };
 // The grid build alone is short and the machine noisy: it is timed again `build_reps` times
 // after the passes, at the last pass's radii and at radii 100x smaller.

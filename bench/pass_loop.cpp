@@ -4,8 +4,10 @@
 #include "plain.h"
 
 #include "photonbound/camera.h"
+#include "photonbound/options.h"
 #include "photonbound/parallel.h"
 #include "photonbound/pass_stages.h"
+#include "photonbound/renderer.h"
 #include "photonbound/rng.h"
 
 #include <algorithm>
@@ -15,11 +17,8 @@ namespace bench {
 
 namespace {
 
-// Renderer's constants (src/renderer.cpp): 4 pixel footprints, floor 1e-6 of the scene size.
-constexpr double kFootprintsPerRadius = 4.0;
-constexpr double kMinRadiusFraction = 1e-6;
-constexpr double kAlpha = 0.7;
-constexpr size_t kGrain = 256;  // Renderer::step's gather grain
+constexpr double kAlpha = 0.7;  // the renderer's default --alpha (option table)
+constexpr size_t kGrain = 256;
 
 struct Phase {
   std::vector<double> t;
@@ -27,32 +26,27 @@ struct Phase {
   double median() const { return bench::median(t); }
 };
 
-// Renderer::step's gather loop: gather, next-event sample, estimator update.
+// Renderer::step's stages 3-5: pb::gather_and_fold over fold blocks of 16384 points.
 void gather_on(const pb::World& world, const pb::EyePassResult& eye, const pb::HashGrid& grid,
                const std::vector<pb::PhotonHit>& hits, const pb::EstimatorParams& params,
-               uint64_t pass, std::vector<pb::PointState>& states) {
-  pb::parallel_for(states.size(), kGrain, [&](size_t begin, size_t end) {
-    for (size_t k = begin; k < end; ++k) {
-      pb::PassGather g;
-      pb::gather_photons(eye.points[k], states[k].r2, grid, hits, g);
-      pb::Rng rng(kSeed, pass, k, pb::Stream::DirectLight);
-      g.direct = pb::direct_light(world, eye.points[k], rng);
-      pb::accumulate_pass(states[k], g, params, pass);
-    }
-  });
+               uint64_t pass, std::vector<pb::PointState>& states, std::vector<float>& radii,
+               std::vector<pb::PassGather>& sums) {
+  const pb::PassInputs in{world, grid, hits, params, kSeed, pass, true};
+  pb::gather_and_fold(in, eye.points, states, radii, sums, nullptr);
 }
 
+// The same without error estimation: no Laplacian sum (gather_photons<false>) and the PPM update
+// without streaming moments (plain.h).
 void gather_off(const pb::World& world, const pb::EyePassResult& eye, const pb::HashGrid& grid,
                 const std::vector<pb::PhotonHit>& hits, const pb::EstimatorParams& params,
                 uint64_t pass, std::vector<PlainState>& states) {
   pb::parallel_for(states.size(), kGrain, [&](size_t begin, size_t end) {
     for (size_t k = begin; k < end; ++k) {
-      pb::dvec3 phi;
-      uint64_t count = 0;
-      gather_plain(eye.points[k], states[k].r2, grid, hits, phi, count);
+      pb::PassGather g;
+      pb::gather_photons<false>(eye.points[k], states[k].r2, grid, hits, g);
       pb::Rng rng(kSeed, pass, k, pb::Stream::DirectLight);
-      const pb::dvec3 direct = pb::direct_light(world, eye.points[k], rng);
-      accumulate_plain(states[k], phi, count, direct, params.alpha, params.min_r2);
+      g.direct = pb::direct_light(world, eye.points[k], rng);
+      accumulate_plain(states[k], g, params.alpha, params.min_r2);
     }
   });
 }
@@ -63,13 +57,11 @@ EyeSetup eye_setup(const pb::World& world, int width, int height) {
   EyeSetup s;
   const pb::PinholeCamera camera(world.scene().cameras.at(0), width, height);
   const double t0 = now();
-  s.eye = pb::run_eye_pass(world, camera, 8);
+  s.eye = pb::run_eye_pass(world, camera, pb::RenderOptions{}.max_depth);
   s.seconds = seconds_since(t0);
-  const double r_min = kMinRadiusFraction * world.scene_size();
+  const double r_min = pb::min_radius(world);
   s.min_r2 = r_min * r_min;
-  double r = 0.01 * world.scene_size();
-  if (!s.eye.points.empty()) r = kFootprintsPerRadius * double(s.eye.median_footprint);
-  s.r0 = std::max(r, r_min);
+  s.r0 = pb::default_initial_radius(s.eye, world);
   return s;
 }
 
@@ -92,9 +84,10 @@ PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photo
   pb::HashGrid grid;
   std::vector<pb::PhotonHit> hits;
   std::vector<pb::vec3> positions;
-  std::vector<float> radii(n);
+  std::vector<float> radii(n, pb::search_radius(initial.r2));
+  std::vector<pb::PassGather> sums(std::min<size_t>(n, 16384));
   std::vector<pb::dvec3> direct(n);  // the next-event-only timing writes here
-  Phase trace, prep, build, t_on, t_off, t_nee;
+  Phase trace, build, t_on, t_off, t_nee;
   double stored = 0.0;
 
   for (int p = 1; p <= passes; ++p) {
@@ -105,19 +98,14 @@ PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photo
     stored += double(hits.size());
 
     t0 = now();
-    positions.resize(hits.size());
-    for (size_t k = 0; k < hits.size(); ++k) positions[k] = hits[k].position;
-    for (size_t k = 0; k < n; ++k) radii[k] = pb::search_radius(on[k].r2);
-    prep.add(t0);
-    t0 = now();
-    grid.build(positions, radii);
+    pb::build_photon_grid(hits, radii, positions, grid);  // radii from the last fold
     build.add(t0);
 
     // Alternate the order so neither variant always finds the other's data in the caches.
     for (int v = 0; v < 2; ++v) {
       t0 = now();
       if ((v == 0) == (p % 2 == 1)) {
-        gather_on(world, eye, grid, hits, params, pass, on);
+        gather_on(world, eye, grid, hits, params, pass, on, radii, sums);
         t_on.add(t0);
       } else {
         gather_off(world, eye, grid, hits, params, pass, off);
@@ -139,7 +127,6 @@ PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photo
   r.points = n;
   r.hits_per_pass = stored / passes;
   r.trace = trace.median();
-  r.grid_prep = prep.median();
   r.gather_on = t_on.median();
   r.gather_off = t_off.median();
   r.nee = t_nee.median();
@@ -154,7 +141,7 @@ PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photo
   // pass's photons and radii; then with every radius 100x smaller (R^2 / 10^4).
   for (int rep = 0; rep < build_reps; ++rep) {
     const double t0 = now();
-    grid.build(positions, radii);
+    pb::build_photon_grid(hits, radii, positions, grid);
     build.add(t0);
   }
   r.grid_build = build.median();
@@ -167,13 +154,14 @@ PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photo
   Phase sbuild, sgather;
   for (int rep = 0; rep < build_reps; ++rep) {
     const double t0 = now();
-    grid.build(positions, radii);
+    pb::build_photon_grid(hits, radii, positions, grid);
     sbuild.add(t0);
   }
   for (int rep = 0; rep < 2; ++rep) {
     std::vector<pb::PointState> scratch = on;
+    std::vector<float> scratch_radii = radii;
     const double t0 = now();
-    gather_on(world, eye, grid, hits, params, uint64_t(passes + 1), scratch);
+    gather_on(world, eye, grid, hits, params, uint64_t(passes + 1), scratch, scratch_radii, sums);
     sgather.add(t0);
   }
   r.shrunk_grid_build = sbuild.median();

@@ -17,13 +17,18 @@ double seconds_since(Clock::time_point t0) {
 
 std::string stop_text(StopReason reason) {
   switch (reason) {
-    case StopReason::None: return "";
-    case StopReason::Passes: return "passes";
-    case StopReason::Time: return "time";
-    case StopReason::TargetError: return "target-error";
+    case StopReason::None:
+      return "";
+    case StopReason::Passes:
+      return "passes";
+    case StopReason::Time:
+      return "time";
+    case StopReason::TargetError:
+      return "target-error";
     case StopReason::Unreachable:
       return "unreachable: the radius cannot shrink and the bias is above the target";
-    case StopReason::Interrupted: return "interrupted";
+    case StopReason::Interrupted:
+      return "interrupted";
   }
   return "";
 }
@@ -68,7 +73,8 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
 
     if (o.passes && pass >= *o.passes) report.stop = StopReason::Passes;
     if (o.time_seconds && run_seconds >= *o.time_seconds) report.stop = StopReason::Time;
-    if (check && report.summary.mean_bound <= *o.target_error) report.stop = StopReason::TargetError;
+    if (check && report.summary.mean_bound <= *o.target_error)
+      report.stop = StopReason::TargetError;
     // A target below the bias cannot be reached once the radii can no longer shrink (alpha = 1,
     // or every radius at its floor): more passes only shrink the noise.
     if (check && report.summary.mean_bias_metric >= *o.target_error && renderer_.radii_fixed())
@@ -79,8 +85,8 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
       report.summary = renderer_.develop();
       developed = true;
     }
-    const PassInfo info{renderer_, state_, pass, run_seconds, developed, report.summary,
-                        report.stop};
+    const PassInfo info{renderer_, state_,         pass,       run_seconds,
+                        developed, report.summary, report.stop};
     for (PassObserver* obs : observers) obs->after_pass(info);
   }
   for (PassObserver* obs : observers) obs->finish();

@@ -10,6 +10,19 @@
 
 namespace pb {
 
+double ppm_radius_update(double& n, double& r2, double m, double alpha, double min_r2) {
+  const double r2_pass = r2;
+  double shrink = 1.0;
+  if (n + m > 0.0) {
+    shrink = (n + alpha * m) / (n + m);
+    n += alpha * m;
+  }
+  // At the radius floor the shrink actually applied is smaller; tau must follow R^2 exactly or
+  // tau / (pi R^2 i M_e) stops being the mean of the per-pass estimates.
+  r2 = std::max(r2_pass * shrink, min_r2);
+  return r2 / r2_pass;
+}
+
 void accumulate_pass(PointState& s, const PassGather& g, const EstimatorParams& params,
                      uint64_t pass) {
   const double r2_pass = s.r2;  // R_j: the radius every deposit of this pass was made with
@@ -29,16 +42,7 @@ void accumulate_pass(PointState& s, const PassGather& g, const EstimatorParams& 
   s.photons += g.count;
 
   // PPM update (section 3, HOJ08): only photons that could contribute shrink the radius.
-  const double m = double(g.count);
-  double shrink = 1.0;
-  if (s.n + m > 0.0) {
-    shrink = (s.n + params.alpha * m) / (s.n + m);
-    s.n += params.alpha * m;
-  }
-  // At the radius floor the shrink actually applied is smaller; tau must follow R^2 exactly or
-  // tau / (pi R^2 i M_e) stops being the mean of the per-pass estimates.
-  s.r2 = std::max(r2_pass * shrink, params.min_r2);
-  const double applied = s.r2 / r2_pass;
+  const double applied = ppm_radius_update(s.n, s.r2, double(g.count), params.alpha, params.min_r2);
   s.tau = (s.tau + g.phi) * applied;
   s.tau_lap = (s.tau_lap + g.phi_lap_r2 / r2_pass) * applied;  // w_lap carries 1 / R_j^2
 }

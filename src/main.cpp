@@ -173,6 +173,9 @@ int main(int argc, char** argv) {
       case pb::Command::Kind::Help:
         std::cout << pb::usage_text();
         return 0;
+      case pb::Command::Kind::HelpTable:
+        std::cout << pb::markdown_option_table();
+        return 0;
       case pb::Command::Kind::Version:
         std::cout << "photonbound " << PHOTONBOUND_VERSION << "\n";
         return 0;

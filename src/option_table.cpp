@@ -214,8 +214,8 @@ OptionSpec text(OptionSpec s, std::string RenderOptions::*m, std::string unset =
 }
 
 OptionSpec resolution() {
-  OptionSpec s = base("--resolution", "resolution", "WxH", "rendering", OptionKind::Image,
-                      "image size");
+  OptionSpec s =
+      base("--resolution", "resolution", "WxH", "rendering", OptionKind::Image, "image size");
   const IntRange r{1, 16384};
   s.range = r.text() + " each";
   s.unset = "512 wide, camera aspect";
@@ -265,22 +265,21 @@ std::vector<OptionSpec> make_table() {
   t.push_back(integer(base("--passes", "passes", "N", stop, K::Stop, "passes to run"),
                       &RenderOptions::passes, {1, 1000000000000ULL}, "none"));
   t.push_back(real(base("--time", "time", "S", stop, K::Stop,
-                        "wall-clock budget in seconds, checked after each pass"),
+                        "wall-clock budget in seconds (steady clock), checked after each pass"),
                    &RenderOptions::time_seconds, {0, 1e9, true, false, " seconds", ""}, "none"));
-  t.push_back(real(
-      base("--target-error", "target_error", "E", stop, K::Stop,
-           "stop when the image mean error bound is <= E"),
-      &RenderOptions::target_error,
-      {0, kInf, true, true, "", "must be a finite number greater than 0"}, "none"));
+  t.push_back(real(base("--target-error", "target_error", "E", stop, K::Stop,
+                        "stop when the image mean error bound is <= E"),
+                   &RenderOptions::target_error,
+                   {0, kInf, true, true, "", "must be a finite number greater than 0"}, "none"));
   t.push_back(integer(base("--photons-per-pass", "photons_per_pass", "M", render, K::Image,
                            "photons emitted per pass (M_e)"),
                       &RenderOptions::photons_per_pass, {1, 1000000000ULL}));
   t.push_back(real(base("--alpha", "alpha", "A", render, K::Image,
                         "PPM radius reduction; 1 never shrinks the radius"),
                    &RenderOptions::alpha, {0, 1, true, false, "", ""}));
-  t.push_back(real(base("--radius", "radius", "R", render, K::Image,
-                        "initial search radius in scene units"),
-                   &RenderOptions::radius, {0, 1e30, true, true, "", ""}, "4 pixel footprints"));
+  t.push_back(real(
+      base("--radius", "radius", "R", render, K::Image, "initial search radius in scene units"),
+      &RenderOptions::radius, {0, 1e30, true, true, "", ""}, "4 pixel footprints"));
   t.push_back(integer(base("--max-depth", "max_depth", "D", render, K::Image,
                            "specular bounces a camera path may take"),
                       &RenderOptions::max_depth, {0, 32}));
@@ -304,17 +303,19 @@ std::vector<OptionSpec> make_table() {
   t.push_back(integer(base("--min-passes", "min_passes", "N", bounds, K::Adjust,
                            "passes before the first stop test"),
                       &RenderOptions::min_passes, {2, 1000000000000ULL}));
-  t.push_back(choice(base("--error-metric", "error_metric", "absolute|relative", bounds,
-                          K::Adjust,
+  t.push_back(choice(base("--error-metric", "error_metric", "absolute|relative", bounds, K::Adjust,
                           "what --target-error measures; relative divides by max(L, 0.01 x "
                           "image mean)"),
                      &RenderOptions::metric,
                      {{"absolute", ErrorMetric::Absolute}, {"relative", ErrorMetric::Relative}}));
-  OptionSpec progress = choice(
-      base("--progress", "progress", "", run, K::Run,
-           "force the progress line on or off (default: on when stderr is a terminal)"),
-      &RenderOptions::progress,
-      {{"auto", ProgressMode::Auto}, {"always", ProgressMode::Always}, {"never", ProgressMode::Never}});
+  OptionSpec progress = choice(base("--progress", "progress", "", run, K::Run,
+                                    "progress lines on stderr (pass, photons, the tested quantity "
+                                    "against the target, unknown "
+                                    "pixels, elapsed, time left); auto = on a terminal"),
+                               &RenderOptions::progress,
+                               {{"auto", ProgressMode::Auto},
+                                {"always", ProgressMode::Always},
+                                {"never", ProgressMode::Never}});
   progress.switches = {{"--progress", "always"}, {"--quiet", "never"}};
   t.push_back(std::move(progress));
   t.push_back(real(base("--checkpoint-every", "checkpoint_every", "S", ckpt, K::Run,
@@ -322,13 +323,13 @@ std::vector<OptionSpec> make_table() {
                    &RenderOptions::checkpoint_every, {0, 1e9, true, false, " seconds", ""},
                    "none"));
   t.push_back(text(base("--state", "state", "FILE", ckpt, K::Run,
-                        "state file (default: OUT with the extension .pbstate)"),
+                        "where the state goes (OUT with the extension .pbstate)"),
                    &RenderOptions::state_path, "OUT.pbstate"));
   t.push_back(text(base("--resume", "resume", "STATE", ckpt, K::Run,
                         "continue the render saved in STATE (scene and image options must match)"),
                    &RenderOptions::resume_from, "none"));
   t.push_back(text(base("--log", "log", "FILE.jsonl", measure, K::Run,
-                        "per-pass JSON log (README \"Measuring the trade\")"),
+                        "per-pass JSON log (\"Measuring the trade\")"),
                    &RenderOptions::log_path, "none"));
   t.push_back(text(base("--reference", "reference", "REF.exr", measure, K::Run,
                         "with --log: add the actual error and coverage against this image"),

@@ -184,6 +184,8 @@ Command parse_command_line(int argc, const char* const* argv) {
   const std::string cmd = argv[1];
   if (cmd == "--help" || cmd == "-h" || cmd == "help") {
     c.kind = Command::Kind::Help;
+  } else if (cmd == "--help-table") {
+    c.kind = Command::Kind::HelpTable;
   } else if (cmd == "--version") {
     c.kind = Command::Kind::Version;
   } else if (cmd == "render") {
@@ -243,6 +245,42 @@ usage:
       }
       s += head + tail + (notes.empty() ? "" : " (" + notes + ")") + "\n";
     }
+  }
+  return s;
+}
+
+std::string markdown_option_table() {
+  auto cell = [](std::string text) {  // a | inside a cell must be escaped in Markdown
+    std::string out;
+    for (const char c : text) out += c == '|' ? std::string("\\|") : std::string(1, c);
+    return out;
+  };
+  auto on_resume = [](OptionKind k) {
+    switch (k) {
+      case OptionKind::Image:
+        return "fixed by the state";
+      case OptionKind::Stop:
+        return "replaces the saved stop conditions";
+      case OptionKind::Adjust:
+        return "kept unless given";
+      case OptionKind::Run:
+        return "this run only";
+    }
+    return "";
+  };
+  std::string s = "| option | range | default | meaning | on resume |\n|---|---|---|---|---|\n";
+  for (const OptionSpec& o : option_table()) {
+    std::string flags;
+    if (o.switches.empty()) {
+      flags =
+          "`" + std::string(o.flag) + (o.metavar.empty() ? "" : " " + std::string(o.metavar)) + "`";
+    } else {
+      for (size_t k = 0; k < o.switches.size(); ++k)
+        flags += (k ? ", `" : "`") + std::string(o.switches[k].first) + "`";
+    }
+    const std::string def = o.default_text();
+    s += "| " + cell(flags) + " | " + o.range + " | " + cell(def.empty() ? "none" : def) + " | " +
+         cell(std::string(o.help)) + " | " + on_resume(o.kind) + " |\n";
   }
   return s;
 }

@@ -46,6 +46,7 @@ void build_photon_grid(const std::vector<PhotonHit>& hits, std::span<const float
   grid.build(positions, radii);
 }
 
+template <bool kLaplacian>
 void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& grid,
                     const std::vector<PhotonHit>& hits, PassGather& out) {
   const float radius = search_radius(r2);
@@ -66,13 +67,18 @@ void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& gr
     const dvec3 flux = dvec3(h.flux) * double(cos_s / cos_g);
     const double t = std::min(1.0, std::sqrt(double(dist2) * inv_r2));
     phi += kernel::weight(t) * flux;
-    lap += kernel::laplacian_weight_r2(t) * flux;
+    if constexpr (kLaplacian) lap += kernel::laplacian_weight_r2(t) * flux;
   });
   const dvec3 f(point.f);
   out.phi += f * phi;
-  out.phi_lap_r2 += f * lap;
+  if constexpr (kLaplacian) out.phi_lap_r2 += f * lap;
   out.count += count;
 }
+
+template void gather_photons<true>(const MeasurementPoint&, double, const HashGrid&,
+                                   const std::vector<PhotonHit>&, PassGather&);
+template void gather_photons<false>(const MeasurementPoint&, double, const HashGrid&,
+                                    const std::vector<PhotonHit>&, PassGather&);
 
 dvec3 direct_light(const World& world, const MeasurementPoint& point, Rng& rng) {
   DirectSample s;
@@ -109,6 +115,31 @@ void fold_pass(std::span<PointState> states, std::span<const PassGather> sums,
     if (copy) stream_copy(copy + k, states[k]);
   }
   if (copy) store_fence();  // the streamed stores are visible before the writer reads them
+}
+
+void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> points,
+                     std::span<PointState> states, std::span<float> radii,
+                     std::span<PassGather> sums, PointState* copy) {
+  constexpr size_t kGrain = 256;  // points per parallel task inside a block
+  const size_t n = states.size(), block = sums.size();
+  for (size_t first = 0; first < n; first += block) {
+    const size_t count = std::min(block, n - first);
+    parallel_for(count, kGrain, [&](size_t b, size_t e) {
+      const std::span<PassGather> out = sums.subspan(b, e - b);
+      gather_pass(points.subspan(first + b, e - b),
+                  std::span<const PointState>(states).subspan(first + b, e - b), in.grid, in.hits,
+                  out);
+      if (in.next_event)
+        next_event_pass(in.world, points.subspan(first + b, e - b), in.seed, in.pass, first + b,
+                        out);
+    });
+    // A distributed render reduces sums[0, count) across machines here.
+    parallel_for(count, kGrain, [&](size_t b, size_t e) {
+      fold_pass(states.subspan(first + b, e - b),
+                std::span<const PassGather>(sums).subspan(b, e - b), in.params, in.pass,
+                radii.subspan(first + b, e - b), copy ? copy + first + b : nullptr);
+    });
+  }
 }
 
 }  // namespace pb

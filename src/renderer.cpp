@@ -26,8 +26,6 @@ constexpr double kMinRadiusFraction = 1e-6;
 // then folded (stage 5). 16384 points keep the block's sums (1.3 MB) and states (2.6 MB) in the
 // last-level cache between the two, and the array exists whole for a distributed reduction.
 constexpr size_t kFoldBlock = 16384;
-// Points per parallel task inside a block.
-constexpr size_t kGrain = 256;
 
 }  // namespace
 
@@ -118,25 +116,8 @@ void Renderer::step(std::vector<PointState>* copy) {
   t = Clock::now();
   const bool nee = options_.direct == DirectMode::NextEvent;
   if (copy) copy->resize(n);
-  const std::span<const MeasurementPoint> points(eye_.points);
-  for (size_t first = 0; first < n; first += kFoldBlock) {
-    const size_t count = std::min(kFoldBlock, n - first);
-    parallel_for(count, kGrain, [&](size_t b, size_t e) {
-      const std::span<PassGather> out = std::span(sums_).subspan(b, e - b);
-      gather_pass(points.subspan(first + b, e - b),
-                  std::span<const PointState>(states_).subspan(first + b, e - b), grid_, hits_,
-                  out);
-      if (nee)
-        next_event_pass(world_, points.subspan(first + b, e - b), options_.seed, pass, first + b,
-                        out);
-    });
-    parallel_for(count, kGrain, [&](size_t b, size_t e) {
-      fold_pass(std::span(states_).subspan(first + b, e - b),
-                std::span<const PassGather>(sums_).subspan(b, e - b), params_, pass,
-                std::span(radii_).subspan(first + b, e - b),
-                copy ? copy->data() + first + b : nullptr);
-    });
-  }
+  const PassInputs in{world_, grid_, hits_, params_, options_.seed, pass, nee};
+  gather_and_fold(in, eye_.points, states_, radii_, sums_, copy ? copy->data() : nullptr);
   timings_.gather += seconds_since(t);
 }
 

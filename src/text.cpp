@@ -69,5 +69,4 @@ std::string one_line(const std::string& s) {
   return out;
 }
 
-
 }  // namespace pb

@@ -187,4 +187,31 @@ TEST_F(Cli, ResumeRefusesAChangedSceneFile) {
   EXPECT_FALSE(fs::exists(dir_ / "r.exr"));
 }
 
+// The identity resume checks is the loaded content, not the .gltf bytes alone: an edited
+// external buffer is another scene.
+TEST_F(Cli, ResumeRefusesAChangedExternalBuffer) {
+  fs::copy_file(scene("plane_point_external.gltf"), dir_ / "p.gltf");
+  fs::copy_file(scene("plane_point_external.bin"), dir_ / "plane_point_external.bin");
+  const std::string state = (dir_ / "p.pbstate").string();
+  ASSERT_EQ(
+      run("render " + quote((dir_ / "p.gltf").string()) + " -o " + quote(out()) +
+          " --resolution 8x8 --photons-per-pass 500 --quiet --passes 2 --state " + quote(state))
+          .code,
+      0);
+  // The lowest byte of the first float: the plane moves by an ulp, the .gltf is untouched.
+  {
+    std::fstream bin(dir_ / "plane_point_external.bin",
+                     std::ios::in | std::ios::out | std::ios::binary);
+    char b = 0;
+    bin.read(&b, 1);
+    bin.seekp(0);
+    b ^= 1;
+    bin.write(&b, 1);
+  }
+  const Outcome r = run("resume " + quote(state) + " -o " + quote((dir_ / "r.exr").string()));
+  EXPECT_EQ(r.code, 1) << r.err;
+  EXPECT_NE(r.err.find("scene"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(dir_ / "r.exr"));
+}
+
 }  // namespace

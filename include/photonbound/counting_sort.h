@@ -21,7 +21,8 @@ inline constexpr size_t kSortBlocks = 16;
 // for reuse). With `starts`, also returns where each digit's run begins (radix + 1 offsets).
 template <class Digit, class Place>
 void stable_counting_sort(size_t n, size_t radix, Digit&& digit, Place&& place,
-                          std::vector<uint32_t>& histogram, std::vector<uint32_t>* starts = nullptr) {
+                          std::vector<uint32_t>& histogram,
+                          std::vector<uint32_t>* starts = nullptr) {
   const size_t block = (n + kSortBlocks - 1) / kSortBlocks;
   histogram.assign(kSortBlocks * radix, 0u);
   parallel_for(kSortBlocks, 1, [&](size_t b0, size_t b1) {

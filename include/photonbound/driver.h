@@ -34,8 +34,8 @@ struct PassInfo {
   const Renderer& renderer;
   const DriverState& schedule;
   uint64_t pass = 0;
-  double run_seconds = 0.0;     // this run
-  bool developed = false;       // summary is of this pass (else of an earlier one, or empty)
+  double run_seconds = 0.0;  // this run
+  bool developed = false;    // summary is of this pass (else of an earlier one, or empty)
   const FilmSummary& summary;
   StopReason stop = StopReason::None;  // None: more passes follow
 };

@@ -41,6 +41,11 @@ struct EstimatorParams {
   double min_r2 = 0.0;            // floor on R^2 (ESTIMATOR.md section 8)
 };
 
+// The PPM radius update (HOJ08; ESTIMATOR.md section 3) for m photons that could contribute:
+// R^2 *= (N + alpha m) / (N + m), N += alpha m, R^2 floored at min_r2. Returns the factor R^2
+// actually changed by, which tau and tauLap must follow exactly.
+double ppm_radius_update(double& n, double& r2, double m, double alpha, double min_r2);
+
 // Folds pass number `pass` (1-based) into the state. state.r2 must be the radius the pass used.
 void accumulate_pass(PointState& state, const PassGather& gather, const EstimatorParams& params,
                      uint64_t pass);
@@ -70,11 +75,10 @@ double student_t_quantile(double nu, double p);
 
 // Error bound half-width for an estimate whose error is its estimated bias B plus noise of
 // standard deviation s with nu degrees of freedom: the smallest q with
-// P(|B + s T_nu| <= q) = confidence. This is where photonbound departs from ESTIMATOR.md
-// section 4, which adds the two-sided noise half-width to |B|: that sum covers the noise on the
-// side away from B too, and is conservative by up to the difference between the two- and
-// one-sided quantiles (README "Error bounds"). q lies between |B| + s t_{nu,conf} and
-// |B| + s t_{nu,(1+conf)/2}; it equals the latter when B = 0.
+// P(|B + s T_nu| <= q) = confidence (ESTIMATOR.md section 4). HJJ10 adds the two-sided noise
+// half-width to |B| instead: that sum covers the noise on the side away from B too, and is
+// conservative by up to the difference between the two- and one-sided quantiles. q lies between |B|
+// + s t_{nu,conf} and |B| + s t_{nu,(1+conf)/2}; it equals the latter when B = 0.
 class BoundQuantile {
  public:
   BoundQuantile(double nu, double confidence);

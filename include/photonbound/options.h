@@ -116,7 +116,7 @@ struct ResumeOptions {
 };
 
 struct Command {
-  enum class Kind { Help, Version, Render, Resume, Preview, Compare } kind = Kind::Help;
+  enum class Kind { Help, HelpTable, Version, Render, Resume, Preview, Compare } kind = Kind::Help;
   RenderOptions render;
   ResumeOptions resume;
   PreviewOptions preview;
@@ -137,6 +137,9 @@ void validate(const RenderOptions& options);
 
 // The --help text, made from the table.
 std::string usage_text();
+// README's option table, made from the table (`photonbound --help-table`; a test checks that
+// README holds exactly this).
+std::string markdown_option_table();
 
 // Shortest text that reads back as the same double (metadata, messages).
 std::string number_text(double v);

@@ -32,7 +32,9 @@ void build_photon_grid(const std::vector<PhotonHit>& hits, std::span<const float
                        std::vector<vec3>& positions, HashGrid& grid);
 
 // Adds every photon within search_radius(r2) of the point that arrived on the point's side
-// (ESTIMATOR.md sections 2-3).
+// (ESTIMATOR.md sections 2-3). Without the Laplacian (the bench's "error estimation off"
+// variant) phi_lap_r2 is left alone.
+template <bool kLaplacian = true>
 void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& grid,
                     const std::vector<PhotonHit>& hits, PassGather& out);
 
@@ -56,5 +58,20 @@ void next_event_pass(const World& world, std::span<const MeasurementPoint> point
 void fold_pass(std::span<PointState> states, std::span<const PassGather> sums,
                const EstimatorParams& params, uint64_t pass, std::span<float> radii,
                PointState* copy);
+
+// Stages 3-5 over all points, block by block in parallel, as Renderer::step runs them: for each
+// block of sums.size() points, gather and next-event samples into `sums`, then fold. `copy`
+// (sized to the points) receives the new states.
+struct PassInputs {
+  const World& world;
+  const HashGrid& grid;
+  const std::vector<PhotonHit>& hits;
+  const EstimatorParams& params;
+  uint64_t seed = 0, pass = 0;
+  bool next_event = true;
+};
+void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> points,
+                     std::span<PointState> states, std::span<float> radii,
+                     std::span<PassGather> sums, PointState* copy);
 
 }  // namespace pb
