@@ -1,18 +1,8 @@
 #include "photonbound/checkpoint_writer.h"
 
-#include <chrono>
+#include "photonbound/timer.h"
 
 namespace pb {
-
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-}  // namespace
 
 CheckpointWriter::CheckpointWriter(double every, RenderOptions options, uint64_t scene_hash,
                                    Write write)

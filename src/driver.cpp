@@ -1,19 +1,10 @@
 #include "photonbound/driver.h"
 
+#include "photonbound/timer.h"
+
 #include <algorithm>
-#include <chrono>
 
 namespace pb {
-
-namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-
-}  // namespace
 
 std::string stop_text(StopReason reason) {
   switch (reason) {

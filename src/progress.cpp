@@ -2,8 +2,8 @@
 
 #include "photonbound/compare.h"
 #include "photonbound/json.h"
+#include "photonbound/timer.h"
 
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <sstream>
@@ -78,7 +78,7 @@ bool PassLogger::wants_summary(uint64_t, double run_seconds) {
 
 void PassLogger::after_pass(const PassInfo& info) {
   if (!want_ && info.stop == StopReason::None) return;
-  const auto t0 = std::chrono::steady_clock::now();
+  const auto t0 = Clock::now();
   const FilmSummary& s = info.summary;
   JsonObject line;
   // JSON has no infinity: an unknown mean bound is written as -1 (README).
@@ -97,7 +97,7 @@ void PassLogger::after_pass(const PassInfo& info) {
     line.add("mae", c.mean_abs_error).add("rmse", c.rmse).add("coverage", c.coverage);
   }
   out_ << line.str() << "\n" << std::flush;
-  log_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  log_seconds_ += seconds_since(t0);
 }
 
 }  // namespace pb

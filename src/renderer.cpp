@@ -3,20 +3,14 @@
 #include "photonbound/checkpoint.h"
 #include "photonbound/parallel.h"
 #include "photonbound/pass_stages.h"
+#include "photonbound/timer.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 namespace pb {
 
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point t0) {
-  return std::chrono::duration<double>(Clock::now() - t0).count();
-}
 
 // Default initial radius: this many pixel footprints (median over measurement points).
 constexpr double kFootprintsPerRadius = 4.0;

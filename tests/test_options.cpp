@@ -108,7 +108,7 @@ TEST(Options, EveryOptionIsValidatedAtItsDocumentedBounds) {
     if (!s.switches.empty()) continue;
     // The same through the parser: a flag with each rejected value exits with a UsageError.
     for (const std::string& v : s.rejected) {
-      std::vector<const char*> argv = {"photonbound", "render", "s.gltf", "-o", "o.exr",
+      std::vector<const char*> argv = {"photonbound", "render", "s.gltf",      "-o",     "o.exr",
                                        "--passes",    "1",      s.flag.data(), v.c_str()};
       EXPECT_THROW(parse_command_line(int(argv.size()), argv.data()), UsageError) << v;
     }
@@ -122,8 +122,8 @@ TEST(Options, ResumeFollowsTheKindOfEachOption) {
     if (!s.switches.empty() || s.key == "resume" || s.key == "output") continue;
     SCOPED_TRACE(std::string(s.flag));
     const std::string v = s.accepted.front();
-    std::vector<const char*> argv = {"photonbound", "resume",      "x.pbstate", "-o", "new.exr",
-                                     s.flag.data(), v.c_str()};
+    std::vector<const char*> argv = {"photonbound", "resume",      "x.pbstate", "-o",
+                                     "new.exr",     s.flag.data(), v.c_str()};
     if (s.key == "reference") argv.insert(argv.end(), {"--log", "l.jsonl"});
     if (s.kind == OptionKind::Image) {
       EXPECT_THROW(parse_command_line(int(argv.size()), argv.data()), UsageError);
