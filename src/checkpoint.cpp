@@ -165,6 +165,8 @@ void save_state(const std::string& path, const SavedRender& s) {
   w.u64(s.schedule.next_check);
   w.u64(s.schedule.early_pass);
   w.f64(s.schedule.early_bound);
+  w.u64(s.render.visible.size());
+  w.raw(s.render.visible.data(), s.render.visible.size() * sizeof(uint32_t));
   const std::vector<PointState>& states = s.render.states;
   w.u64(states.size());
   // The states go to the file straight from the snapshot, without a copy into the buffer.
@@ -217,6 +219,10 @@ SavedRender load_state(const std::string& path) {
     s.schedule.next_check = r.u64();
     s.schedule.early_pass = r.u64();
     s.schedule.early_bound = r.f64();
+    const uint64_t v = r.u64();
+    if (v > r.remaining() / sizeof(uint32_t)) throw StateError(path + ": truncated state file");
+    s.render.visible.resize(v);
+    r.raw(s.render.visible.data(), v * sizeof(uint32_t));
     const uint64_t n = r.u64();
     if (n > r.remaining() / sizeof(PointState)) throw StateError(path + ": truncated state file");
     s.render.states.resize(n);

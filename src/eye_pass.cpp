@@ -115,4 +115,24 @@ EyePassResult run_eye_pass(const World& world, const PinholeCamera& camera, int 
   return r;
 }
 
+float median_footprint(const World& world, const PinholeCamera& camera, int max_depth, int stride) {
+  const size_t rows = size_t((camera.height() + stride - 1) / stride);
+  std::vector<std::vector<float>> row_footprints(rows);
+  parallel_for(rows, 1, [&](size_t begin, size_t end) {
+    PixelOutput out;
+    for (size_t r = begin; r < end; ++r) {
+      out.footprints.clear();
+      const int y = std::min(int(r) * stride + stride / 2, camera.height() - 1);
+      for (int x = std::min(stride / 2, camera.width() - 1); x < camera.width(); x += stride)
+        trace_pixel(world, camera, max_depth, x, y, out);
+      row_footprints[r] = out.footprints;
+    }
+  });
+  std::vector<float> all;
+  for (const auto& row : row_footprints) all.insert(all.end(), row.begin(), row.end());
+  if (all.empty()) return 0.0f;
+  std::nth_element(all.begin(), all.begin() + all.size() / 2, all.end());
+  return all[all.size() / 2];
+}
+
 }  // namespace pb

@@ -13,24 +13,39 @@ struct PixelResult {
   dvec3 radiance{0.0}, bias{0.0}, variance{0.0};
   double photons = 0.0;
   float radius = 0.0f;
-  bool has_points = false;
+  bool exact = false;  // PPM: no point, so nothing random (background, exact emission)
   bool known = true;
 };
 
 // L_pix = Le_seen + sum_k W_k L_k; B_pix = sum_k W_k B_k; Var_pix = sum_k W_k^2 S_k^2 / i
 // (ESTIMATOR.md section 5). W_k is already inside each point's estimate (MeasurementPoint::f).
-PixelResult combine(const EyePassResult& eye, const std::vector<PointState>& states, size_t pixel,
+// SPPM (section 10): one state per pixel, whose samples carry the emission seen along the path.
+PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& states, size_t pixel,
                     uint64_t passes, double photons_per_pass) {
   PixelResult r;
-  r.radiance = eye.emission[pixel];
-  for (uint32_t k = eye.pixel_begin[pixel]; k < eye.pixel_begin[pixel + 1]; ++k) {
+  if (layout.pixel_begin.empty()) {
+    const PointEstimate e = estimate(states[pixel], passes, photons_per_pass);
+    r.radiance = e.radiance;
+    r.bias = e.bias;
+    r.variance = e.variance;
+    r.photons = double(states[pixel].photons);
+    r.radius = float(std::sqrt(states[pixel].r2));
+    // A pixel that never had a visible point has no photon part to wait for: its samples are
+    // the emission along its paths, known from two passes on.
+    const bool no_photon_part = !layout.visible_passes.empty() && layout.visible_passes[pixel] == 0;
+    r.known = passes >= 2 && (e.known || no_photon_part);
+    return r;
+  }
+  if (!layout.emission.empty()) r.radiance = layout.emission[pixel];
+  r.exact = true;
+  for (uint32_t k = layout.pixel_begin[pixel]; k < layout.pixel_begin[pixel + 1]; ++k) {
     const PointEstimate e = estimate(states[k], passes, photons_per_pass);
     r.radiance += e.radiance;
     r.bias += e.bias;
     r.variance += e.variance;
     r.photons += double(states[k].photons);
-    if (!r.has_points) r.radius = float(std::sqrt(states[k].r2));
-    r.has_points = true;
+    if (r.exact) r.radius = float(std::sqrt(states[k].r2));
+    r.exact = false;
     r.known = r.known && e.known;
   }
   return r;
@@ -58,8 +73,17 @@ const std::vector<float>& FilmImage::plane(Channel id) const {
   return radiance;
 }
 
+PixelLayout layout_of(const EyePassResult& eye) {
+  return {eye.width, eye.height, eye.pixel_begin, eye.emission, {}};
+}
+
 FilmSummary develop(const EyePassResult& eye, const std::vector<PointState>& states,
-                    uint64_t passes, const FilmSettings& s, FilmImage* image) {
+                    uint64_t passes, const FilmSettings& settings, FilmImage* image) {
+  return develop(layout_of(eye), states, passes, settings, image);
+}
+
+FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& states, uint64_t passes,
+                    const FilmSettings& s, FilmImage* image) {
   const size_t pixels = size_t(eye.width) * size_t(eye.height);
   std::vector<PixelResult> results(pixels);
   parallel_for(pixels, 1024, [&](size_t begin, size_t end) {
@@ -90,13 +114,13 @@ FilmSummary develop(const EyePassResult& eye, const std::vector<PointState>& sta
   uint64_t known = 0, below = 0;
   for (size_t p = 0; p < pixels; ++p) {
     const PixelResult& r = results[p];
-    const bool known_pixel = !r.has_points || (passes >= 2 && r.known);
+    const bool known_pixel = r.exact || (passes >= 2 && r.known);
     dvec3 noise(0.0), bound(std::numeric_limits<double>::infinity());
     if (known_pixel) {
-      // Pixels without points see only background or exact emission: bound 0.
+      // PPM pixels without points see only background or exact emission: bound 0.
       const dvec3 sd = glm::sqrt(r.variance);
-      noise = r.has_points ? t * sd : dvec3(0.0);
-      for (int c = 0; c < 3; ++c) bound[c] = r.has_points ? quantile(r.bias[c], sd[c]) : 0.0;
+      noise = r.exact ? dvec3(0.0) : t * sd;
+      for (int c = 0; c < 3; ++c) bound[c] = r.exact ? 0.0 : quantile(r.bias[c], sd[c]);
       dvec3 metric = bound, bias_metric = glm::abs(r.bias);
       if (s.metric == ErrorMetric::Relative) {
         const dvec3 denominator = glm::max(r.radiance, dvec3(std::max(sum.relative_floor, 1e-300)));

@@ -271,6 +271,10 @@ std::vector<OptionSpec> make_table() {
                         "stop when the image mean error bound is <= E"),
                    &RenderOptions::target_error,
                    {0, kInf, true, true, "", "must be a finite number greater than 0"}, "none"));
+  t.push_back(choice(base("--method", "method", "sppm|ppm", render, K::Image,
+                          "stochastic PPM, whose pixels are area averages (anti-aliased), or PPM "
+                          "with fixed pixel-centre points (HJJ10's setting)"),
+                     &RenderOptions::method, {{"sppm", Method::SPPM}, {"ppm", Method::PPM}}));
   t.push_back(integer(base("--photons-per-pass", "photons_per_pass", "M", render, K::Image,
                            "photons emitted per pass (M_e)"),
                       &RenderOptions::photons_per_pass, {1, 1000000000ULL}));

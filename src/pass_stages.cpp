@@ -1,5 +1,7 @@
 #include "photonbound/pass_stages.h"
 
+#include "photonbound/camera_paths.h"
+
 #include "photonbound/parallel.h"
 
 #include "photonbound/kernel.h"
@@ -92,17 +94,17 @@ dvec3 direct_light(const World& world, const MeasurementPoint& point, Rng& rng) 
 void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
                  const HashGrid& grid, const std::vector<PhotonHit>& hits,
                  std::span<PassGather> out) {
-  for (size_t k = 0; k < points.size(); ++k) {
-    out[k] = PassGather{};
-    gather_photons(points[k], states[k].r2, grid, hits, out[k]);
-  }
+  for (size_t k = 0; k < points.size(); ++k)
+    if (max_component(points[k].f) > 0.0f)  // SPPM: a pixel without a visible point this pass
+      gather_photons(points[k], states[k].r2, grid, hits, out[k]);
 }
 
 void next_event_pass(const World& world, std::span<const MeasurementPoint> points, uint64_t seed,
                      uint64_t pass, size_t first, std::span<PassGather> out) {
   for (size_t k = 0; k < points.size(); ++k) {
+    if (!(max_component(points[k].f) > 0.0f)) continue;
     Rng rng(seed, pass, first + k, Stream::DirectLight);
-    out[k].direct = direct_light(world, points[k], rng);
+    out[k].direct += direct_light(world, points[k], rng);
   }
 }
 
@@ -126,12 +128,41 @@ void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> poi
     const size_t count = std::min(block, n - first);
     parallel_for(count, kGrain, [&](size_t b, size_t e) {
       const std::span<PassGather> out = sums.subspan(b, e - b);
+      std::fill(out.begin(), out.end(), PassGather{});
       gather_pass(points.subspan(first + b, e - b),
                   std::span<const PointState>(states).subspan(first + b, e - b), in.grid, in.hits,
                   out);
       if (in.next_event)
         next_event_pass(in.world, points.subspan(first + b, e - b), in.seed, in.pass, first + b,
                         out);
+    });
+    // A distributed render reduces sums[0, count) across machines here.
+    parallel_for(count, kGrain, [&](size_t b, size_t e) {
+      fold_pass(states.subspan(first + b, e - b),
+                std::span<const PassGather>(sums).subspan(b, e - b), in.params, in.pass,
+                radii.subspan(first + b, e - b), copy ? copy + first + b : nullptr);
+    });
+  }
+}
+
+void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
+                          std::span<PointState> states, std::span<float> radii,
+                          std::span<uint32_t> visible, std::span<MeasurementPoint> points,
+                          std::span<PassGather> sums, PointState* copy) {
+  constexpr size_t kGrain = 256;  // pixels per parallel task inside a block
+  const size_t n = states.size(), block = sums.size();
+  for (size_t first = 0; first < n; first += block) {
+    const size_t count = std::min(block, n - first);
+    parallel_for(count, kGrain, [&](size_t b, size_t e) {
+      const std::span<MeasurementPoint> pts = points.subspan(b, e - b);
+      const std::span<PassGather> out = sums.subspan(b, e - b);
+      trace_visible_points(camera, first + b, pts, out);
+      gather_pass(pts, std::span<const PointState>(states).subspan(first + b, e - b), in.grid,
+                  in.hits, out);
+      if (in.next_event) next_event_pass(in.world, pts, in.seed, in.pass, first + b, out);
+      for (size_t k = 0; k < pts.size(); ++k)  // saturating: 2^32 - 1 passes is far beyond use
+        if (max_component(pts[k].f) > 0.0f && visible[first + b + k] != UINT32_MAX)
+          ++visible[first + b + k];
     });
     // A distributed render reduces sums[0, count) across machines here.
     parallel_for(count, kGrain, [&](size_t b, size_t e) {

@@ -25,17 +25,20 @@ ExrImage pack_channels(const FilmImage& film) {
 }
 
 ExrImage Renderer::image(const RunInfo& run) const {
-  return image(run, work_, initial_radius_, states_);
+  return image(run, work_, initial_radius_, states_, visible_);
 }
 
 ExrImage Renderer::image(const RunInfo& run, const RenderState& state) const {
-  return image(run, state.work, state.initial_radius, state.states);
+  return image(run, state.work, state.initial_radius, state.states, state.visible);
 }
 
 ExrImage Renderer::image(const RunInfo& run, const WorkCounters& work, double initial_radius,
-                         const std::vector<PointState>& states) const {
+                         const std::vector<PointState>& states,
+                         const std::vector<uint32_t>& visible) const {
   FilmImage film;
-  const FilmSummary summary = pb::develop(eye_, states, work.passes, film_settings(), &film);
+  PixelLayout l = layout();
+  if (!l.visible_passes.empty()) l.visible_passes = visible;
+  const FilmSummary summary = pb::develop(l, states, work.passes, film_settings(), &film);
   ExrImage out = pack_channels(film);
   out.metadata = describe(options_);
   out.metadata.insert(out.metadata.end(),
@@ -49,7 +52,7 @@ ExrImage Renderer::image(const RunInfo& run, const WorkCounters& work, double in
                           {"initial_radius", number_text(initial_radius)},
                           {"mean_error_bound", number_text(summary.mean_bound)},
                           {"unknown_pixels", std::to_string(summary.unknown_pixels)},
-                          {"measurement_points", std::to_string(eye_.points.size())},
+                          {"estimator_states", std::to_string(states.size())},
                       });
   return out;
 }

@@ -1,5 +1,6 @@
 #include "photonbound/renderer.h"
 
+#include "photonbound/camera_paths.h"
 #include "photonbound/checkpoint.h"
 #include "photonbound/parallel.h"
 #include "photonbound/pass_stages.h"
@@ -49,7 +50,7 @@ double min_radius(const World& world) { return kMinRadiusFraction * world.scene_
 
 double default_initial_radius(const EyePassResult& eye, const World& world) {
   double r = 0.01 * world.scene_size();
-  if (!eye.points.empty()) {
+  if (eye.median_footprint > 0.0f) {
     const double f = kFootprintsPerRadius * double(eye.median_footprint);
     if (f > 0.0 && std::isfinite(f)) r = f;
   }
@@ -62,7 +63,19 @@ Renderer::Renderer(Scene scene, const RenderOptions& options)
       camera_(choose_camera(world_.scene(), options)),
       tracer_(world_, options.direct == DirectMode::Photons) {
   const auto t0 = Clock::now();
-  eye_ = run_eye_pass(world_, camera_, options_.max_depth);
+  size_t states = 0;
+  if (options_.method == Method::PPM) {
+    eye_ = run_eye_pass(world_, camera_, options_.max_depth);
+    states = eye_.points.size();
+  } else {
+    // SPPM keeps no points: the default radius comes from the footprints of a sample of
+    // pixel-centre paths (every 4th pixel each way).
+    eye_.width = camera_.width();
+    eye_.height = camera_.height();
+    eye_.median_footprint = median_footprint(world_, camera_, options_.max_depth, 4);
+    states = size_t(eye_.width) * size_t(eye_.height);
+    visible_.assign(states, 0);
+  }
   timings_.eye = seconds_since(t0);
   params_.alpha = options_.alpha;
   params_.photons_per_pass = double(options_.photons_per_pass);
@@ -72,9 +85,10 @@ Renderer::Renderer(Scene scene, const RenderOptions& options)
       options_.radius ? std::max(*options_.radius, r_min) : default_initial_radius(eye_, world_);
   PointState initial;
   initial.r2 = initial_radius_ * initial_radius_;
-  states_.assign(eye_.points.size(), initial);
-  radii_.assign(eye_.points.size(), search_radius(initial.r2));
+  states_.assign(states, initial);
+  radii_.assign(states, search_radius(initial.r2));
   sums_.resize(std::min(kFoldBlock, states_.size()));
+  if (options_.method == Method::SPPM) visible_points_.resize(sums_.size());
 }
 
 bool Renderer::radii_fixed() const {
@@ -111,7 +125,13 @@ void Renderer::step(std::vector<PointState>* copy) {
   const bool nee = options_.direct == DirectMode::NextEvent;
   if (copy) copy->resize(n);
   const PassInputs in{world_, grid_, hits_, params_, options_.seed, pass, nee};
-  gather_and_fold(in, eye_.points, states_, radii_, sums_, copy ? copy->data() : nullptr);
+  PointState* const out = copy ? copy->data() : nullptr;
+  if (options_.method == Method::PPM) {
+    gather_and_fold(in, eye_.points, states_, radii_, sums_, out);
+  } else {
+    const CameraPathInputs cam{world_, camera_, options_.max_depth, options_.seed, pass};
+    sppm_gather_and_fold(in, cam, states_, radii_, visible_, visible_points_, sums_, out);
+  }
   timings_.gather += seconds_since(t);
 }
 
@@ -120,6 +140,7 @@ RenderState Renderer::snapshot(std::vector<PointState> states) const {
   s.work = work_;
   s.initial_radius = initial_radius_;
   s.states = std::move(states);
+  s.visible = visible_;
   return s;
 }
 
@@ -128,18 +149,29 @@ void Renderer::restore(const RenderState& saved) {
     throw StateError("the state holds " + std::to_string(saved.states.size()) +
                      " measurement points but this scene and camera give " +
                      std::to_string(states_.size()));
+  if (saved.visible.size() != visible_.size())
+    throw StateError("the state holds " + std::to_string(saved.visible.size()) +
+                     " SPPM pixel counters but this render has " + std::to_string(visible_.size()));
   states_ = saved.states;
+  visible_ = saved.visible;
   for (size_t k = 0; k < states_.size(); ++k) radii_[k] = search_radius(states_[k].r2);
   work_ = saved.work;
   initial_radius_ = saved.initial_radius;
 }
 
+PixelLayout Renderer::layout() const {
+  if (options_.method == Method::PPM) return layout_of(eye_);
+  return {eye_.width, eye_.height, {}, {}, visible_};
+}
+
 FilmSummary Renderer::develop(FilmImage* image) const {
-  return pb::develop(eye_, states_, work_.passes, film_settings(), image);
+  return pb::develop(layout(), states_, work_.passes, film_settings(), image);
 }
 
 FilmSummary Renderer::develop(const RenderState& state, FilmImage* image) const {
-  return pb::develop(eye_, state.states, state.work.passes, film_settings(), image);
+  PixelLayout l = layout();
+  if (!l.visible_passes.empty()) l.visible_passes = state.visible;
+  return pb::develop(l, state.states, state.work.passes, film_settings(), image);
 }
 
 }  // namespace pb

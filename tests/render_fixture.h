@@ -18,8 +18,10 @@ inline RenderReport run_to_stop(Renderer& r, const DriverState& state = {}) {
   return Driver(r, state).run();
 }
 
+// PPM, whose measurement points the tests written for it inspect; SPPM tests set the method.
 inline RenderOptions quick_options(const std::string& scene, int size, uint64_t passes) {
   RenderOptions o;
+  o.method = Method::PPM;
   o.scene = scene_path(scene);
   o.output = "unused.exr";
   o.width = size;

@@ -10,6 +10,7 @@ namespace {
 
 struct Golden {
   const char* name;
+  Method method;
   const char* scene;
   int size;
   uint64_t passes;
@@ -21,14 +22,18 @@ struct Golden {
 
 // Rendered before the architecture change (issue 12), on the code of commit 45c8a0b.
 const Golden kGolden[] = {
-    {"cornell_nee", "cornell.gltf", 24, 5, 4000, DirectMode::NextEvent, 0.7, 0x5ac5b1728eb3f768ULL},
-    {"cornell_photons", "cornell.gltf", 20, 4, 3000, DirectMode::Photons, 0.8,
+    {"cornell_nee", Method::PPM, "cornell.gltf", 24, 5, 4000, DirectMode::NextEvent, 0.7,
+     0x5ac5b1728eb3f768ULL},
+    {"cornell_photons", Method::PPM, "cornell.gltf", 20, 4, 3000, DirectMode::Photons, 0.8,
      0x4d430f8daa26a20aULL},
-    {"glass_slab", "glass_slab.gltf", 20, 4, 3000, DirectMode::Photons, 0.7, 0x0a28d536620ea04dULL},
-    {"spot", "spot.gltf", 16, 3, 2000, DirectMode::NextEvent, 0.7, 0xbee0566f1b8f602eULL},
-    {"closed_box", "closed_box.gltf", 16, 4, 2000, DirectMode::NextEvent, 0.9,
+    {"glass_slab", Method::PPM, "glass_slab.gltf", 20, 4, 3000, DirectMode::Photons, 0.7,
+     0x0a28d536620ea04dULL},
+    {"spot", Method::PPM, "spot.gltf", 16, 3, 2000, DirectMode::NextEvent, 0.7,
+     0xbee0566f1b8f602eULL},
+    {"closed_box", Method::PPM, "closed_box.gltf", 16, 4, 2000, DirectMode::NextEvent, 0.9,
      0x423fa80618498e40ULL},
-    {"plane", "plane_point.gltf", 16, 4, 2000, DirectMode::Photons, 0.7, 0x9513915a75e21423ULL},
+    {"plane", Method::PPM, "plane_point.gltf", 16, 4, 2000, DirectMode::Photons, 0.7,
+     0x9513915a75e21423ULL},
 };
 
 uint64_t checksum_of(const Golden& g) {
@@ -36,6 +41,7 @@ uint64_t checksum_of(const Golden& g) {
   o.photons_per_pass = g.photons;
   o.direct = g.direct;
   o.alpha = g.alpha;
+  o.method = g.method;
   const Scene scene = load_gltf(o.scene);
   Renderer r(scene, o);
   for (uint64_t p = 0; p < g.passes; ++p) r.step();

@@ -1,4 +1,5 @@
-// Pinhole camera rays through pixel centres (pixel (0, 0) is the top-left corner).
+// Pinhole camera rays through pixel centres or any point of a pixel (pixel (0, 0) is the
+// top-left corner).
 #pragma once
 
 #include "photonbound/scene.h"
@@ -13,7 +14,10 @@ class PinholeCamera {
   int height() const { return height_; }
   const vec3& origin() const { return camera_.position; }
   // Unit direction through the centre of pixel (x, y).
-  vec3 direction(int x, int y) const;
+  vec3 direction(int x, int y) const { return direction(float(x) + 0.5f, float(y) + 0.5f); }
+  // Unit direction through the image point (px, py) in pixel units: pixel (x, y) covers
+  // [x, x + 1) x [y, y + 1).
+  vec3 direction(float px, float py) const;
   // Angle subtended by one pixel at the image centre (radians): the pixel footprint at
   // distance d is about d * pixel_angle().
   float pixel_angle() const { return 2.0f * tan_half_ / float(height_); }

@@ -4,7 +4,8 @@
 // Format (little-endian): "PBSTATE\0", u32 version, u32 sizeof(PointState), then the scene path
 // and command line, the options block (u64 count, then key and value strings written by the
 // option table's format(), strings as u64 length + bytes), the scene hash, the render's counters
-// and initial radius, the driver's schedule, the per-point states as raw PointState records, and
+// and initial radius, the driver's schedule, SPPM's per-pixel visible-pass counters (u64 count +
+// u32 each), the per-point states as raw PointState records, and
 // last a u64 checksum of every byte before it. Written atomically (file_io.h).
 #pragma once
 

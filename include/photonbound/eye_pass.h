@@ -35,4 +35,9 @@ struct EyePassResult {
 // max_depth: the most specular bounces a camera path may take before it is cut.
 EyePassResult run_eye_pass(const World& world, const PinholeCamera& camera, int max_depth);
 
+// The median pixel footprint over the measurement points of the pixel-centre paths of every
+// stride-th pixel in each direction (SPPM's default radius, without keeping the points); 0 when
+// no path reaches a diffuse surface.
+float median_footprint(const World& world, const PinholeCamera& camera, int max_depth, int stride);
+
 }  // namespace pb

@@ -7,6 +7,7 @@
 #include "photonbound/options.h"
 
 #include <cstdint>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -45,8 +46,22 @@ struct FilmSettings {
   double target = 0.0;  // 0 = no target
 };
 
-// Combines the points of every pixel. With passes < 2 no bound exists: every pixel with
-// points is unknown.
+// Which states make up each pixel (ESTIMATOR.md sections 5 and 10): PPM's measurement points,
+// grouped by pixel, plus the emission its camera rays see exactly; or SPPM's one state per
+// pixel (pixel_begin and emission empty) with the passes in which the pixel had a visible point.
+struct PixelLayout {
+  int width = 0, height = 0;
+  std::span<const uint32_t> pixel_begin;     // empty: state p is pixel p
+  std::span<const dvec3> emission;           // empty: no light outside the states
+  std::span<const uint32_t> visible_passes;  // SPPM: per pixel
+};
+PixelLayout layout_of(const EyePassResult& eye);
+
+// Combines the states of every pixel. With passes < 2 no bound exists: every pixel with
+// a state that is random is unknown.
+FilmSummary develop(const PixelLayout& layout, const std::vector<PointState>& states,
+                    uint64_t passes, const FilmSettings& settings, FilmImage* image);
+// PPM's layout (layout_of(eye)).
 FilmSummary develop(const EyePassResult& eye, const std::vector<PointState>& states,
                     uint64_t passes, const FilmSettings& settings, FilmImage* image);
 

@@ -21,6 +21,7 @@ class UsageError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+enum class Method { SPPM, PPM };
 enum class DirectMode { NextEvent, Photons };
 enum class ErrorMetric { Absolute, Relative };
 enum class ProgressMode { Auto, Always, Never };
@@ -33,6 +34,7 @@ struct RenderOptions {
   std::optional<uint64_t> passes;
   std::optional<double> time_seconds;
   std::optional<double> target_error;
+  Method method = Method::SPPM;
   uint64_t photons_per_pass = 100000;  // M_e
   double alpha = 0.7;
   std::optional<double> radius;  // world units; default from the pixel footprint

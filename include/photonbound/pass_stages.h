@@ -1,5 +1,6 @@
 // The stages of one pass, each a function of plain inputs and outputs, in the order the
 // renderer runs them (the bench times the same functions):
+//   0. SPPM only: camera paths trace_visible_points (camera_paths.h) -> visible points, emission
 //   1. trace photons          PhotonTracer::run (photon_pass.h)      -> hits
 //   2. build the grid         build_photon_grid                      -> grid over the hits
 //   3. gather                 gather_pass: photons within each radius -> pass sums (phi, lap, M)
@@ -41,14 +42,15 @@ void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& gr
 // One light sample with a shadow ray: D_j = f Li cos / pdf (ESTIMATOR.md section 4).
 dvec3 direct_light(const World& world, const MeasurementPoint& point, Rng& rng);
 
-// Stage 3: out[k] = the photons of the pass at points[k] (phi, phi_lap_r2, count; the direct
-// part is left alone). states[k].r2 is the radius of the pass.
+// Stage 3: adds the photons of the pass at points[k] into out[k] (phi, phi_lap_r2, count).
+// states[k].r2 is the radius of the pass. A point with f = 0 (SPPM: no visible point this
+// pass) gathers nothing and so does not shrink its radius.
 void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
                  const HashGrid& grid, const std::vector<PhotonHit>& hits,
                  std::span<PassGather> out);
 
-// Stage 4: out[k].direct = one next-event sample at points[k], drawn from
-// Rng(seed, pass, first + k, Stream::DirectLight): point first + k's own stream.
+// Stage 4: adds one next-event sample at points[k] to out[k].direct, drawn from
+// Rng(seed, pass, first + k, Stream::DirectLight): point (or pixel) first + k's own stream.
 void next_event_pass(const World& world, std::span<const MeasurementPoint> points, uint64_t seed,
                      uint64_t pass, size_t first, std::span<PassGather> out);
 
@@ -73,5 +75,14 @@ struct PassInputs {
 void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> points,
                      std::span<PointState> states, std::span<float> radii,
                      std::span<PassGather> sums, PointState* copy);
+
+// SPPM (ESTIMATOR.md section 10): the same with the camera stage first, per block of pixels:
+// trace_visible_points into `points` (block-sized scratch) and the sums' emission, gather,
+// next-event samples, count each pixel's passes with a visible point in `visible`, then fold.
+struct CameraPathInputs;
+void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
+                          std::span<PointState> states, std::span<float> radii,
+                          std::span<uint32_t> visible, std::span<MeasurementPoint> points,
+                          std::span<PassGather> sums, PointState* copy);
 
 }  // namespace pb

@@ -1,7 +1,8 @@
-// The render itself: state, step() and snapshot/restore, nothing else. The eye pass runs once;
-// then every pass runs the stages of pass_stages.h in turn (trace photons, build the grid,
-// gather into pass sums, fold the sums into the estimator). When to stop, what to print and
-// when to checkpoint belong to the driver (driver.h).
+// The render itself: state, step() and snapshot/restore, nothing else. PPM runs the eye pass
+// once and keeps its measurement points; SPPM traces fresh camera paths every pass and keeps one
+// state per pixel. Every pass runs the stages of pass_stages.h in turn (trace photons, build the
+// grid, [SPPM: camera paths,] gather into pass sums, fold the sums into the estimator). When to
+// stop, what to print and when to checkpoint belong to the driver (driver.h).
 #pragma once
 
 #include "photonbound/estimator.h"
@@ -30,7 +31,8 @@ struct WorkCounters {
 struct RenderState {
   WorkCounters work;
   double initial_radius = 0.0;
-  std::vector<PointState> states;
+  std::vector<PointState> states;  // PPM: one per measurement point; SPPM: one per pixel
+  std::vector<uint32_t> visible;   // SPPM: passes with a visible point, per pixel
 };
 
 // Wall-clock seconds spent in each phase, accumulated over all passes (for the benchmark).
@@ -80,6 +82,8 @@ class Renderer {
   // True when no radius can shrink any more (alpha = 1, or every radius at its floor).
   bool radii_fixed() const;
 
+  // Which states make up each pixel.
+  PixelLayout layout() const;
   // Radiance and bounds of the current states, or of a snapshot's; the film when wanted.
   FilmSummary develop(FilmImage* image = nullptr) const;
   FilmSummary develop(const RenderState& state, FilmImage* image) const;
@@ -88,6 +92,7 @@ class Renderer {
   ExrImage image(const RunInfo& run, const RenderState& state) const;
 
   const RenderOptions& options() const { return options_; }
+  // PPM: the measurement points. SPPM: the image size and the median footprint only.
   const EyePassResult& eye() const { return eye_; }
   const std::vector<PointState>& states() const { return states_; }
   FilmSettings film_settings() const;
@@ -97,7 +102,7 @@ class Renderer {
 
  private:
   ExrImage image(const RunInfo& run, const WorkCounters& work, double initial_radius,
-                 const std::vector<PointState>& states) const;
+                 const std::vector<PointState>& states, const std::vector<uint32_t>& visible) const;
 
   const RenderOptions options_;
   World world_;
@@ -109,8 +114,10 @@ class Renderer {
   HashGrid grid_;
   std::vector<PhotonHit> hits_;
   std::vector<vec3> hit_positions_;
-  std::vector<float> radii_;      // search_radius(r2) per point, for the grid build
-  std::vector<PassGather> sums_;  // one fold block's pass sums (pass_stages.h)
+  std::vector<float> radii_;                      // search_radius(r2) per point, for the grid build
+  std::vector<PassGather> sums_;                  // one fold block's pass sums (pass_stages.h)
+  std::vector<uint32_t> visible_;                 // SPPM: passes with a visible point, per pixel
+  std::vector<MeasurementPoint> visible_points_;  // SPPM: one fold block's, reused
   WorkCounters work_;
   double initial_radius_ = 0.0;
   PhaseTimings timings_;

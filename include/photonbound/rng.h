@@ -14,7 +14,7 @@ inline uint64_t mix64(uint64_t z) {
 }
 
 // Purposes separate the streams that share a (pass, item) key.
-enum class Stream : uint64_t { Photon = 1, DirectLight = 2, Test = 3 };
+enum class Stream : uint64_t { Photon = 1, DirectLight = 2, Test = 3, Camera = 4 };
 
 // PCG32 (O'Neill 2014, XSH-RR output) seeded from a hashed key.
 class Rng {
