@@ -119,8 +119,8 @@ void Loader::substitute(const tinygltf::Accessor& a, const std::string& al, size
     if (isize == 2) i = uint32_t(ib.data[2 * k]) | uint32_t(ib.data[2 * k + 1]) << 8;
     if (isize == 4) std::memcpy(&i, ib.data + 4 * k, 4);  // glTF is little-endian, as we are
     if (i >= a.count)
-      fail(sl + " index " + std::to_string(k) + " is " + std::to_string(i) +
-           ", out of range for " + std::to_string(a.count) + " elements");
+      fail(sl + " index " + std::to_string(k) + " is " + std::to_string(i) + ", out of range for " +
+           std::to_string(a.count) + " elements");
     if (k > 0 && i <= previous)
       fail(sl + " indices are not strictly increasing (index " + std::to_string(k) + " is " +
            std::to_string(i) + " after " + std::to_string(previous) + ")");
@@ -205,7 +205,8 @@ Bytes Loader::meshopt_view(int index, const std::string& vl) {
       {"EXPONENTIAL", MeshoptFilter::Exponential}};
   const auto filter = filters.find(filter_s);
   if (filter == filters.end())
-    fail(el + " has filter '" + filter_s + "'; expected NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL");
+    fail(el + " has filter '" + filter_s +
+         "'; expected NONE, OCTAHEDRAL, QUATERNION or EXPONENTIAL");
   if (v.byteStride != 0 && v.byteStride != stride)
     fail(vl + " has byteStride " + std::to_string(v.byteStride) +
          " but its EXT_meshopt_compression byteStride is " + std::to_string(stride));
@@ -215,7 +216,8 @@ Bytes Loader::meshopt_view(int index, const std::string& vl) {
   if (buffer >= m_.buffers.size())
     fail(el + " refers to " + absent("buffer", double(buffer), m_.buffers.size()));
   if (pre_.placeholders.count(size_t(buffer)))
-    fail(el + " reads buffer " + std::to_string(buffer) + ", which has no data (a fallback buffer)");
+    fail(el + " reads buffer " + std::to_string(buffer) +
+         ", which has no data (a fallback buffer)");
   const std::vector<unsigned char>& data = m_.buffers[size_t(buffer)].data;
   if (offset > data.size() || length > data.size() - offset)
     fail(el + " (offset " + std::to_string(offset) + ", length " + std::to_string(length) +
@@ -223,8 +225,8 @@ Bytes Loader::meshopt_view(int index, const std::string& vl) {
          std::to_string(data.size()) + " bytes)");
   std::vector<unsigned char> decoded;
   try {
-    decoded = decode_meshopt(data.data() + offset, size_t(length), count, stride, mode,
-                             filter->second);
+    decoded =
+        decode_meshopt(data.data() + offset, size_t(length), count, stride, mode, filter->second);
   } catch (const DecodeError& x) {
     fail(el + ": " + x.what());
   }

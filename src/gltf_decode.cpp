@@ -17,8 +17,8 @@ namespace {
 // The attribute's values for every point, converted to T (draco's ConvertValue refuses values
 // that do not fit T), packed.
 template <class T>
-std::vector<unsigned char> convert(const draco::PointAttribute& att, size_t points,
-                                   int components, int id) {
+std::vector<unsigned char> convert(const draco::PointAttribute& att, size_t points, int components,
+                                   int id) {
   std::vector<unsigned char> out(points * size_t(components) * sizeof(T));
   T value[4] = {};
   for (size_t p = 0; p < points; ++p) {
@@ -42,13 +42,20 @@ std::vector<unsigned char> attribute(const draco::Mesh& mesh, const DracoRequest
                       " components; the accessor has " + std::to_string(r.components));
   const size_t n = mesh.num_points();
   switch (r.component) {  // glTF componentType codes
-    case 5120: return convert<int8_t>(*att, n, r.components, r.unique_id);
-    case 5121: return convert<uint8_t>(*att, n, r.components, r.unique_id);
-    case 5122: return convert<int16_t>(*att, n, r.components, r.unique_id);
-    case 5123: return convert<uint16_t>(*att, n, r.components, r.unique_id);
-    case 5125: return convert<uint32_t>(*att, n, r.components, r.unique_id);
-    case 5126: return convert<float>(*att, n, r.components, r.unique_id);
-    default: throw DecodeError(al + ": unsupported componentType " + std::to_string(r.component));
+    case 5120:
+      return convert<int8_t>(*att, n, r.components, r.unique_id);
+    case 5121:
+      return convert<uint8_t>(*att, n, r.components, r.unique_id);
+    case 5122:
+      return convert<int16_t>(*att, n, r.components, r.unique_id);
+    case 5123:
+      return convert<uint16_t>(*att, n, r.components, r.unique_id);
+    case 5125:
+      return convert<uint32_t>(*att, n, r.components, r.unique_id);
+    case 5126:
+      return convert<float>(*att, n, r.components, r.unique_id);
+    default:
+      throw DecodeError(al + ": unsupported componentType " + std::to_string(r.component));
   }
 }
 
@@ -75,8 +82,7 @@ DracoMesh decode_draco(const unsigned char* data, size_t size,
 }
 
 std::vector<unsigned char> decode_meshopt(const unsigned char* data, size_t size, uint64_t count,
-                                          uint64_t stride, MeshoptMode mode,
-                                          MeshoptFilter filter) {
+                                          uint64_t stride, MeshoptMode mode, MeshoptFilter filter) {
   const std::string s = std::to_string(stride);
   if (mode == MeshoptMode::Attributes) {
     if (stride == 0 || stride % 4 != 0 || stride > 256)

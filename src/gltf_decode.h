@@ -46,7 +46,6 @@ enum class MeshoptFilter { None, Octahedral, Quaternion, Exponential };
 // asserts on them), and so is the smallest compressed size the codecs can reach, so that a
 // hostile count cannot make the output buffer arbitrarily large. Throws DecodeError.
 std::vector<unsigned char> decode_meshopt(const unsigned char* data, size_t size, uint64_t count,
-                                          uint64_t stride, MeshoptMode mode,
-                                          MeshoptFilter filter);
+                                          uint64_t stride, MeshoptMode mode, MeshoptFilter filter);
 
 }  // namespace pb::gltf

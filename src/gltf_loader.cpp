@@ -1,11 +1,13 @@
 // glTF 2.0 -> pb::Scene. Only the loader's files (src/gltf_*.cpp through gltf_loader_impl.h)
 // include tiny_gltf.h; the helpers that need no tinygltf types live in gltf_support.cpp.
 //
-// Phases: read the file (checking the GLB container), let tinygltf parse it (images are never
-// decoded), walk the default scene's node tree composing transforms, and turn every
+// Phases: read the file (checking the GLB container), rewrite the JSON where tinygltf 2.7 would
+// refuse valid glTF (gltf_prepass.h), let tinygltf parse it (images are never decoded), walk the
+// default scene's node tree composing transforms, and turn every
 // node x primitive into a world-space Mesh, every KHR_lights_punctual light instance into a
 // PunctualLight and every perspective camera into a Camera. Each accessor is validated before
-// it is read. Errors throw SceneError("<file>: <one line>"); a Scene is only returned whole.
+// it is read; Draco and meshoptimizer data are decoded on first use (gltf_decode.h). Errors throw
+// SceneError("<file>: <one line>"); a Scene is only returned whole.
 //
 // Material rules (the README repeats them):
 //  1. KHR_materials_transmission.transmissionFactor > 0 -> Dielectric (smooth glass) with

@@ -87,8 +87,7 @@ inline void expect_grid(const Mesh& m, const Grid& g, const Tolerance& tol, bool
         if (glm::length(p - want[k]) < glm::length(p - want[best])) best = k;
     map[i] = uint32_t(best);
     ASSERT_LE(glm::length(p - want[best]), tol.position) << "vertex " << i;
-    EXPECT_LE(glm::length(glm::dvec3(m.normals[i]) - world_normal(p3(g.normals, best))),
-              tol.normal)
+    EXPECT_LE(glm::length(glm::dvec3(m.normals[i]) - world_normal(p3(g.normals, best))), tol.normal)
         << "vertex " << i;
     for (int c = 0; c < 2; ++c) {
       EXPECT_NEAR(m.texcoords[0][i][c], g.uv0[2 * best + size_t(c)], tol.uv0) << "vertex " << i;
@@ -106,8 +105,7 @@ inline void expect_grid(const Mesh& m, const Grid& g, const Tolerance& tol, bool
   for (size_t t = 0; t < g.indices.size(); t += 3)
     grid.push_back(canonical({g.indices[t], g.indices[t + 1], g.indices[t + 2]}));
   for (size_t t = 0; t + 2 < m.indices.size(); t += 3)
-    loaded.push_back(
-        canonical({map[m.indices[t]], map[m.indices[t + 1]], map[m.indices[t + 2]]}));
+    loaded.push_back(canonical({map[m.indices[t]], map[m.indices[t + 1]], map[m.indices[t + 2]]}));
   EXPECT_EQ(m.indices.size(), g.indices.size());
   if (!same_order) {
     std::sort(grid.begin(), grid.end());

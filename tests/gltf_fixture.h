@@ -205,8 +205,7 @@ struct Doc {
     if (more_buffers.empty()) {
       more_buffers.push_back(json{{"byteLength", 0}});
       if (tagged)
-        more_buffers[0]["extensions"] =
-            json{{"EXT_meshopt_compression", json{{"fallback", true}}}};
+        more_buffers[0]["extensions"] = json{{"EXT_meshopt_compression", json{{"fallback", true}}}};
     }
     json& fallback = more_buffers[0];
     const size_t at = (fallback["byteLength"].get<size_t>() + 3) / 4 * 4;
@@ -272,6 +271,61 @@ struct Doc {
       f << gltf();
     }
     return path;
+  }
+};
+
+constexpr int kFloat = 5126, kShort = 5122, kUShort = 5123, kUInt = 5125;
+
+// A Draco primitive over bufferView `bv`, its accessors without bufferView.
+inline json draco_primitive(Doc& d, const Grid& g, int bv, const DracoIds& ids, size_t points) {
+  const json ext = json{{"bufferView", bv},
+                        {"attributes", json{{"POSITION", ids.position},
+                                            {"NORMAL", ids.normal},
+                                            {"TEXCOORD_0", ids.uv0},
+                                            {"TEXCOORD_1", ids.uv1}}}};
+  const json minmax = json{{"min", {-1, -1, -0.2}}, {"max", {1, 1, 0.2}}};
+  return json{{"attributes", json{{"POSITION", d.accessor(-1, kFloat, points, "VEC3", minmax)},
+                                  {"NORMAL", d.accessor(-1, kFloat, points, "VEC3")},
+                                  {"TEXCOORD_0", d.accessor(-1, kFloat, points, "VEC2")},
+                                  {"TEXCOORD_1", d.accessor(-1, kFloat, points, "VEC2")}}},
+              {"indices", d.accessor(-1, kUInt, g.indices.size(), "SCALAR")},
+              {"extensions", json{{"KHR_draco_mesh_compression", ext}}}};
+}
+
+// The grid with every attribute and the indices in EXT_meshopt_compression bufferViews: POSITION
+// FLOAT (no filter), NORMAL SHORT normalised with the OCTAHEDRAL filter (12 bits), TEXCOORD_0
+// FLOAT with the EXPONENTIAL filter (15-bit mantissa), TEXCOORD_1 FLOAT, indices TRIANGLES.
+struct MeshoptGrid {
+  static constexpr int kOctBits = 12, kExpBits = 15;
+  Doc d;
+  json prim;
+  MeshoptGrid(const Grid& g, bool tagged) {
+    const size_t n = g.vertices();
+    std::vector<float> n4;
+    for (size_t k = 0; k < n; ++k)
+      n4.insert(n4.end(), {g.normals[3 * k], g.normals[3 * k + 1], g.normals[3 * k + 2], 0.0f});
+    std::vector<int16_t> oct(4 * n);
+    meshopt_encodeFilterOct(oct.data(), n, 8, kOctBits, n4.data());
+    std::vector<float> exp(2 * n);
+    meshopt_encodeFilterExp(exp.data(), n, 8, kExpBits, g.uv0.data());
+    d.require({"EXT_meshopt_compression", "KHR_mesh_quantization"});
+    const auto attr = [&](const void* data, size_t stride, const char* filter) {
+      return d.meshopt_view(meshopt_vertices(data, n, stride), n, stride, "ATTRIBUTES", filter,
+                            true, tagged);
+    };
+    const int pos = attr(g.positions.data(), 12, "NONE"), nor = attr(oct.data(), 8, "OCTAHEDRAL"),
+              uv0 = attr(exp.data(), 8, "EXPONENTIAL"), uv1 = attr(g.uv1.data(), 8, "NONE");
+    const int idx = d.meshopt_view(meshopt_triangles(g.indices, n), g.indices.size(), 4,
+                                   "TRIANGLES", "NONE", false, tagged);
+    prim = json{{"attributes",
+                 json{{"POSITION", d.accessor(pos, kFloat, n, "VEC3")},
+                      {"NORMAL", d.accessor(nor, kShort, n, "VEC3", json{{"normalized", true}})},
+                      {"TEXCOORD_0", d.accessor(uv0, kFloat, n, "VEC2")},
+                      {"TEXCOORD_1", d.accessor(uv1, kFloat, n, "VEC2")}}},
+                {"indices", d.accessor(idx, kUInt, g.indices.size(), "SCALAR")}};
+  }
+  json& ext(int view) {
+    return d.j["bufferViews"][size_t(view)]["extensions"]["EXT_meshopt_compression"];
   }
 };
 

@@ -11,22 +11,27 @@ namespace {
 using namespace pb::test;
 using pb::Scene;
 
-constexpr int kByte = 5120, kUByte = 5121, kShort = 5122, kUShort = 5123, kUInt = 5125,
-              kFloat = 5126;
+constexpr int kByte = 5120, kUByte = 5121;  // the others are in gltf_fixture.h
 
 // The glTF 2.0 dequantisation of component type `c` (normalised or not).
 double dequantise(int c, bool normalized, int64_t v) {
   if (!normalized) return double(v);
   switch (c) {
-    case kByte: return std::max(double(v) / 127.0, -1.0);
-    case kUByte: return double(v) / 255.0;
-    case kShort: return std::max(double(v) / 32767.0, -1.0);
-    default: return double(v) / 65535.0;
+    case kByte:
+      return std::max(double(v) / 127.0, -1.0);
+    case kUByte:
+      return double(v) / 255.0;
+    case kShort:
+      return std::max(double(v) / 32767.0, -1.0);
+    default:
+      return double(v) / 65535.0;
   }
 }
 
 int64_t lowest(int c) { return c == kByte ? -128 : c == kShort ? -32768 : 0; }
-int64_t highest(int c) { return c == kByte ? 127 : c == kUByte ? 255 : c == kShort ? 32767 : 65535; }
+int64_t highest(int c) {
+  return c == kByte ? 127 : c == kUByte ? 255 : c == kShort ? 32767 : 65535;
+}
 size_t size_of(int c) { return c == kByte || c == kUByte ? 1 : 2; }
 
 // `v` (n elements of `comps` components) stored as component type c, each element padded to a
@@ -76,12 +81,11 @@ TEST_F(DecodeTest, QuantisedAttributesAreDequantisedThenTransformed) {
       const int t1 = d.accessor(packed(c, uv, 2), c, 4, "VEC2", json{{"normalized", !normalized}});
       const std::vector<uint16_t> idx = {0, 1, 2, 0, 2, 3};
       const int ia = d.accessor(d.view(idx), kUShort, 6, "SCALAR");
-      d.mesh_node(json{{"attributes", json{{"POSITION", pa},
-                                           {"NORMAL", na},
-                                           {"TEXCOORD_0", t0},
-                                           {"TEXCOORD_1", t1}}},
-                       {"indices", ia}},
-                  json{{"matrix", matrix}});
+      d.mesh_node(
+          json{{"attributes",
+                json{{"POSITION", pa}, {"NORMAL", na}, {"TEXCOORD_0", t0}, {"TEXCOORD_1", t1}}},
+               {"indices", ia}},
+          json{{"matrix", matrix}});
       SCOPED_TRACE("componentType " + std::to_string(c) + (normalized ? " normalized" : ""));
       const pb::Mesh& m = only_mesh(pb::load_gltf(d.write(path("quantised.gltf"))));
       ASSERT_EQ(m.positions.size(), 4u);
@@ -93,10 +97,11 @@ TEST_F(DecodeTest, QuantisedAttributesAreDequantisedThenTransformed) {
         const glm::dvec3 p(v(pos, c, normalized, 3 * i), v(pos, c, normalized, 3 * i + 1),
                            v(pos, c, normalized, 3 * i + 2));
         const glm::dvec3 w = glm::dvec3(m4 * glm::dvec4(p, 1.0));
-        for (int k = 0; k < 3; ++k) EXPECT_NEAR(m.positions[i][k], w[k], 1e-6 * (1 + std::abs(w[k])));
-        const glm::dvec3 n = glm::normalize(nm * glm::dvec3(v(nor, nc, true, 3 * i),
-                                                            v(nor, nc, true, 3 * i + 1),
-                                                            v(nor, nc, true, 3 * i + 2)));
+        for (int k = 0; k < 3; ++k)
+          EXPECT_NEAR(m.positions[i][k], w[k], 1e-6 * (1 + std::abs(w[k])));
+        const glm::dvec3 n =
+            glm::normalize(nm * glm::dvec3(v(nor, nc, true, 3 * i), v(nor, nc, true, 3 * i + 1),
+                                           v(nor, nc, true, 3 * i + 2)));
         for (int k = 0; k < 3; ++k) EXPECT_NEAR(m.normals[i][k], n[k], 1e-6);
         for (int k = 0; k < 2; ++k) {
           const double u0 = v(uv, c, normalized, 2 * i + size_t(k));
@@ -157,8 +162,8 @@ TEST_F(DecodeTest, SparseIndicesAccessorWithoutBufferView) {
     const int iv = d.view(std::vector<uint32_t>{1, 2, 4, 5});
     const int vv = d.view(std::vector<uint32_t>{1, 2, 2, 3});
     const int ia = d.accessor(-1, kUInt, 6, "SCALAR", json{{"sparse", sparse(4, iv, kUInt, vv)}});
-    const pb::Mesh& m = only_mesh(
-        pb::load_gltf(quad_file(d, json{{"bufferView", d.view(kQuad)}}, path(name), ia)));
+    const pb::Mesh& m =
+        only_mesh(pb::load_gltf(quad_file(d, json{{"bufferView", d.view(kQuad)}}, path(name), ia)));
     EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3}));
   }
 }
@@ -183,8 +188,9 @@ TEST_F(DecodeTest, MalformedSparseIsASceneError) {
   d.view(kQuad);
   const int huge = d.accessor(-1, kFloat, size_t(1) << 27, "VEC3");
   d.mesh_node(json{{"attributes", json{{"POSITION", huge}}}}, json::object());
-  expect_error(d.write(path("huge.gltf")), "POSITION accessor 0 has no bufferView and 134217728 "
-                                           "elements of 12 bytes, more than the 256 MiB");
+  expect_error(d.write(path("huge.gltf")),
+               "POSITION accessor 0 has no bufferView and 134217728 "
+               "elements of 12 bytes, more than the 256 MiB");
 }
 
 TEST_F(DecodeTest, SkinWithoutInverseBindMatricesLoadsWithOnlyTheSkinWarning) {
@@ -195,8 +201,8 @@ TEST_F(DecodeTest, SkinWithoutInverseBindMatricesLoadsWithOnlyTheSkinWarning) {
   d.j["nodes"].back()["skin"] = 0;
   d.j["skins"] = json::array({json{{"joints", json::array({0})}}});
   const Scene s = pb::load_gltf(d.write(path("skin.gltf")));
-  EXPECT_EQ(s.warnings,
-            std::vector<std::string>{"node 'grid node': skins are ignored; the mesh is drawn unposed"});
+  EXPECT_EQ(s.warnings, std::vector<std::string>{
+                            "node 'grid node': skins are ignored; the mesh is drawn unposed"});
   EXPECT_EQ(only_mesh(s).indices.size(), 6u);
 }
 

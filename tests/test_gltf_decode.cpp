@@ -11,8 +11,6 @@ namespace {
 using namespace pb::test;
 using pb::Scene;
 
-constexpr int kFloat = 5126, kShort = 5122, kUShort = 5123, kUInt = 5125;
-
 double range(const std::vector<float>& v) {  // Draco quantises over the largest extent
   double lo[2] = {1e30, 1e30}, hi[2] = {-1e30, -1e30}, r = 0;
   for (size_t i = 0; i < v.size(); ++i) {
@@ -21,22 +19,6 @@ double range(const std::vector<float>& v) {  // Draco quantises over the largest
   }
   for (int c = 0; c < 2; ++c) r = std::max(r, hi[c] - lo[c]);
   return r;
-}
-
-// A Draco primitive over bufferView `bv`, its accessors without bufferView.
-json draco_primitive(Doc& d, const Grid& g, int bv, const DracoIds& ids, size_t points) {
-  const json ext = json{{"bufferView", bv},
-                        {"attributes", json{{"POSITION", ids.position},
-                                            {"NORMAL", ids.normal},
-                                            {"TEXCOORD_0", ids.uv0},
-                                            {"TEXCOORD_1", ids.uv1}}}};
-  const json minmax = json{{"min", {-1, -1, -0.2}}, {"max", {1, 1, 0.2}}};
-  return json{{"attributes", json{{"POSITION", d.accessor(-1, kFloat, points, "VEC3", minmax)},
-                                  {"NORMAL", d.accessor(-1, kFloat, points, "VEC3")},
-                                  {"TEXCOORD_0", d.accessor(-1, kFloat, points, "VEC2")},
-                                  {"TEXCOORD_1", d.accessor(-1, kFloat, points, "VEC2")}}},
-              {"indices", d.accessor(-1, kUInt, g.indices.size(), "SCALAR")},
-              {"extensions", json{{"KHR_draco_mesh_compression", ext}}}};
 }
 
 TEST_F(DecodeTest, DracoRoundTripsTheGrid) {
@@ -103,45 +85,11 @@ TEST_F(DecodeTest, MalformedDracoIsASceneError) {
   {
     Doc d;
     d.mesh_node(draco_primitive(d, g, d.view(enc), DracoIds{}, g.vertices() + 1));
-    expect_error(d.write(path("count.gltf")), "POSITION accessor 0 has count 82, but the Draco "
-                                              "data has 81 points");
+    expect_error(d.write(path("count.gltf")),
+                 "POSITION accessor 0 has count 82, but the Draco "
+                 "data has 81 points");
   }
 }
-
-// The grid with every attribute and the indices in EXT_meshopt_compression bufferViews: POSITION
-// FLOAT (no filter), NORMAL SHORT normalised with the OCTAHEDRAL filter (12 bits), TEXCOORD_0
-// FLOAT with the EXPONENTIAL filter (15-bit mantissa), TEXCOORD_1 FLOAT, indices TRIANGLES.
-struct MeshoptGrid {
-  static constexpr int kOctBits = 12, kExpBits = 15;
-  Doc d;
-  json prim;
-  MeshoptGrid(const Grid& g, bool tagged) {
-    const size_t n = g.vertices();
-    std::vector<float> n4;
-    for (size_t k = 0; k < n; ++k)
-      n4.insert(n4.end(), {g.normals[3 * k], g.normals[3 * k + 1], g.normals[3 * k + 2], 0.0f});
-    std::vector<int16_t> oct(4 * n);
-    meshopt_encodeFilterOct(oct.data(), n, 8, kOctBits, n4.data());
-    std::vector<float> exp(2 * n);
-    meshopt_encodeFilterExp(exp.data(), n, 8, kExpBits, g.uv0.data());
-    d.require({"EXT_meshopt_compression", "KHR_mesh_quantization"});
-    const auto attr = [&](const void* data, size_t stride, const char* filter) {
-      return d.meshopt_view(meshopt_vertices(data, n, stride), n, stride, "ATTRIBUTES", filter,
-                            true, tagged);
-    };
-    const int pos = attr(g.positions.data(), 12, "NONE"), nor = attr(oct.data(), 8, "OCTAHEDRAL"),
-              uv0 = attr(exp.data(), 8, "EXPONENTIAL"), uv1 = attr(g.uv1.data(), 8, "NONE");
-    const int idx = d.meshopt_view(meshopt_triangles(g.indices, n), g.indices.size(), 4,
-                                   "TRIANGLES", "NONE", false, tagged);
-    prim = json{{"attributes",
-                 json{{"POSITION", d.accessor(pos, kFloat, n, "VEC3")},
-                      {"NORMAL", d.accessor(nor, kShort, n, "VEC3", json{{"normalized", true}})},
-                      {"TEXCOORD_0", d.accessor(uv0, kFloat, n, "VEC2")},
-                      {"TEXCOORD_1", d.accessor(uv1, kFloat, n, "VEC2")}}},
-                {"indices", d.accessor(idx, kUInt, g.indices.size(), "SCALAR")}};
-  }
-  json& ext(int view) { return d.j["bufferViews"][size_t(view)]["extensions"]["EXT_meshopt_compression"]; }
-};
 
 TEST_F(DecodeTest, MeshoptRoundTripsTheGridWithAFallbackBuffer) {
   const Grid g = make_grid(17);
@@ -178,14 +126,14 @@ TEST_F(DecodeTest, MeshoptIndexSequenceAndQuaternionFilter) {
   const std::vector<uint32_t> tri = {0, 1, 4, 1, 2, 5, 3, 4, 7, 4, 5, 8, 0, 4, 3};
   Doc d;
   d.require({"EXT_meshopt_compression"});
-  const int pos = d.meshopt_view(meshopt_vertices(enc.data(), n, 8), n, 8, "ATTRIBUTES",
-                                 "QUATERNION");
-  const int idx = d.meshopt_view(meshopt_sequence(tri, n), tri.size(), 2, "INDICES", "NONE",
-                                 false);
-  d.mesh_node(json{{"attributes", json{{"POSITION", d.accessor(pos, kShort, n, "VEC3",
-                                                              json{{"normalized", true}})}}},
-                   {"indices", d.accessor(idx, kUShort, tri.size(), "SCALAR")}},
-              json::object());
+  const int pos =
+      d.meshopt_view(meshopt_vertices(enc.data(), n, 8), n, 8, "ATTRIBUTES", "QUATERNION");
+  const int idx = d.meshopt_view(meshopt_sequence(tri, n), tri.size(), 2, "INDICES", "NONE", false);
+  d.mesh_node(
+      json{{"attributes",
+            json{{"POSITION", d.accessor(pos, kShort, n, "VEC3", json{{"normalized", true}})}}},
+           {"indices", d.accessor(idx, kUShort, tri.size(), "SCALAR")}},
+      json::object());
   const pb::Mesh& m = only_mesh(pb::load_gltf(d.write(path("quat.glb"))));
   ASSERT_EQ(m.positions.size(), n);
   // The filter stores the three smallest components (12 bits each over [-1/sqrt(2), 1/sqrt(2)]:
@@ -211,25 +159,28 @@ TEST_F(DecodeTest, MalformedMeshoptIsASceneError) {
     mg.d.mesh_node(mg.prim);
     expect_error(mg.d.write(path(name)), phrase);
   };
-  bad("count.gltf", [](MeshoptGrid& mg) { mg.ext(0)["count"] = 26; },
+  bad(
+      "count.gltf", [](MeshoptGrid& mg) { mg.ext(0)["count"] = 26; },
       "bufferView 0 (of mesh 'grid' primitive 0 POSITION accessor 0) EXT_meshopt_compression: "
       "count x byteStride (26 x 12) is not the bufferView's byteLength (300)");
-  bad("stride.glb", [](MeshoptGrid& mg) { mg.ext(0)["byteStride"] = 16; },
+  bad(
+      "stride.glb", [](MeshoptGrid& mg) { mg.ext(0)["byteStride"] = 16; },
       "has byteStride 12 but its EXT_meshopt_compression byteStride is 16");
-  bad("filter-stride.gltf",
-      [](MeshoptGrid& mg) {
-        mg.ext(0)["filter"] = "QUATERNION";
-      },
+  bad(
+      "filter-stride.gltf", [](MeshoptGrid& mg) { mg.ext(0)["filter"] = "QUATERNION"; },
       "this filter cannot decode a byteStride of 12");
-  bad("truncated.glb",
+  bad(
+      "truncated.glb",
       [](MeshoptGrid& mg) { mg.ext(0)["byteLength"] = mg.ext(0)["byteLength"].get<int>() - 8; },
       "EXT_meshopt_compression: the compressed data is malformed");
-  bad("mode.gltf", [](MeshoptGrid& mg) { mg.ext(4)["mode"] = "STRIPS"; },
+  bad(
+      "mode.gltf", [](MeshoptGrid& mg) { mg.ext(4)["mode"] = "STRIPS"; },
       "has mode 'STRIPS'; expected ATTRIBUTES, TRIANGLES or INDICES");
-  bad("uncompressed.gltf",
-      [](MeshoptGrid& mg) { mg.d.j["bufferViews"][0].erase("extensions"); },
+  bad(
+      "uncompressed.gltf", [](MeshoptGrid& mg) { mg.d.j["bufferViews"][0].erase("extensions"); },
       "reads buffer 1, which has no data (a fallback buffer), and is not compressed");
-  bad("from-fallback.glb", [](MeshoptGrid& mg) { mg.ext(1)["buffer"] = 1; },
+  bad(
+      "from-fallback.glb", [](MeshoptGrid& mg) { mg.ext(1)["buffer"] = 1; },
       "EXT_meshopt_compression reads buffer 1, which has no data (a fallback buffer)");
 }
 

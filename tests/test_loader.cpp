@@ -571,7 +571,7 @@ TEST_F(LoaderTest, LinesModeIsRejected) {
   expect_error(g, "mesh 'tri' primitive 0 uses mode LINES; only TRIANGLES is supported");
 }
 
-TEST_F(LoaderTest, SparseIndicesMustIncrease) {  // test_gltf_decode.cpp has the valid cases
+TEST_F(LoaderTest, SparseIndicesMustIncrease) {  // test_gltf_accessors.cpp: the valid cases
   Gltf g = basic();
   const int iv = g.view(std::vector<uint16_t>{1, 0});
   const int vv = g.view(std::vector<float>{5, 5, 5, 6, 6, 6});
