@@ -1,50 +1,148 @@
-// The glTF loader's accessors and primitives (see gltf_loader_impl.h).
+// The glTF loader's primitives (see gltf_loader_impl.h): POSITION, NORMAL, TEXCOORD_0/1 and
+// indices, read from accessors (gltf_accessor.cpp) or from the decoded KHR_draco_mesh_compression
+// data, integer attributes dequantised (KHR_mesh_quantization), then placed in world space.
+#include "gltf_decode.h"
 #include "gltf_loader_impl.h"
 
 #include <algorithm>
 #include <climits>
+#include <cmath>
 
 namespace pb::gltf {
 
-View Loader::accessor(int index, const std::string& ctx, std::initializer_list<int> components,
-                      int type) const {
-  if (index < 0 || size_t(index) >= m_.accessors.size())
-    fail(ctx + " refers to " + absent("accessor", index, m_.accessors.size()));
-  const tinygltf::Accessor& a = m_.accessors[size_t(index)];
-  const std::string al = ctx + " accessor " + std::to_string(index);
-  if (a.sparse.isSparse) fail(al + " is sparse; sparse accessors are not supported");
-  if (a.type != type) fail(al + " has type " + type_name(a.type) + "; expected " + type_name(type));
-  if (std::find(components.begin(), components.end(), a.componentType) == components.end()) {
-    std::string want;
-    for (int c : components) want += (want.empty() ? "" : " or ") + component_name(c);
-    fail(al + " has componentType " + component_name(a.componentType) + "; expected " + want);
+namespace {
+
+constexpr std::initializer_list<int> kIndexComponents = {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE,
+                                                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
+                                                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT};
+
+// The vertex attributes the renderer reads: their accessor type, and float or (normalised or
+// not) 8- and 16-bit integers (KHR_mesh_quantization; it allows fewer combinations for NORMAL,
+// but every one of these has one meaning).
+int attribute_type(const std::string& name) {
+  return name.rfind("TEXCOORD_", 0) == 0 ? TINYGLTF_TYPE_VEC2 : TINYGLTF_TYPE_VEC3;
+}
+constexpr std::initializer_list<int> kAttributeComponents = {
+    TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE,
+    TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT,
+    TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT};
+const char* const kAttributes[] = {"POSITION", "NORMAL", "TEXCOORD_0", "TEXCOORD_1"};
+
+// An integer member of an extension object, or -1 when absent or not an integer.
+int ext_int(const tinygltf::Value& obj, const char* key) {
+  if (!obj.IsObject() || !obj.Has(key) || !obj.Get(key).IsInt()) return -1;
+  return obj.Get(key).GetNumberAsInt();
+}
+
+}  // namespace
+
+// KHR_draco_mesh_compression: the extension's bufferView holds a Draco mesh; "attributes" maps
+// glTF attribute names to Draco unique ids. The accessors of the attributes it maps (and of the
+// indices) keep their type, componentType and count, which must match the decoded data; their
+// bufferView (if any, an uncompressed fallback) is not read. Decoded once per primitive.
+const DracoPrimitive* Loader::draco(size_t mesh, size_t p, const std::string& where) {
+  const tinygltf::Primitive& prim = m_.meshes[mesh].primitives[p];
+  const auto ext = prim.extensions.find("KHR_draco_mesh_compression");
+  if (ext == prim.extensions.end()) return nullptr;
+  if (const auto it = draco_.find({mesh, p}); it != draco_.end()) return &it->second;
+  const std::string el = where + " KHR_draco_mesh_compression";
+  const tinygltf::Value& e = ext->second;
+  const int view = ext_int(e, "bufferView");
+  if (view < 0) fail(el + " has no valid bufferView");
+  if (!e.Has("attributes") || !e.Get("attributes").IsObject())
+    fail(el + " has no attributes object");
+  const tinygltf::Value& ids = e.Get("attributes");
+  std::vector<DracoRequest> want;
+  std::vector<std::string> names;
+  for (const char* name : kAttributes) {
+    if (!ids.Has(name)) continue;
+    const int id = ext_int(ids, name);
+    if (id < 0) fail(el + ": the id of " + name + " is not a non-negative integer");
+    const auto a = prim.attributes.find(name);
+    if (a == prim.attributes.end())
+      fail(el + " maps " + name + ", which the primitive's attributes do not list");
+    std::string al;
+    const tinygltf::Accessor& acc =
+        header(a->second, where + " " + name, kAttributeComponents, attribute_type(name), al);
+    want.push_back({id, acc.componentType, tinygltf::GetNumComponentsInType(uint32_t(acc.type))});
+    names.push_back(name);
   }
-  if (a.bufferView < 0) fail(al + " has no bufferView; accessors without data are not supported");
-  if (size_t(a.bufferView) >= m_.bufferViews.size())
-    fail(al + " refers to " + absent("bufferView", a.bufferView, m_.bufferViews.size()));
-  const tinygltf::BufferView& v = m_.bufferViews[size_t(a.bufferView)];
-  const std::string vl = "bufferView " + std::to_string(a.bufferView) + " (of " + al + ")";
-  if (v.buffer < 0 || size_t(v.buffer) >= m_.buffers.size())
-    fail(vl + " refers to " + absent("buffer", v.buffer, m_.buffers.size()));
-  const size_t size = m_.buffers[size_t(v.buffer)].data.size();
-  if (v.byteOffset > size || v.byteLength > size - v.byteOffset)
-    fail(vl + " (offset " + std::to_string(v.byteOffset) + ", length " +
-         std::to_string(v.byteLength) + ") extends past the end of buffer " +
-         std::to_string(v.buffer) + " (" + std::to_string(size) + " bytes)");
+  const Bytes b = view_bytes(view, el);
+  DracoMesh decoded;
+  try {
+    decoded = decode_draco(b.data, b.size, want);
+  } catch (const DecodeError& x) {
+    fail(el + ": " + x.what());
+  }
+  DracoPrimitive out;
+  out.points = decoded.points;
+  out.indices = std::move(decoded.indices);
+  for (size_t k = 0; k < names.size(); ++k)
+    out.attributes[names[k]] = std::move(decoded.attributes[k]);
+  return &draco_.emplace(std::make_pair(mesh, p), std::move(out)).first->second;
+}
+
+// The primitive's attribute `name`, from the Draco data when the extension maps it.
+std::optional<View> Loader::attribute(const tinygltf::Primitive& prim, const DracoPrimitive* dp,
+                                      const std::string& name, const std::string& where) {
+  const auto it = prim.attributes.find(name);
+  if (it == prim.attributes.end()) return std::nullopt;
+  const std::string ctx = where + " " + name;
+  const int type = attribute_type(name);
+  const auto d = dp ? dp->attributes.find(name) : decltype(dp->attributes.end())();
+  if (!dp || d == dp->attributes.end())
+    return accessor(it->second, ctx, kAttributeComponents, type);
+  std::string al;
+  const tinygltf::Accessor& a = header(it->second, ctx, kAttributeComponents, type, al);
+  if (a.count != dp->points)
+    fail(al + " has count " + std::to_string(a.count) + ", but the Draco data has " +
+         std::to_string(dp->points) + " points");
   const size_t element = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType)) *
                                 tinygltf::GetNumComponentsInType(uint32_t(a.type)));
-  const size_t stride = v.byteStride != 0 ? v.byteStride : element;
-  if (stride < element)
-    fail(vl + " has byteStride " + std::to_string(stride) + ", smaller than the " +
-         std::to_string(element) + "-byte elements of " + al);
-  const size_t room = v.byteLength - std::min(v.byteLength, a.byteOffset);
-  if (a.count > 0 && (element > room || (a.count - 1) > (room - element) / stride))
-    fail(al + " reads past the end of bufferView " + std::to_string(a.bufferView) + " (" +
-         std::to_string(a.count) + " elements of " + std::to_string(element) + " bytes, stride " +
-         std::to_string(stride) + ", from offset " + std::to_string(a.byteOffset) + " in " +
-         std::to_string(v.byteLength) + " bytes)");
-  return View{m_.buffers[size_t(v.buffer)].data.data() + v.byteOffset + a.byteOffset, stride,
-              a.count, a.componentType};
+  return View{d->second.data(), element, a.count, a.componentType, a.normalized};
+}
+
+// Three per triangle, each below `vertices`: the Draco faces, the indices accessor, or
+// 0, 1, 2, ... when there is none. tinygltf never sees an indices accessor without bufferView
+// (gltf_prepass.h), so that one comes from the prepass.
+std::vector<uint32_t> Loader::indices(size_t mesh, size_t p, const DracoPrimitive* dp,
+                                      size_t vertices, const std::string& where) {
+  const tinygltf::Primitive& prim = m_.meshes[mesh].primitives[p];
+  int index = prim.indices;
+  if (const auto it = pre_.indices.find({mesh, p}); it != pre_.indices.end()) index = it->second;
+  const std::string il = where + " indices";
+  std::vector<uint32_t> idx;
+  if (dp) {
+    if (index >= 0) {
+      std::string al;
+      const tinygltf::Accessor& a = header(index, il, kIndexComponents, TINYGLTF_TYPE_SCALAR, al);
+      if (a.count != dp->indices.size())
+        fail(al + " has count " + std::to_string(a.count) + ", but the Draco data has " +
+             std::to_string(dp->indices.size()) + " indices");
+    }
+    idx = dp->indices;
+  } else if (index >= 0) {
+    const View iv = accessor(index, il, kIndexComponents, TINYGLTF_TYPE_SCALAR);
+    idx.resize(iv.count);
+    for (size_t i = 0; i < iv.count; ++i)
+      idx[i] = iv.component == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? iv.get<uint8_t>(i, 0)
+               : iv.component == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? iv.get<uint16_t>(i, 0)
+                                                                        : iv.get<uint32_t>(i, 0);
+  } else {
+    if (vertices % 3 != 0)
+      fail(where + " has " + std::to_string(vertices) + " vertices, not a multiple of 3, and " +
+           "no indices");
+    idx.resize(vertices);
+    for (size_t i = 0; i < idx.size(); ++i) idx[i] = uint32_t(i);
+  }
+  const std::string from = dp ? il + " (Draco faces)" : il + " accessor " + std::to_string(index);
+  for (size_t i = 0; i < idx.size(); ++i)
+    if (idx[i] >= vertices)
+      fail(from + ": index " + std::to_string(i) + " has value " + std::to_string(idx[i]) +
+           ", out of range for " + std::to_string(vertices) + " vertices");
+  if (idx.size() % 3 != 0)
+    fail(where + " has " + std::to_string(idx.size()) + " indices, not a multiple of 3");
+  return idx;
 }
 
 void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
@@ -55,16 +153,15 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
   if (prim.mode != TINYGLTF_MODE_TRIANGLES)
     fail(where + " uses mode " + mode_name(prim.mode) + "; only TRIANGLES is supported");
   if (!prim.targets.empty()) warn(ml + ": morph targets are ignored");
-  const auto pit = prim.attributes.find("POSITION");
-  if (pit == prim.attributes.end()) fail(where + " has no POSITION attribute");
-  constexpr int kFloat = TINYGLTF_COMPONENT_TYPE_FLOAT;
-  const View pos = accessor(pit->second, where + " POSITION", {kFloat}, TINYGLTF_TYPE_VEC3);
+  if (!prim.attributes.count("POSITION")) fail(where + " has no POSITION attribute");
+  const DracoPrimitive* dp = draco(mesh_index, p, where);
+  const View pos = *attribute(prim, dp, "POSITION", where);
   if (pos.count > UINT32_MAX) fail(where + " has more than 2^32 vertices");
   Mesh out;
   out.name = gm.name.empty() ? "mesh " + std::to_string(mesh_index) : gm.name;
   out.positions.resize(pos.count);
   for (size_t i = 0; i < pos.count; ++i) {
-    const dvec3 local = pos.vec3f(i), w = xf.point(local);
+    const dvec3 local = pos.vec3(i), w = xf.point(local);
     if (!is_finite(vec3(local)))
       fail(ml + " has a non-finite vertex coordinate (POSITION, vertex " + std::to_string(i) + ")");
     if (!(std::max({std::abs(w.x), std::abs(w.y), std::abs(w.z)}) <= kMaxCoordinate))
@@ -72,15 +169,14 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
            std::to_string(i) + ")");
     out.positions[i] = vec3(w);
   }
-  if (const auto nit = prim.attributes.find("NORMAL"); nit != prim.attributes.end()) {
-    const View nor = accessor(nit->second, where + " NORMAL", {kFloat}, TINYGLTF_TYPE_VEC3);
-    if (nor.count != pos.count)
-      fail(where + " has " + std::to_string(nor.count) + " normals for " +
+  if (const std::optional<View> nor = attribute(prim, dp, "NORMAL", where)) {
+    if (nor->count != pos.count)
+      fail(where + " has " + std::to_string(nor->count) + " normals for " +
            std::to_string(pos.count) + " positions");
     const dmat3 normal_matrix = glm::transpose(glm::inverse(xf.linear));
-    out.normals.resize(nor.count);
-    for (size_t i = 0; i < nor.count; ++i) {
-      const dvec3 local = nor.vec3f(i), w = normal_matrix * local;
+    out.normals.resize(nor->count);
+    for (size_t i = 0; i < nor->count; ++i) {
+      const dvec3 local = nor->vec3(i), w = normal_matrix * local;
       if (!is_finite(vec3(local)))
         fail(ml + " has a non-finite vertex coordinate (NORMAL, vertex " + std::to_string(i) + ")");
       const dvec3 unit = w / glm::length(w);
@@ -92,32 +188,23 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
       }
     }
   }
-  std::vector<uint32_t> idx;
-  if (prim.indices >= 0) {
-    const View iv =
-        accessor(prim.indices, where + " indices",
-                 {TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT,
-                  TINYGLTF_COMPONENT_TYPE_UNSIGNED_INT},
-                 TINYGLTF_TYPE_SCALAR);
-    idx.resize(iv.count);
-    for (size_t i = 0; i < iv.count; ++i) {
-      idx[i] = iv.component == TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE    ? iv.get<uint8_t>(i, 0)
-               : iv.component == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? iv.get<uint16_t>(i, 0)
-                                                                        : iv.get<uint32_t>(i, 0);
-      if (idx[i] >= pos.count)
-        fail(where + " indices accessor " + std::to_string(prim.indices) + ": index " +
-             std::to_string(i) + " has value " + std::to_string(idx[i]) + ", out of range for " +
-             std::to_string(pos.count) + " vertices");
+  for (int set = 0; set < 2; ++set) {
+    const std::string name = "TEXCOORD_" + std::to_string(set);
+    const std::optional<View> uv = attribute(prim, dp, name, where);
+    if (!uv) continue;
+    if (uv->count != pos.count)
+      fail(where + " has " + std::to_string(uv->count) + " " + name + " values for " +
+           std::to_string(pos.count) + " positions");
+    std::vector<vec2>& dst = out.texcoords[set];
+    dst.resize(uv->count);
+    for (size_t i = 0; i < uv->count; ++i) {
+      dst[i] = vec2(float(uv->scalar(i, 0)), float(uv->scalar(i, 1)));
+      if (!std::isfinite(dst[i].x) || !std::isfinite(dst[i].y))
+        fail(ml + " has a non-finite texture coordinate (" + name + ", vertex " +
+             std::to_string(i) + ")");
     }
-    if (idx.size() % 3 != 0)
-      fail(where + " has " + std::to_string(idx.size()) + " indices, not a multiple of 3");
-  } else {
-    if (pos.count % 3 != 0)
-      fail(where + " has " + std::to_string(pos.count) + " vertices, not a multiple of 3, and " +
-           "no indices");
-    idx.resize(pos.count);
-    for (size_t i = 0; i < idx.size(); ++i) idx[i] = uint32_t(i);
   }
+  const std::vector<uint32_t> idx = indices(mesh_index, p, dp, pos.count, where);
   out.material = material(prim.material, where);
   const bool flip = xf.det < 0.0;  // a mirroring transform: keep the counter-clockwise front
   for (size_t t = 0; t < idx.size(); t += 3) {
@@ -131,5 +218,4 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
   if (!out.indices.empty()) scene_.meshes.push_back(std::move(out));
 }
 
-// extensions[name][key] as a number, or fallback when absent; a present non-number is an error.
 }  // namespace pb::gltf

@@ -1,11 +1,13 @@
 // glTF 2.0 -> pb::Scene. Only the loader's files (src/gltf_*.cpp through gltf_loader_impl.h)
 // include tiny_gltf.h; the helpers that need no tinygltf types live in gltf_support.cpp.
 //
-// Phases: read the file (checking the GLB container), let tinygltf parse it (images are never
-// decoded), walk the default scene's node tree composing transforms, and turn every
+// Phases: read the file (checking the GLB container), rewrite the JSON where tinygltf 2.7 would
+// refuse valid glTF (gltf_prepass.h), let tinygltf parse it (images are never decoded), walk the
+// default scene's node tree composing transforms, and turn every
 // node x primitive into a world-space Mesh, every KHR_lights_punctual light instance into a
 // PunctualLight and every perspective camera into a Camera. Each accessor is validated before
-// it is read. Errors throw SceneError("<file>: <one line>"); a Scene is only returned whole.
+// it is read; Draco and meshoptimizer data are decoded on first use (gltf_decode.h). Errors throw
+// SceneError("<file>: <one line>"); a Scene is only returned whole.
 //
 // Material rules (the README repeats them):
 //  1. KHR_materials_transmission.transmissionFactor > 0 -> Dielectric (smooth glass) with
@@ -40,12 +42,34 @@ bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, in
   return true;  // accept without decoding: textures are not used
 }
 
-// .glb by extension, otherwise glTF JSON. Every error tinygltf reports is fatal, even when it
-// returns true (2.7 drops e.g. a baseColorFactor of the wrong length with only a message).
+// tinygltf 2.7 parses "inverseBindMatrices" as required (glTF makes it optional: identity
+// matrices) but still reads the skin; this is the one error line it then reports.
+bool spurious(const std::string& line) {
+  return line == "'inverseBindMatrices' property is missing in Skin.";
+}
+
+// .glb by extension, otherwise glTF JSON, rewritten first where tinygltf needs it
+// (gltf_prepass.h). Every error tinygltf reports is fatal, even when it returns true (2.7 drops
+// e.g. a baseColorFactor of the wrong length with only a message), but the spurious ones.
 tinygltf::Model parse(const std::string& path, const std::vector<unsigned char>& bytes,
-                      std::vector<std::string>& warnings) {
+                      std::vector<std::string>& warnings, Prepass& pre) {
   const bool glb = std::filesystem::path(path).extension() == ".glb";
-  const uint32_t size = glb ? check_glb(path, bytes) : uint32_t(bytes.size());
+  uint32_t size = glb ? check_glb(path, bytes) : uint32_t(bytes.size());
+  const unsigned char* data = bytes.data();
+  std::string json;
+  std::vector<unsigned char> rewritten_glb;
+  const std::string_view text =
+      glb ? glb_json(bytes) : std::string_view(reinterpret_cast<const char*>(data), size);
+  if (prepass(text, glb, pre, json)) {
+    if (glb) {
+      rewritten_glb = replace_glb_json(bytes, size, json);
+      data = rewritten_glb.data();
+      size = uint32_t(rewritten_glb.size());
+    } else {
+      data = reinterpret_cast<const unsigned char*>(json.data());
+      size = uint32_t(json.size());
+    }
+  }
   const std::string dir = std::filesystem::path(path).parent_path().string();
   tinygltf::TinyGLTF reader;
   reader.SetImageLoader(&skip_image, nullptr);
@@ -53,14 +77,16 @@ tinygltf::Model parse(const std::string& path, const std::vector<unsigned char>&
   std::string err, warn;
   bool ok = false;
   try {
-    ok = glb ? reader.LoadBinaryFromMemory(&model, &err, &warn, bytes.data(), size, dir)
-             : reader.LoadASCIIFromString(&model, &err, &warn,
-                                          reinterpret_cast<const char*>(bytes.data()), size, dir);
+    ok = glb ? reader.LoadBinaryFromMemory(&model, &err, &warn, data, size, dir)
+             : reader.LoadASCIIFromString(&model, &err, &warn, reinterpret_cast<const char*>(data),
+                                          size, dir);
   } catch (const std::exception& e) {
     err = e.what();
     ok = false;
   }
-  const std::vector<std::string> errors = nonempty_lines(err), notes = nonempty_lines(warn);
+  std::vector<std::string> errors = nonempty_lines(err);
+  const std::vector<std::string> notes = nonempty_lines(warn);
+  errors.erase(std::remove_if(errors.begin(), errors.end(), spurious), errors.end());
   if (!ok || !errors.empty()) {
     std::string first = !errors.empty() ? errors[0] : !notes.empty() ? notes[0] : "unknown error";
     if (first.size() > 160) first = first.substr(0, 160) + "...";  // it may quote a data URI
@@ -98,10 +124,11 @@ Scene Loader::run(const std::vector<std::string>& parse_warnings) {
 
 void Loader::check_extensions() {
   static const std::set<std::string> known = {
-      "KHR_lights_punctual",   "KHR_materials_transmission",
-      "KHR_materials_ior",     "KHR_materials_emissive_strength",
-      "KHR_texture_transform", "KHR_texture_basisu",
-      "EXT_texture_webp"};  // textures: unread
+      "KHR_lights_punctual",        "KHR_materials_transmission",
+      "KHR_materials_ior",          "KHR_materials_emissive_strength",
+      "KHR_draco_mesh_compression", "EXT_meshopt_compression",
+      "KHR_mesh_quantization",      "KHR_texture_transform",
+      "KHR_texture_basisu",         "EXT_texture_webp"};  // textures: unread
   for (const std::string& e : m_.extensionsRequired)
     if (!known.count(e)) fail("requires extension '" + e + "', which is not supported");
   for (const std::string& e : m_.extensionsUsed)
@@ -179,8 +206,6 @@ void Loader::visit(const tinygltf::Node& n, const std::string& nl, const Xform& 
   if (n.extensions.count("KHR_lights_punctual")) add_light(n, nl, xf);
 }
 
-// Index, bufferView and buffer in range, type and componentType as expected, not sparse, and
-// byteOffset + stride * (count - 1) + element size within the bufferView within the buffer.
 void Loader::finish() {
   if (scene_.degenerate_triangles > 0)
     warn(std::to_string(scene_.degenerate_triangles) + " degenerate triangles skipped");
@@ -207,8 +232,9 @@ Scene load_gltf(const std::string& path) { return load_gltf_bytes(path, gltf::re
 
 Scene load_gltf_bytes(const std::string& path, const std::vector<unsigned char>& bytes) {
   std::vector<std::string> warnings;
-  const tinygltf::Model model = gltf::parse(path, bytes, warnings);
-  Scene scene = gltf::Loader(path, model).run(warnings);
+  gltf::Prepass pre;
+  const tinygltf::Model model = gltf::parse(path, bytes, warnings, pre);
+  Scene scene = gltf::Loader(path, model, pre).run(warnings);
   uint64_t total = bytes.size();
   for (const tinygltf::Buffer& b : model.buffers) total += b.data.size();
   Checksum hash(total);

@@ -1,10 +1,13 @@
 // The glTF loader's internals, shared by its translation units (src/gltf_loader.cpp: parsing,
-// the node walk and the final checks; src/gltf_geometry.cpp: accessors and primitives;
-// src/gltf_material.cpp: materials, lights and cameras). Only these files see tinygltf types.
+// the node walk and the final checks; src/gltf_accessor.cpp: accessors, sparse substitution and
+// EXT_meshopt_compression bufferViews; src/gltf_geometry.cpp: primitives, quantised attributes
+// and KHR_draco_mesh_compression; src/gltf_material.cpp: materials, lights and cameras). Only
+// these files see tinygltf types.
 #pragma once
 
 #include "photonbound/gltf_loader.h"
 
+#include "gltf_prepass.h"
 #include "gltf_support.h"
 
 #include <tiny_gltf.h>
@@ -12,6 +15,8 @@
 #include <cstdint>
 #include <initializer_list>
 #include <limits>
+#include <map>
+#include <optional>
 #include <set>
 #include <string>
 #include <vector>
@@ -28,9 +33,24 @@ inline bool fits_float(double v) {
   return std::abs(v) <= double(std::numeric_limits<float>::max());
 }
 
+// Bytes of a bufferView (or a part of one), validated.
+struct Bytes {
+  const unsigned char* data = nullptr;
+  size_t size = 0;
+};
+
+// A KHR_draco_mesh_compression primitive, decoded: the attributes the renderer reads, in the
+// layout of their glTF accessors, and the faces.
+struct DracoPrimitive {
+  size_t points = 0;
+  std::vector<uint32_t> indices;
+  std::map<std::string, std::vector<unsigned char>> attributes;  // by glTF attribute name
+};
+
 class Loader {
  public:
-  Loader(const std::string& file, const tinygltf::Model& model) : file_(file), m_(model) {}
+  Loader(const std::string& file, const tinygltf::Model& model, const Prepass& pre)
+      : file_(file), m_(model), pre_(pre) {}
   Scene run(const std::vector<std::string>& parse_warnings);
 
  private:
@@ -44,8 +64,24 @@ class Loader {
   void walk(int root, const std::string& from);
   void visit(const tinygltf::Node& n, const std::string& nl, const Xform& xf);
   dmat4 local_matrix(const tinygltf::Node& n, const std::string& nl) const;
-  View accessor(int index, const std::string& ctx, std::initializer_list<int> components,
-                int type) const;
+  // gltf_accessor.cpp
+  const tinygltf::Accessor& header(int index, const std::string& ctx,
+                                   std::initializer_list<int> components, int type,
+                                   std::string& al) const;
+  View accessor(int index, const std::string& ctx, std::initializer_list<int> components, int type);
+  View stored(const tinygltf::Accessor& a, const std::string& al, size_t element);
+  View synthesized(int index, const tinygltf::Accessor& a, const std::string& al, size_t element);
+  void substitute(const tinygltf::Accessor& a, const std::string& al, size_t element,
+                  std::vector<unsigned char>& data);
+  Bytes view_bytes(int index, const std::string& who);
+  Bytes span(int view, int offset, size_t length, const std::string& who);
+  Bytes meshopt_view(int index, const std::string& vl);
+  // gltf_geometry.cpp
+  const DracoPrimitive* draco(size_t mesh, size_t prim, const std::string& where);
+  std::optional<View> attribute(const tinygltf::Primitive& prim, const DracoPrimitive* draco,
+                                const std::string& name, const std::string& where);
+  std::vector<uint32_t> indices(size_t mesh, size_t prim, const DracoPrimitive* draco,
+                                size_t vertices, const std::string& where);
   void add_primitive(size_t mesh, size_t prim, const Xform& xf);
   uint32_t material(int index, const std::string& where);
   Material convert_material(size_t index);
@@ -58,6 +94,10 @@ class Loader {
 
   const std::string& file_;
   const tinygltf::Model& m_;
+  const Prepass& pre_;
+  std::map<int, std::vector<unsigned char>> decoded_views_;  // EXT_meshopt_compression
+  std::map<int, std::vector<unsigned char>> synthesized_;    // sparse or without bufferView
+  std::map<std::pair<size_t, size_t>, DracoPrimitive> draco_;
   Scene scene_;
   std::set<std::string> warned_;
   std::vector<char> visited_;

@@ -94,6 +94,28 @@ uint32_t check_glb(const std::string& path, const std::vector<unsigned char>& d)
   return uint32_t(length);
 }
 
+std::string_view glb_json(const std::vector<unsigned char>& glb) {
+  return std::string_view(reinterpret_cast<const char*>(glb.data()) + 20, size_t(le32(glb, 12)));
+}
+
+std::vector<unsigned char> replace_glb_json(const std::vector<unsigned char>& glb, uint32_t length,
+                                            const std::string& json) {
+  std::vector<unsigned char> out(glb.begin(), glb.begin() + 12);
+  std::string chunk = json;
+  while (chunk.size() % 4) chunk += ' ';  // chunks are 4-byte aligned
+  const uint64_t rest = 20 + le32(glb, 12), total = 20 + chunk.size() + (length - rest);
+  auto put32 = [&](size_t at, uint64_t v) {
+    for (int k = 0; k < 4; ++k) out[at + size_t(k)] = uint8_t(v >> (8 * k));
+  };
+  put32(8, total);
+  out.resize(20);
+  put32(12, chunk.size());
+  put32(16, 0x4E4F534Au);  // "JSON"
+  out.insert(out.end(), chunk.begin(), chunk.end());
+  out.insert(out.end(), glb.begin() + int64_t(rest), glb.begin() + int64_t(length));
+  return out;
+}
+
 Xform::Xform(const glm::dmat4& world)
     : m(world), linear(world), det(glm::determinant(glm::dmat3(world))) {}
 

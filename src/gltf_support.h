@@ -1,4 +1,4 @@
-// tinygltf-free helpers of the glTF loader (src/gltf_loader.cpp, the only file that sees
+// tinygltf-free helpers of the glTF loader (src/gltf_*.cpp, the only files that see
 // tinygltf types): one-line messages, reading the file, checking the GLB container, world
 // transforms and the degenerate-triangle test.
 #pragma once
@@ -6,9 +6,11 @@
 #include "photonbound/math.h"
 #include "photonbound/text.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <cstring>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace pb::gltf {
@@ -28,15 +30,33 @@ struct View {
   const unsigned char* base = nullptr;
   size_t stride = 0, count = 0;
   int component = 0;  // glTF componentType
+  bool normalized = false;
   template <class T>
   T get(size_t i, int c) const {
     T v;
     std::memcpy(&v, base + i * stride + size_t(c) * sizeof(T), sizeof(T));
     return v;
   }
-  dvec3 vec3f(size_t i) const {  // a FLOAT VEC3 element
-    return dvec3(get<float>(i, 0), get<float>(i, 1), get<float>(i, 2));
+  // Component c of element i as a number: FLOAT as stored, integers as stored or, when
+  // normalized, dequantised (glTF 2.0 "Animations": signed max(c / 127, -1) and
+  // max(c / 32767, -1), unsigned c / 255 and c / 65535; KHR_mesh_quantization uses the same).
+  double scalar(size_t i, int c) const {
+    switch (component) {
+      case 5120:
+        return normalized ? std::max(get<int8_t>(i, c) / 127.0, -1.0) : get<int8_t>(i, c);
+      case 5121:
+        return normalized ? get<uint8_t>(i, c) / 255.0 : get<uint8_t>(i, c);
+      case 5122:
+        return normalized ? std::max(get<int16_t>(i, c) / 32767.0, -1.0) : get<int16_t>(i, c);
+      case 5123:
+        return normalized ? get<uint16_t>(i, c) / 65535.0 : get<uint16_t>(i, c);
+      case 5125:
+        return get<uint32_t>(i, c);
+      default:
+        return get<float>(i, c);  // 5126: the loader checks componentType first
+    }
   }
+  dvec3 vec3(size_t i) const { return dvec3(scalar(i, 0), scalar(i, 1), scalar(i, 2)); }
 };
 
 // The whole file; throws SceneError "<path>: cannot open (<strerror>)" when it cannot.
@@ -45,6 +65,12 @@ std::vector<unsigned char> read_file(const std::string& path);
 // Checks the GLB header and chunk bounds (tinygltf 2.7 lets the BIN chunk run up to 8 bytes
 // past the declared length) and returns the declared length. Throws SceneError.
 uint32_t check_glb(const std::string& path, const std::vector<unsigned char>& data);
+
+// The JSON chunk of a GLB that check_glb accepted, and the same GLB (its first `length` bytes)
+// with that chunk replaced by `json`.
+std::string_view glb_json(const std::vector<unsigned char>& glb);
+std::vector<unsigned char> replace_glb_json(const std::vector<unsigned char>& glb, uint32_t length,
+                                            const std::string& json);
 
 // A node's world transform and what meshes, normals and directions need from it.
 struct Xform {

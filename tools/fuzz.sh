@@ -16,6 +16,7 @@ findings="$root/build-fuzz/findings"
 mkdir -p "$corpus" "$findings"
 cp "$root"/scenes/*.gltf "$root"/scenes/*.glb "$corpus"/
 cp "$root"/tests/data/fuzz/* "$corpus"/ 2>/dev/null || true
+"$root/build-fuzz/make_gltf_corpus" "$corpus"  # Draco, meshopt, quantised, sparse, skin
 cd "$root/build-fuzz"
 # Embree and TBB keep allocations alive until exit by design: leaks are not findings here.
 export ASAN_OPTIONS=detect_leaks=0

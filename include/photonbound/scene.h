@@ -28,9 +28,12 @@ struct Material {
 };
 
 struct Mesh {
-  std::string name;               // glTF mesh name (or "mesh <index>") for messages
-  std::vector<vec3> positions;    // world space
-  std::vector<vec3> normals;      // world space, unit length; empty when the file has none
+  std::string name;             // glTF mesh name (or "mesh <index>") for messages
+  std::vector<vec3> positions;  // world space
+  std::vector<vec3> normals;    // world space, unit length; empty when the file has none
+  // TEXCOORD_0 and TEXCOORD_1 as the file gives them (dequantised), one per position; empty
+  // when absent. Read for the texture work to come; nothing uses them yet.
+  std::vector<vec2> texcoords[2];
   std::vector<uint32_t> indices;  // three per triangle, degenerate triangles already removed
   uint32_t material = 0;          // index into Scene::materials
 };

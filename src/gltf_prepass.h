@@ -1,0 +1,34 @@
+// A rewrite of the glTF JSON before tinygltf 2.7 parses it, for two things glTF allows and
+// that parser refuses (the whole load fails):
+//  - EXT_meshopt_compression fallback buffers, which have no uri: in a .gltf tinygltf reports
+//    "'uri' is missing" and then fails to open the file "", in a .glb it copies the BIN chunk
+//    into every buffer without uri and fails when the declared byteLength is longer. Every such
+//    buffer (but the GLB's own BIN buffer, index 0 unless it is marked "fallback": true) becomes
+//    a one-byte data URI here; the loader knows it has no data.
+//  - a primitive whose indices accessor has no bufferView (every KHR_draco_mesh_compression
+//    primitive): tinygltf fails with "accessor[N] invalid bufferView". Its "indices" member is
+//    taken out here and handed to the loader beside the model.
+// Only files that name EXT_meshopt_compression, KHR_draco_mesh_compression or a "sparse"
+// accessor are parsed twice; nlohmann::json (the parser tinygltf uses) is seen only here.
+#pragma once
+
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <string_view>
+#include <utility>
+
+namespace pb::gltf {
+
+struct Prepass {
+  std::map<size_t, uint64_t> placeholders;           // buffer index -> declared byteLength
+  std::map<std::pair<size_t, size_t>, int> indices;  // (mesh, primitive) -> indices accessor
+};
+
+// When anything in `json` (the JSON text, or the GLB's JSON chunk when `glb`) needs changing,
+// writes the changed text to `rewritten`, fills `out` and returns true. Text that is not JSON,
+// or nests deeper than 512 levels, is left to tinygltf to report.
+bool prepass(std::string_view json, bool glb, Prepass& out, std::string& rewritten);
+
+}  // namespace pb::gltf
