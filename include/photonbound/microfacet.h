@@ -1,0 +1,134 @@
+// The glTF 2.0 metallic-roughness BRDF (glTF 2.0 specification, appendix B "BRDF
+// Implementation"): GGX microfacet reflection with height-correlated Smith masking-shadowing,
+// Schlick's Fresnel, a Lambertian base, and sampling of the visible normals (Heitz 2018).
+//
+// Everything is in a local shading frame whose normal is +z; the caller maps directions to and
+// from world space with an orthonormal basis. Directions are unit vectors pointing away from the
+// surface: wo toward the viewer (where light goes), wi toward the light (where it came from).
+// Reflection only: any direction with z <= 0 gets value and density 0.
+#pragma once
+
+#include "photonbound/math.h"
+
+namespace pb {
+
+// Smallest GGX alpha the functions below use (roughness 0.01); smaller alphas are raised to it,
+// so roughness 0 gives no NaN or infinity (the peak of D is 1/(pi alpha^2) = 3.2e7). Down to it,
+// values and densities are exact to float rounding for the float directions given. What float
+// directions cannot do is resolve a lobe close to their spacing (6e-8): the reflected lobe is
+// about 2 alpha wide in the plane of incidence and 2 alpha wo.z across it, so the directions
+// sample() draws follow pdf() (chi-square, 4e5 samples) only while alpha wo.z >= 1e-6, and
+// integrals over float directions are good to 1e-3 at alpha = 1e-4, wo.z = 0.01
+// (tests/test_microfacet*.cpp). A renderer should treat smaller roughness as a perfect mirror:
+// roughness >= 0.032 (alpha >= 1e-3) keeps alpha wo.z >= 1e-6 down to wo.z = 1e-3.
+inline constexpr float kMinGgxAlpha = 1e-4f;
+
+// glTF's remapping of perceptual roughness: alpha = roughness^2 (appendix B "Specular BRDF"),
+// roughness clamped to [0, 1] and alpha raised to kMinGgxAlpha.
+float ggx_alpha(float roughness);
+
+// The functions below take alpha in [kMinGgxAlpha, 1] (smaller values are raised to the
+// minimum) and unit vectors in the local frame.
+
+// GGX (Trowbridge-Reitz) normal distribution D(h) (Walter et al. 2007, eq. 33; glTF appendix B
+// "Specular BRDF"). Normalised over projected area: integral of D(h) h.z over the hemisphere is
+// 1. Zero for h.z <= 0.
+float ggx_d(const vec3& h, float alpha);
+
+// Smith's Lambda for GGX (Heitz 2014, eq. 72):
+// (-1 + sqrt(1 + alpha^2 tan^2 theta)) / 2, written without cancellation. Infinite for w.z <= 0.
+float smith_lambda(const vec3& w, float alpha);
+
+// Smith masking G1(w) = 1 / (1 + Lambda(w)) (Heitz 2014; for GGX the same as Walter et al.
+// 2007, eq. 34). Zero for w.z <= 0.
+float smith_g1(const vec3& w, float alpha);
+
+// Height-correlated masking-shadowing G2 = 1 / (1 + Lambda(wo) + Lambda(wi)) (Heitz 2014,
+// eq. 99), which is glTF appendix B's G for directions above the surface. Zero if either is below.
+float smith_g2(const vec3& wo, const vec3& wi, float alpha);
+
+// glTF's visibility term V = G2 / (4 |n.l| |n.v|) from the cosines of the two directions
+// (appendix B "Specular BRDF"): 1 / (2 (|n.v| sqrt(a^2 + (1-a^2)(n.l)^2) + |n.l| sqrt(a^2 +
+// (1-a^2)(n.v)^2))). Symmetric in its two cosines. Cosines below kMinCosine are raised to it,
+// which keeps V D finite when both directions graze the surface.
+inline constexpr float kMinCosine = 1e-7f;
+float ggx_visibility(float cos_o, float cos_i, float alpha);
+
+// Distribution of visible normals D_wo(h) = G1(wo) max(0, wo.h) D(h) / wo.z (Heitz 2018,
+// eq. 3); integrates to 1 over h for every wo above the surface. Zero when wo.z <= 0.
+float ggx_vndf(const vec3& wo, const vec3& h, float alpha);
+
+// A microfacet normal h distributed by D_wo, from two uniform numbers in [0, 1) (Heitz 2018,
+// "Sampling the GGX Distribution of Visible Normals", listing 1, isotropic). wo.z > 0.
+vec3 sample_ggx_vndf(const vec3& wo, float alpha, float u1, float u2);
+
+// Density, per solid angle of wi, of wi = reflect(wo, h) with h from sample_ggx_vndf:
+// D_wo(h) / (4 |wo.h|) (Heitz 2018, eq. 17) = D(h) / (2 (wo.z + sqrt(alpha^2 + (1 - alpha^2)
+// wo.z^2))), which stays finite at grazing wo. Zero unless wo.z > 0 and wi.z > 0 (the sampler's
+// reflections below the surface are rejected by the caller).
+float ggx_reflection_pdf(const vec3& wo, const vec3& wi, float alpha);
+
+// Schlick's weight (1 - |cos|)^5 and Fresnel f0 + (1 - f0)(1 - |cos|)^5 (Schlick 1994; glTF
+// appendix B "Fresnel"), with cos = v.h.
+float schlick_weight(float cos_theta);
+inline float schlick_fresnel(float f0, float cos_theta) {
+  return f0 + (1.0f - f0) * schlick_weight(cos_theta);
+}
+inline vec3 schlick_fresnel(const vec3& f0, float cos_theta) {
+  return f0 + (vec3(1.0f) - f0) * schlick_weight(cos_theta);
+}
+
+// Normal-incidence reflectance of a dielectric: ((ior - 1) / (ior + 1))^2 (glTF appendix B
+// "Fresnel", fresnel_mix); 0.04 at ior 1.5.
+float dielectric_f0(float ior);
+
+// glTF's metallic-roughness material as a BRDF (appendix B "Metal BRDF and Dielectric BRDF"):
+//   specular   = V D                                    (alpha = roughness^2)
+//   metal      = specular * schlick_fresnel(base_color, v.h)
+//   dielectric = mix(base_color / pi, specular, schlick_fresnel(dielectric_f0(ior), v.h))
+//   material   = mix(dielectric, metal, metallic)
+// The spec says (appendix B "Coupling Diffuse and Specular Reflection") that this model is not
+// energy conserving: fresnel_mix weights the diffuse base by 1 - F(v.h) at the half vector of
+// each pair of directions, so a bright dielectric reflects more than it receives at oblique
+// angles. A white one (roughness 0.05) has albedo 1.15 at wo.z = 0.3 and 1.84 near grazing, 1.04
+// averaged over incidence; tests/test_microfacet.cpp gives the brightest base colour that stays
+// <= 1 per roughness. The metal lobe conserves energy (single scattering loses some when rough).
+struct MetalRoughBrdf {
+  vec3 base_color{1.0f};   // linear RGB in [0, 1]: diffuse colour, and f0 of the metal
+  float metallic = 0.0f;   // [0, 1]: 0 dielectric, 1 metal
+  float roughness = 1.0f;  // [0, 1], perceptual; alpha = roughness^2
+  float ior = 1.5f;        // > 0, index of refraction of the dielectric's specular layer
+
+  // f(wo, wi) without the cosine. Zero unless wo.z > 0 and wi.z > 0. Reciprocal: every term is
+  // symmetric in wo and wi, so eval(wo, wi) == eval(wi, wo) bit for bit (unless the compiler
+  // contracts a*b + c*d into a fused multiply-add, which costs one rounding).
+  vec3 eval(const vec3& wo, const vec3& wi) const;
+
+  // Density per solid angle of wi that sample() draws from wo: the mixture
+  // p_spec * ggx_reflection_pdf + (1 - p_spec) * wi.z / pi, p_spec = specular_probability(wo).
+  // Zero unless wo.z > 0 and wi.z > 0. Its integral over the hemisphere is below 1 by the
+  // probability that the specular lobe's reflection falls below the surface (sample() fails).
+  float pdf(const vec3& wo, const vec3& wi) const;
+
+  // Draws wi: the specular lobe by its visible normals with probability
+  // specular_probability(wo) (chosen by u_lobe < p_spec), else the cosine-weighted diffuse
+  // lobe, from the uniform numbers u1, u2. Returns false (wi, weight, pdf unspecified) when
+  // wo.z <= 0 or the reflection falls below the surface. On success pdf = pdf(wo, wi) > 0 and
+  // weight = eval(wo, wi) * wi.z / pdf, finite.
+  bool sample(const vec3& wo, float u_lobe, float u1, float u2, vec3& wi, vec3& weight,
+              float& pdf) const;
+
+  // Probability that sample() takes the specular lobe, from estimates of the two lobes'
+  // albedos (Schlick's Fresnel at the macro normal for the specular, (1 - f0) max(base_color)
+  // for the diffuse):
+  //   s = (1 - metallic) F(f0, wo.z) + metallic max(F(base_color, wo.z))
+  //   d = (1 - metallic) (1 - f0) max(base_color)
+  //   p_spec = s / (s + d), or 1 when s + d = 0.
+  // Either way the mixture density is positive wherever the BRDF is: when p_spec < 1 the
+  // cosine lobe covers the whole hemisphere, and when p_spec = 1 (metallic = 1, black base
+  // colour, or f0 = 1: exactly where the diffuse lobe vanishes) so does the visible-normal lobe,
+  // since D > 0 for every h above the surface.
+  float specular_probability(const vec3& wo) const;
+};
+
+}  // namespace pb
