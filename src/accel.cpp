@@ -1,11 +1,15 @@
 #include "photonbound/accel.h"
 
+#include "photonbound/texture.h"
+
 #include <embree3/rtcore.h>
 
 #include <cstdio>
 #include <limits>
+#include <span>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace pb {
 
@@ -23,11 +27,34 @@ void check(RTCDevice device, const char* what) {
   if (err != RTC_ERROR_NONE) throw std::runtime_error(std::string("embree failed in ") + what);
 }
 
+// What the cut-out filter of one alphaMode MASK mesh reads.
+struct MaskedMesh {
+  const Mesh* mesh;
+  const Material* material;
+  std::span<const Image> images;
+};
+
+// Embree's filter function for MASK meshes, on closest-hit and occlusion rays alike: a hit where
+// the alpha is below the cutoff is rejected, so camera rays, photons and shadow rays all pass
+// through the cut-out (Embree 3 "rtcSetGeometryIntersectFilterFunction"; u, v are the hit's
+// barycentrics of vertices 1 and 2).
+void cut_out_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* m = static_cast<const MaskedMesh*>(args->geometryUserPtr);
+  for (unsigned i = 0; i < args->N; ++i) {
+    if (args->valid[i] != -1) continue;
+    const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
+    const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
+    const vec2 uv[2] = {mesh_uv(*m->mesh, prim, 0, u, v), mesh_uv(*m->mesh, prim, 1, u, v)};
+    if (cut_out(m->images, *m->material, uv)) args->valid[i] = 0;
+  }
+}
+
 }  // namespace
 
 struct Accel::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
+  std::vector<MaskedMesh> masked;  // sized up front: Embree keeps pointers into it
 };
 
 Accel::Accel(const Scene& scene) : impl_(std::make_unique<Impl>()) {
@@ -36,6 +63,7 @@ Accel::Accel(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   rtcSetDeviceErrorFunction(impl_->device, on_embree_error, nullptr);
   impl_->scene = rtcNewScene(impl_->device);
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
+  impl_->masked.reserve(scene.meshes.size());
 
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const Mesh& mesh = scene.meshes[m];
@@ -54,6 +82,13 @@ Accel::Accel(const Scene& scene) : impl_(std::make_unique<Impl>()) {
       v[3 * i + 2] = mesh.positions[i].z;
     }
     std::copy(mesh.indices.begin(), mesh.indices.end(), idx);
+    const Material& mat = scene.materials[mesh.material];
+    if (mat.masked()) {
+      impl_->masked.push_back({&mesh, &mat, scene.images});
+      rtcSetGeometryUserData(geom, &impl_->masked.back());
+      rtcSetGeometryIntersectFilterFunction(geom, cut_out_filter);
+      rtcSetGeometryOccludedFilterFunction(geom, cut_out_filter);
+    }
     rtcCommitGeometry(geom);
     rtcAttachGeometryByID(impl_->scene, geom, unsigned(m));
     rtcReleaseGeometry(geom);  // the scene holds the reference now

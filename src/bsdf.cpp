@@ -68,41 +68,185 @@ vec3 reflect_checked(const vec3& wo, const vec3& ns, const vec3& ng) {
 
 }  // namespace
 
-Bsdf::Bsdf(const Material& m, const vec3& ng, const vec3& ns)
-    : model_(m.model), color_(m.base_color), ior_(m.ior), ng_(ng), ns_(ns) {}
+BsdfParams BsdfParams::of(const Material& m) {
+  BsdfParams p;
+  p.base_color = m.base_color;
+  p.metallic = m.metallic;
+  p.roughness = m.roughness;
+  p.ior = m.ior;
+  p.specular = m.specular;
+  p.specular_color = m.specular_color;
+  p.transmission = m.transmission;
+  p.thin = m.thin;
+  return p;
+}
+
+Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_roughness)
+    : thin_(p.thin), ng_(ng), ns_(ns) {
+  brdf_.base_color = p.base_color;
+  brdf_.roughness = p.roughness;
+  brdf_.ior = p.ior;
+  brdf_.specular = p.specular;
+  brdf_.specular_color = p.specular_color;
+  const float m = std::clamp(p.metallic, 0.0f, 1.0f), t = std::clamp(p.transmission, 0.0f, 1.0f);
+  if (m == 0.0f && t == 0.0f && p.specular == 0.0f) {  // KHR_materials_specular: no layer
+    brdf_.metallic = 0.0f;
+    reflect_ = 1.0f;
+    return;  // kind_ Lambertian
+  }
+  // KHR_materials_transmission: dielectric = fresnel_mix(mix(diffuse, btdf, t), specular) is
+  // (1 - t) fresnel_mix(diffuse, specular) + t fresnel_mix(btdf, specular): the parts split.
+  glass_ = (1.0f - m) * t;
+  reflect_ = m + (1.0f - m) * (1.0f - t);
+  brdf_.metallic = reflect_ > 0.0f ? m / reflect_ : 0.0f;
+  smooth_ = p.roughness < mirror_roughness;
+  const float opaque = (1.0f - m) * (1.0f - t);
+  const bool non_delta = reflect_ > 0.0f && (!smooth_ || opaque > 0.0f);
+  const bool delta = glass_ > 0.0f || (smooth_ && reflect_ > 0.0f);
+  kind_ = non_delta ? Kind::Layered : Kind::Delta;
+  has_delta_ = non_delta && delta;
+}
+
+namespace {
+
+// Directions in the shading frame (t, b, n) and back.
+struct Frame {
+  vec3 t, b, n;
+  explicit Frame(const vec3& normal) : n(normal) { orthonormal_basis(n, t, b); }
+  vec3 local(const vec3& w) const { return vec3(glm::dot(w, t), glm::dot(w, b), glm::dot(w, n)); }
+  vec3 world(const vec3& w) const { return glm::normalize(w.x * t + w.y * b + w.z * n); }
+};
+
+}  // namespace
+
+vec3 Bsdf::eval_local(const vec3& wo, const vec3& wi, float* pdf) const {
+  if (pdf) *pdf = 0.0f;
+  if (wo.z <= 0.0f || wi.z <= 0.0f) return vec3(0.0f);
+  if (!smooth_) {
+    if (pdf) *pdf = brdf_.pdf(wo, wi);
+    return reflect_ * brdf_.eval(wo, wi);
+  }
+  // The mirror limit of appendix B's dielectric: the GGX layer is a delta branch, the diffuse
+  // base keeps its weight 1 - max F(v.h) at this pair's half vector (v.h averaged over both
+  // directions, so that f stays reciprocal bit for bit).
+  const vec3 h = glm::normalize(wo + wi);
+  const float v_h = 0.5f * (glm::dot(wo, h) + glm::dot(wi, h));
+  const vec3 f0 = brdf_.dielectric_f0();
+  const vec3 fr = f0 + (vec3(brdf_.dielectric_f90()) - f0) * schlick_weight(v_h);
+  if (pdf) *pdf = wi.z / kPi;
+  const float opaque = reflect_ * (1.0f - brdf_.metallic);
+  return (opaque * (1.0f - max_component(fr)) / kPi) * brdf_.base_color;
+}
 
 vec3 Bsdf::eval(const vec3& wo, const vec3& wi) const {
-  if (is_delta()) return vec3(0.0f);
+  if (kind_ == Kind::Delta) return vec3(0.0f);
   // Both directions on one side of the true surface: reflection only.
   if (glm::dot(wo, ng_) * glm::dot(wi, ng_) <= 0.0f) return vec3(0.0f);
-  return diffuse_f();
+  if (kind_ == Kind::Lambertian) return diffuse_f();
+  const Frame f(glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_);
+  return eval_local(f.local(wo), f.local(wi), nullptr);
 }
 
 float Bsdf::pdf(const vec3& wo, const vec3& wi) const {
-  if (is_delta()) return 0.0f;
+  if (kind_ == Kind::Delta) return 0.0f;
   const vec3 ns = glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_;
   if (glm::dot(wo, ng_) * glm::dot(wi, ng_) <= 0.0f) return 0.0f;
-  return std::max(0.0f, glm::dot(wi, ns)) / kPi;  // cosine-weighted about the shading normal
+  if (kind_ == Kind::Lambertian)
+    return std::max(0.0f, glm::dot(wi, ns)) / kPi;  // cosine-weighted about the shading normal
+  const Frame f(ns);
+  float p = 0.0f;
+  eval_local(f.local(wo), f.local(wi), &p);
+  return has_delta_ ? (1.0f - delta_probability(wo)) * p : p;
+}
+
+float Bsdf::non_delta_albedo(float cos_o) const {
+  // Estimates only (they choose between the parts; the weights stay exact): the diffuse base's
+  // (1 - f0) max(base) and, for glossy lobes, Schlick's Fresnel at the macro normal. The floor
+  // keeps the part's probability above 0 wherever it may reflect.
+  const float mu = brdf_.metallic, f0 = max_component(brdf_.dielectric_f0());
+  const float diffuse = (1.0f - mu) * (1.0f - f0) * max_component(brdf_.base_color);
+  float a = diffuse;
+  if (!smooth_)
+    a += (1.0f - mu) * (f0 + (brdf_.dielectric_f90() - f0) * schlick_weight(cos_o)) +
+         mu * max_component(schlick_fresnel(brdf_.base_color, cos_o));
+  return reflect_ * std::max(a, 0.01f);
+}
+
+float Bsdf::delta_probability(const vec3& wo) const {
+  if (kind_ != Kind::Layered) return kind_ == Kind::Delta ? 1.0f : 0.0f;
+  if (!has_delta_) return 0.0f;
+  SpecularBranch b[2];
+  const int n = delta_branches(wo, Transport::Importance, b);
+  float wd = 0.0f;
+  for (int k = 0; k < n; ++k) wd += average(b[k].weight);
+  const float wn = non_delta_albedo(std::fabs(glm::dot(wo, ns_)));
+  return wd > 0.0f ? wd / (wd + wn) : 0.0f;
 }
 
 bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const {
-  const bool front = glm::dot(wo, ng_) > 0.0f;
-  const vec3 ng = front ? ng_ : -ng_;
-  const vec3 ns = front ? ns_ : -ns_;
-  if (!is_delta()) {
+  if (kind_ == Kind::Lambertian) {
+    const bool front = glm::dot(wo, ng_) > 0.0f;
+    const vec3 ng = front ? ng_ : -ng_;
+    const vec3 ns = front ? ns_ : -ns_;
     // Drawn in this order: the arguments of an earlier call, which GCC evaluated right to left
     // (images stay bit-identical; the order is now explicit for every compiler).
     const float u2 = rng.next_float(), u1 = rng.next_float();
     out.wi = sample_cosine_hemisphere(ns, u1, u2);
     if (glm::dot(out.wi, ng) <= 0.0f) return false;  // below the true surface: absorbed
     // Cosine sampling cancels f cos / pdf to rho.
-    out.weight = color_;
+    out.weight = brdf_.base_color;
     out.pdf = glm::dot(out.wi, ns) / kPi;
     out.delta = false;
     return true;
   }
+  if (kind_ == Kind::Delta) return sample_delta(wo, rng, mode, out);
+  const float pd = delta_probability(wo);
+  if (pd > 0.0f) {
+    const float u = rng.next_float();  // which part, then that part's numbers
+    if (u < pd) {
+      if (!sample_delta(wo, rng, mode, out)) return false;
+      out.weight /= pd;
+      return true;
+    }
+  }
+  if (!sample_non_delta(wo, rng, out)) return false;
+  out.weight /= 1.0f - pd;
+  out.pdf *= 1.0f - pd;
+  return true;
+}
+
+bool Bsdf::sample_non_delta(const vec3& wo, Rng& rng, BsdfSample& out) const {
+  const bool front = glm::dot(wo, ng_) > 0.0f;
+  const vec3 ng = front ? ng_ : -ng_;
+  const Frame f(front ? ns_ : -ns_);
+  const vec3 wo_l = f.local(wo);
+  if (wo_l.z <= 0.0f) return false;  // seen from below the shading hemisphere
+  if (!smooth_) {
+    const float u_lobe = rng.next_float(), u1 = rng.next_float(), u2 = rng.next_float();
+    vec3 wi_l, w;
+    float p = 0.0f;
+    if (!brdf_.sample(wo_l, u_lobe, u1, u2, wi_l, w, p)) return false;
+    out.wi = f.world(wi_l);
+    out.weight = reflect_ * w;
+    out.pdf = p;
+  } else {
+    const float u2 = rng.next_float(), u1 = rng.next_float();
+    out.wi = sample_cosine_hemisphere(f.n, u1, u2);
+    const vec3 wi_l = f.local(out.wi);
+    float p = 0.0f;
+    const vec3 value = eval_local(wo_l, wi_l, &p);
+    if (!(p > 0.0f)) return false;
+    out.weight = value * (wi_l.z / p);
+    out.pdf = p;
+  }
+  out.delta = false;
+  return glm::dot(out.wi, ng) > 0.0f;  // below the true surface: absorbed
+}
+
+bool Bsdf::sample_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const {
   SpecularBranch b[2];
   const int n = delta_branches(wo, mode, b);
+  if (n == 0) return false;
   int pick = 0;
   float p = 1.0f;
   if (n == 2) {
@@ -123,29 +267,49 @@ bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) con
 }
 
 int Bsdf::delta_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) const {
+  if (kind_ == Kind::Lambertian) return 0;
   const bool front = glm::dot(wo, ng_) > 0.0f;
   const vec3 ng = front ? ng_ : -ng_;  // normals on wo's side
   const vec3 ns = front ? ns_ : -ns_;
-  if (model_ == Reflection::Mirror) {
-    out[0] = {reflect_checked(wo, ns, ng), color_};
+  const float cos_i = std::fabs(glm::dot(wo, ns));
+  vec3 mirror(0.0f);
+  if (smooth_ && reflect_ > 0.0f) {
+    // The mirror limit of the GGX lobes (h = n): appendix B's Fresnel terms at cos_i.
+    const float mu = brdf_.metallic;
+    const vec3 f0 = brdf_.dielectric_f0();
+    const vec3 fd = f0 + (vec3(brdf_.dielectric_f90()) - f0) * schlick_weight(cos_i);
+    mirror = reflect_ * ((1.0f - mu) * fd + mu * brdf_.base_color);
+  }
+  if (glass_ <= 0.0f) {
+    if (!(max_component(mirror) > 0.0f)) return 0;
+    out[0] = {reflect_checked(wo, ns, ng), mirror};
     return 1;
   }
-  if (model_ != Reflection::Dielectric) return 0;
-  const float eta = front ? ior_ : 1.0f / ior_;  // eta_t / eta_i
-  const float cos_i = std::fabs(glm::dot(wo, ns));
+  if (thin_) {
+    // Thin-walled (KHR_materials_transmission without a volume): no refraction; Schlick's
+    // Fresnel of the layer reflects, the rest goes straight through, tinted by base colour.
+    const vec3 f0 = brdf_.dielectric_f0();
+    const vec3 fr = f0 + (vec3(brdf_.dielectric_f90()) - f0) * schlick_weight(cos_i);
+    out[0] = {reflect_checked(wo, ns, ng), mirror + glass_ * fr};
+    out[1] = {-wo, brdf_.base_color * (glass_ * (1.0f - max_component(fr)))};
+    return 2;
+  }
+  // A volume boundary: the exact Fresnel equations with total internal reflection (Schlick's
+  // term has none from the dense side; KHR_materials_volume, "Implementation").
+  const float eta = front ? brdf_.ior : 1.0f / brdf_.ior;  // eta_t / eta_i
   const float f = fresnel_dielectric(cos_i, eta);
-  out[0] = {reflect_checked(wo, ns, ng), vec3(f)};
+  out[0] = {reflect_checked(wo, ns, ng), mirror + glass_ * f};
   if (f >= 1.0f) return 1;
   vec3 wt;
   if (!refract(wo, ns, eta, wt) || glm::dot(wt, ng) >= 0.0f) {
     if (!refract(wo, ng, eta, wt)) {
       // No transmission about either normal: all of the energy is reflected.
-      out[0].weight = vec3(1.0f);
+      out[0].weight = mirror + vec3(glass_);
       return 1;
     }
   }
   const float scale = mode == Transport::Radiance ? 1.0f / (eta * eta) : 1.0f;
-  out[1] = {wt, color_ * ((1.0f - f) * scale)};
+  out[1] = {wt, glass_ * brdf_.base_color * ((1.0f - f) * scale)};
   return 2;
 }
 

@@ -5,9 +5,11 @@
 
 namespace pb {
 
-void trace_visible_points(const CameraPathInputs& in, size_t first,
-                          std::span<MeasurementPoint> points, std::span<PassGather> out) {
+size_t trace_visible_points(const CameraPathInputs& in, size_t first,
+                            std::span<MeasurementPoint> points, std::span<GlossyPoint> glossy,
+                            std::span<PassGather> out) {
   const int width = in.camera.width();
+  size_t glossy_count = 0;
   for (size_t k = 0; k < points.size(); ++k) {
     const size_t pixel = first + k;
     Rng rng(in.seed, in.pass, pixel, Stream::Camera);
@@ -26,19 +28,33 @@ void trace_visible_points(const CameraPathInputs& in, size_t first,
       const Surface s = in.world.surface(hit);
       const vec3 wo = -dir;
       const bool front = glm::dot(wo, s.ng) > 0.0f;
-      if (s.material->emits() && front) emission += dvec3(weight * s.material->emission);
-      if (!s.bsdf.is_delta()) {
+      weight *= in.world.transmittance(s, wo, hit.t);  // inside an absorbing volume
+      if (s.material->emits()) emission += dvec3(weight * in.world.emitted(s, wo));
+      // Stop here (the non-delta part) or follow a delta branch: 1 - p_delta and p_delta.
+      const float p_delta = s.bsdf.delta_probability(wo);
+      bool stop = p_delta < 1.0f;
+      if (stop && p_delta > 0.0f) {
+        const float u = rng.next_float();
+        stop = u >= p_delta;
+      }
+      if (stop) {
+        const vec3 w = p_delta > 0.0f ? weight / (1.0f - p_delta) : weight;
         point.position = s.position;
         point.normal = front ? s.ng : -s.ng;
         point.shading = front ? s.ns : -s.ns;
-        point.f = weight * s.bsdf.diffuse_f();
-        if (!(max_component(point.f) > 0.0f)) point.f = vec3(0.0f);
+        const bool lambertian = s.bsdf.is_lambertian();
+        point.f = lambertian ? w * s.bsdf.diffuse_f() : w;
+        if (!(max_component(point.f) > 0.0f)) {
+          point.f = vec3(0.0f);
+        } else if (!lambertian) {
+          glossy[glossy_count++] = {uint32_t(k), wo, s.bsdf};
+        }
         break;
       }
       if (depth >= in.max_depth) break;  // the chain is cut
       BsdfSample b;
-      if (!s.bsdf.sample(wo, rng, Transport::Radiance, b)) break;
-      weight *= b.weight;
+      if (!s.bsdf.sample_delta(wo, rng, Transport::Radiance, b)) break;
+      weight *= p_delta < 1.0f ? b.weight / p_delta : b.weight;
       if (!(max_component(weight) > 0.0f)) break;
       origin = s.position;
       origin_normal = s.ng;
@@ -48,6 +64,7 @@ void trace_visible_points(const CameraPathInputs& in, size_t first,
     out[k] = PassGather{};
     out[k].direct = emission;
   }
+  return glossy_count;
 }
 
 }  // namespace pb

@@ -18,7 +18,8 @@ struct PathVertex {
 
 struct PixelOutput {
   std::vector<MeasurementPoint> points;
-  std::vector<float> footprints;  // one per point
+  std::vector<float> footprints;    // one per point
+  std::vector<GlossyPoint> glossy;  // point = index into points
   dvec3 emission{0.0};
 };
 
@@ -36,10 +37,11 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
                                     : world.trace(v.origin, v.origin_normal, v.dir, hit);
     if (!found) continue;  // background is black
     const Surface s = world.surface(hit);
-    const Material& m = *s.material;
     const vec3 wo = -v.dir;
-    // Emission seen along the chain is exact for this ray (one-sided: front side only).
-    if (m.emits() && glm::dot(wo, s.ng) > 0.0f) out.emission += dvec3(v.weight * m.emission);
+    // Inside an absorbing volume the segment's transmittance weighs what it reaches.
+    const vec3 weight = v.weight * world.transmittance(s, wo, hit.t);
+    // Emission seen along the chain is exact for this ray (front side unless double-sided).
+    if (s.material->emits()) out.emission += dvec3(weight * world.emitted(s, wo));
     const float length = v.length + hit.t;
     if (!s.bsdf.is_delta()) {
       const bool front = glm::dot(wo, s.ng) > 0.0f;
@@ -47,18 +49,20 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
       p.position = s.position;
       p.normal = front ? s.ng : -s.ng;
       p.shading = front ? s.ns : -s.ns;
-      p.f = v.weight * s.bsdf.diffuse_f();
+      const bool lambertian = s.bsdf.is_lambertian();
+      p.f = lambertian ? weight * s.bsdf.diffuse_f() : weight;
       if (max_component(p.f) > 0.0f) {
+        if (!lambertian) out.glossy.push_back({uint32_t(out.points.size()), wo, s.bsdf});
         out.points.push_back(p);
         out.footprints.push_back(length * camera.pixel_angle());
       }
-      continue;
+      if (!s.bsdf.has_delta()) continue;
     }
     if (v.depth >= max_depth) continue;  // the chain is cut
     SpecularBranch branches[2];
     const int n = s.bsdf.delta_branches(wo, Transport::Radiance, branches);
     for (int k = 0; k < n; ++k) {
-      const vec3 w = v.weight * branches[k].weight;
+      const vec3 w = weight * branches[k].weight;
       if (max_component(w) <= 0.0f || top >= 64) continue;
       stack[top++] = {s.position, branches[k].dir, w, s.ng, length, v.depth + 1};
     }
@@ -77,12 +81,14 @@ EyePassResult run_eye_pass(const World& world, const PinholeCamera& camera, int 
   // One output per row, joined in row order: the point order is independent of threads.
   std::vector<std::vector<MeasurementPoint>> rows(size_t(r.height));
   std::vector<std::vector<float>> row_footprints(size_t(r.height));
+  std::vector<std::vector<GlossyPoint>> row_glossy(size_t(r.height));
   r.pixel_begin.assign(pixels + 1, 0);
   parallel_for(size_t(r.height), 1, [&](size_t begin, size_t end) {
     PixelOutput out;
     for (size_t y = begin; y < end; ++y) {
       out.points.clear();
       out.footprints.clear();
+      out.glossy.clear();
       for (int x = 0; x < r.width; ++x) {
         const size_t pixel = y * size_t(r.width) + size_t(x);
         const size_t before = out.points.size();
@@ -93,6 +99,7 @@ EyePassResult run_eye_pass(const World& world, const PinholeCamera& camera, int 
       }
       rows[y] = out.points;
       row_footprints[y] = out.footprints;
+      row_glossy[y] = out.glossy;
     }
   });
 
@@ -102,6 +109,10 @@ EyePassResult run_eye_pass(const World& world, const PinholeCamera& camera, int 
   std::vector<float> footprints;
   footprints.reserve(total);
   for (size_t y = 0; y < rows.size(); ++y) {
+    for (GlossyPoint g : row_glossy[y]) {  // row-local indices become global ones
+      g.point += uint32_t(r.points.size());
+      r.glossy.push_back(g);
+    }
     r.points.insert(r.points.end(), rows[y].begin(), rows[y].end());
     footprints.insert(footprints.end(), row_footprints[y].begin(), row_footprints[y].end());
     std::vector<MeasurementPoint>().swap(rows[y]);

@@ -1,6 +1,7 @@
-// The glTF loader's primitives (see gltf_loader_impl.h): POSITION, NORMAL, TEXCOORD_0/1 and
-// indices, read from accessors (gltf_accessor.cpp) or from the decoded KHR_draco_mesh_compression
-// data, integer attributes dequantised (KHR_mesh_quantization), then placed in world space.
+// The glTF loader's primitives (see gltf_loader_impl.h): POSITION, NORMAL, TEXCOORD_0/1, TANGENT
+// and indices, read from accessors (gltf_accessor.cpp) or from the decoded
+// KHR_draco_mesh_compression data, integer attributes dequantised (KHR_mesh_quantization), then
+// placed in world space.
 #include "gltf_decode.h"
 #include "gltf_loader_impl.h"
 
@@ -20,13 +21,23 @@ constexpr std::initializer_list<int> kIndexComponents = {TINYGLTF_COMPONENT_TYPE
 // not) 8- and 16-bit integers (KHR_mesh_quantization; it allows fewer combinations for NORMAL,
 // but every one of these has one meaning).
 int attribute_type(const std::string& name) {
+  if (name == "TANGENT") return TINYGLTF_TYPE_VEC4;
   return name.rfind("TEXCOORD_", 0) == 0 ? TINYGLTF_TYPE_VEC2 : TINYGLTF_TYPE_VEC3;
 }
 constexpr std::initializer_list<int> kAttributeComponents = {
     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE,
     TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT,
     TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT};
-const char* const kAttributes[] = {"POSITION", "NORMAL", "TEXCOORD_0", "TEXCOORD_1"};
+const char* const kAttributes[] = {"POSITION", "NORMAL", "TEXCOORD_0", "TEXCOORD_1", "TANGENT"};
+
+// The texture coordinate sets a material's textures read.
+bool uses_set(const Material& m, int set) {
+  for (const TextureRef* t : {&m.base_color_texture, &m.metallic_roughness_texture,
+                              &m.normal_texture, &m.emissive_texture, &m.transmission_texture,
+                              &m.specular_texture, &m.specular_color_texture})
+    if (t->present() && t->texcoord == set) return true;
+  return false;
+}
 
 // An integer member of an extension object, or -1 when absent or not an integer.
 int ext_int(const tinygltf::Value& obj, const char* key) {
@@ -215,7 +226,14 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
     }
     out.indices.insert(out.indices.end(), {a, b, c});
   }
-  if (!out.indices.empty()) scene_.meshes.push_back(std::move(out));
+  if (out.indices.empty()) return;
+  const Material& mat = scene_.materials[out.material];
+  for (int set = 0; set < 2; ++set)
+    if (uses_set(mat, set) && out.texcoords[set].empty())
+      warn(ml + ": its material's textures read TEXCOORD_" + std::to_string(set) +
+           ", which it does not have (one texel is read)");
+  add_tangents(out, prim, dp, xf, where);
+  scene_.meshes.push_back(std::move(out));
 }
 
 }  // namespace pb::gltf

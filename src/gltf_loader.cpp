@@ -2,26 +2,23 @@
 // include tiny_gltf.h; the helpers that need no tinygltf types live in gltf_support.cpp.
 //
 // Phases: read the file (checking the GLB container), rewrite the JSON where tinygltf 2.7 would
-// refuse valid glTF (gltf_prepass.h), let tinygltf parse it (images are never decoded), walk the
+// refuse valid glTF (gltf_prepass.h), let tinygltf parse it (images are kept encoded and decoded
+// when a material uses them), walk the
 // default scene's node tree composing transforms, and turn every
 // node x primitive into a world-space Mesh, every KHR_lights_punctual light instance into a
 // PunctualLight and every perspective camera into a Camera. Each accessor is validated before
 // it is read; Draco and meshoptimizer data are decoded on first use (gltf_decode.h). Errors throw
 // SceneError("<file>: <one line>"); a Scene is only returned whole.
 //
-// Material rules (the README repeats them):
-//  1. KHR_materials_transmission.transmissionFactor > 0 -> Dielectric (smooth glass) with
-//     ior = KHR_materials_ior.ior (default 1.5; must be finite and >= 1) and
-//     base_color = baseColorFactor.rgb as the transmission tint.
-//  2. else pbrMetallicRoughness.metallicFactor >= 0.5 -> Mirror tinted by baseColorFactor.rgb.
-//     glTF defaults apply: metallicFactor defaults to 1, so a material without
-//     pbrMetallicRoughness is a mirror. roughnessFactor > 0.05 gets a warning (smooth mirror).
-//  3. else Lambertian with base_color = baseColorFactor.rgb.
-//  emission = emissiveFactor x KHR_materials_emissive_strength.emissiveStrength (default 1).
-//  baseColorFactor.rgb must be within [0, 1] (a reflectance above 1 creates energy) and
-//  emission finite and >= 0, or the file is rejected. Textures are never read (one warning per
-//  file) and alpha is ignored. Primitives without a material share one Lambertian material
-//  named "default" with base_color 0.8 (one warning).
+// Material rules (README "Materials" repeats them): glTF 2.0's metallic-roughness material with
+// glTF's defaults (metallicFactor and roughnessFactor 1: a material without
+// pbrMetallicRoughness is a rough metal), KHR_materials_ior, _specular, _transmission,
+// _volume and _emissive_strength, textures (base colour, metallic-roughness, normal,
+// emissive, transmission, specular, specular colour) with KHR_texture_transform, alphaMode
+// MASK cut-outs and doubleSided emitters. Factors must be in their documented ranges (a
+// reflectance above 1 creates energy) or the file is rejected; what is rendered approximately
+// (BLEND, rough transmission) is warned about. Primitives without a material share one
+// Lambertian material named "default" with base_color 0.8 (one warning).
 #include "gltf_loader_impl.h"
 
 #include "photonbound/file_io.h"
@@ -37,9 +34,13 @@ namespace gltf {
 
 namespace {
 
-bool skip_image(tinygltf::Image*, const int, std::string*, std::string*, int, int,
-                const unsigned char*, int, void*) {
-  return true;  // accept without decoding: textures are not used
+// Keeps an image's encoded bytes for the loader, which decodes the images materials use
+// (gltf_texture.cpp). An image in a bufferView is read from the buffer there, where its range is
+// checked; tinygltf does not check it before this call.
+bool keep_image(tinygltf::Image* image, const int, std::string*, std::string*, int, int,
+                const unsigned char* bytes, int size, void*) {
+  if (image->bufferView < 0 && bytes && size > 0) image->image.assign(bytes, bytes + size);
+  return true;
 }
 
 // tinygltf 2.7 parses "inverseBindMatrices" as required (glTF makes it optional: identity
@@ -72,7 +73,7 @@ tinygltf::Model parse(const std::string& path, const std::vector<unsigned char>&
   }
   const std::string dir = std::filesystem::path(path).parent_path().string();
   tinygltf::TinyGLTF reader;
-  reader.SetImageLoader(&skip_image, nullptr);
+  reader.SetImageLoader(&keep_image, nullptr);
   tinygltf::Model model;
   std::string err, warn;
   bool ok = false;
@@ -104,6 +105,7 @@ Scene Loader::run(const std::vector<std::string>& parse_warnings) {
   check_extensions();
   visited_.assign(m_.nodes.size(), 0);
   material_slot_.assign(m_.materials.size(), -1);
+  image_slot_.assign(m_.images.size(), -1);
   const int s = m_.defaultScene;
   if (s != -1 && (s < 0 || size_t(s) >= m_.scenes.size()))
     fail("\"scene\" refers to " + absent("scene", s, m_.scenes.size()));
@@ -126,9 +128,10 @@ void Loader::check_extensions() {
   static const std::set<std::string> known = {
       "KHR_lights_punctual",        "KHR_materials_transmission",
       "KHR_materials_ior",          "KHR_materials_emissive_strength",
+      "KHR_materials_specular",     "KHR_materials_volume",
       "KHR_draco_mesh_compression", "EXT_meshopt_compression",
       "KHR_mesh_quantization",      "KHR_texture_transform",
-      "KHR_texture_basisu",         "EXT_texture_webp"};  // textures: unread
+      "KHR_texture_basisu",         "EXT_texture_webp"};  // basisu: the fallback image or a warning
   for (const std::string& e : m_.extensionsRequired)
     if (!known.count(e)) fail("requires extension '" + e + "', which is not supported");
   for (const std::string& e : m_.extensionsUsed)
@@ -235,11 +238,15 @@ Scene load_gltf_bytes(const std::string& path, const std::vector<unsigned char>&
   gltf::Prepass pre;
   const tinygltf::Model model = gltf::parse(path, bytes, warnings, pre);
   Scene scene = gltf::Loader(path, model, pre).run(warnings);
+  // External images are part of the identity too (embedded ones already are: their bytes are in
+  // the file or a buffer).
   uint64_t total = bytes.size();
   for (const tinygltf::Buffer& b : model.buffers) total += b.data.size();
+  for (const tinygltf::Image& im : model.images) total += im.image.size();
   Checksum hash(total);
   hash.add(bytes.data(), bytes.size());
   for (const tinygltf::Buffer& b : model.buffers) hash.add(b.data.data(), b.data.size());
+  for (const tinygltf::Image& im : model.images) hash.add(im.image.data(), im.image.size());
   scene.content_hash = hash.finish();
   return scene;
 }

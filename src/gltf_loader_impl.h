@@ -1,8 +1,8 @@
 // The glTF loader's internals, shared by its translation units (src/gltf_loader.cpp: parsing,
 // the node walk and the final checks; src/gltf_accessor.cpp: accessors, sparse substitution and
 // EXT_meshopt_compression bufferViews; src/gltf_geometry.cpp: primitives, quantised attributes
-// and KHR_draco_mesh_compression; src/gltf_material.cpp: materials, lights and cameras). Only
-// these files see tinygltf types.
+// and KHR_draco_mesh_compression; src/gltf_material.cpp: materials, lights and cameras;
+// src/gltf_texture.cpp: textures, images and tangents). Only these files see tinygltf types.
 #pragma once
 
 #include "photonbound/gltf_loader.h"
@@ -87,6 +87,17 @@ class Loader {
   Material convert_material(size_t index);
   double ext_number(const tinygltf::ExtensionMap& ext, const std::string& owner, const char* name,
                     const char* key, double fallback) const;
+  // Three numbers in [0, hi], or nullopt when absent.
+  std::optional<vec3> ext_color(const tinygltf::ExtensionMap& ext, const std::string& owner,
+                                const char* name, const char* key, double hi) const;
+  // gltf_texture.cpp
+  TextureRef texture(int index, int tex_coord, const tinygltf::ExtensionMap& info_ext,
+                     const std::string& where);
+  TextureRef ext_texture(const tinygltf::ExtensionMap& ext, const std::string& owner,
+                         const char* name, const char* key);
+  int32_t image(int index, const std::string& where);
+  void add_tangents(Mesh& out, const tinygltf::Primitive& prim, const DracoPrimitive* dp,
+                    const Xform& xf, const std::string& where);
   void add_light(const tinygltf::Node& n, const std::string& nl, const Xform& xf);
   void add_camera(int index, const std::string& nl, const Xform& xf);
   vec3 origin(const Xform& xf, const std::string& nl) const;
@@ -102,6 +113,7 @@ class Loader {
   std::set<std::string> warned_;
   std::vector<char> visited_;
   std::vector<int64_t> material_slot_;  // glTF material -> Scene::materials index, -1 unused
+  std::vector<int64_t> image_slot_;     // glTF image -> Scene::images index, -1 not decoded
   int64_t default_material_ = -1;
 };
 

@@ -2,6 +2,8 @@
 // at the top of gltf_loader.cpp).
 #include "gltf_loader_impl.h"
 
+#include "photonbound/microfacet.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -21,9 +23,9 @@ uint32_t Loader::material(int index, const std::string& where) {
     if (default_material_ < 0) {
       warn("primitives without a material use a default grey Lambertian material (0.8)");
       default_material_ = int64_t(scene_.materials.size());
-      Material def;
+      Material def = Material::lambertian(vec3(0.8f));
       def.name = "default";
-      scene_.materials.push_back(def);  // Lambertian, base_color 0.8
+      scene_.materials.push_back(def);
     }
     return uint32_t(default_material_);
   }
@@ -38,43 +40,96 @@ uint32_t Loader::material(int index, const std::string& where) {
   return uint32_t(slot);
 }
 
+std::optional<vec3> Loader::ext_color(const tinygltf::ExtensionMap& ext, const std::string& owner,
+                                      const char* name, const char* key, double hi) const {
+  const auto it = ext.find(name);
+  if (it == ext.end() || !it->second.IsObject() || !it->second.Has(key)) return std::nullopt;
+  const tinygltf::Value& v = it->second.Get(key);
+  vec3 out(0.0f);
+  bool ok = v.IsArray() && v.ArrayLen() == 3;
+  for (int c = 0; ok && c < 3; ++c) {
+    const double x = v.Get(c).IsNumber() ? v.Get(c).GetNumberAsDouble() : -1.0;
+    ok = x >= 0.0 && x <= hi;
+    out[c] = float(x);
+  }
+  if (!ok)
+    fail(owner + ": " + name + "." + key + " must be 3 numbers in [0, " +
+         (std::isinf(hi) ? std::string("inf)") : num(hi) + "]"));
+  return out;
+}
+
 Material Loader::convert_material(size_t index) {  // the rules are in the comment at the top
   const tinygltf::Material& gm = m_.materials[index];
   const tinygltf::PbrMetallicRoughness& pbr = gm.pbrMetallicRoughness;
   const std::string ml = label("material", gm.name, index);
+  const tinygltf::ExtensionMap& ext = gm.extensions;
   Material out;
   out.name = gm.name.empty() ? "material " + std::to_string(index) : gm.name;
-  bool textured = pbr.baseColorTexture.index >= 0 || pbr.metallicRoughnessTexture.index >= 0 ||
-                  gm.normalTexture.index >= 0 || gm.occlusionTexture.index >= 0 ||
-                  gm.emissiveTexture.index >= 0;
-  for (const auto& [name, value] : gm.extensions)  // e.g. transmissionTexture
-    for (const std::string& key : value.Keys())
-      textured |= key.size() > 7 && key.compare(key.size() - 7, 7, "Texture") == 0;
-  if (textured) warn("textures are not read; factors are used");
+  auto unit = [&](double v, const char* what) {
+    if (!(v >= 0.0 && v <= 1.0)) fail(ml + ": " + what + " " + num(v) + " is outside [0, 1]");
+    return float(v);
+  };
   const std::vector<double>& bc = pbr.baseColorFactor;
   if (bc.size() < 3) fail(ml + ": baseColorFactor has fewer than 3 numbers");
   if (!std::all_of(bc.begin(), bc.begin() + 3, [](double v) { return v >= 0.0 && v <= 1.0; }))
     fail(ml + ": baseColorFactor (" + num(bc[0]) + ", " + num(bc[1]) + ", " + num(bc[2]) +
          ") is outside [0, 1] (a reflectance above 1 would create energy)");
   out.base_color = vec3(float(bc[0]), float(bc[1]), float(bc[2]));
-  const tinygltf::ExtensionMap& ext = gm.extensions;
-  const double transmission =
-      ext_number(ext, ml, "KHR_materials_transmission", "transmissionFactor", 0.0);
-  if (transmission > 0.0) {
-    out.model = Reflection::Dielectric;
-    const double ior = ext_number(ext, ml, "KHR_materials_ior", "ior", 1.5);
-    if (!(ior >= 1.0 && fits_float(ior)))
-      fail(ml + ": ior " + num(ior) + " must be finite and >= 1");
-    out.ior = float(ior);
-    if (transmission < 1.0)
-      warn(ml + ": transmissionFactor " + num(transmission) + " treated as clear glass");
-  } else if (pbr.metallicFactor >= 0.5) {
-    out.model = Reflection::Mirror;
-    if (pbr.roughnessFactor > 0.05)
-      warn(ml + ": roughness " + num(pbr.roughnessFactor) + " treated as a smooth mirror");
-  } else {
-    out.model = Reflection::Lambertian;
+  out.alpha = bc.size() > 3 ? unit(bc[3], "the alpha of baseColorFactor") : 1.0f;
+  out.metallic = unit(pbr.metallicFactor, "metallicFactor");
+  out.roughness = unit(pbr.roughnessFactor, "roughnessFactor");
+  out.base_color_texture = texture(pbr.baseColorTexture.index, pbr.baseColorTexture.texCoord,
+                                   pbr.baseColorTexture.extensions, ml + " baseColorTexture");
+  const tinygltf::TextureInfo& mr = pbr.metallicRoughnessTexture;
+  out.metallic_roughness_texture =
+      texture(mr.index, mr.texCoord, mr.extensions, ml + " metallicRoughnessTexture");
+  out.normal_texture = texture(gm.normalTexture.index, gm.normalTexture.texCoord,
+                               gm.normalTexture.extensions, ml + " normalTexture");
+  if (!std::isfinite(gm.normalTexture.scale)) fail(ml + ": normalTexture.scale is not finite");
+  out.normal_scale = float(gm.normalTexture.scale);
+  out.emissive_texture = texture(gm.emissiveTexture.index, gm.emissiveTexture.texCoord,
+                                 gm.emissiveTexture.extensions, ml + " emissiveTexture");
+  // occlusionTexture is a rasteriser's stand-in for the shadowing a path tracer computes: unread.
+
+  const double ior = ext_number(ext, ml, "KHR_materials_ior", "ior", 1.5);
+  if (!((ior >= 1.0 || ior == 0.0) && fits_float(ior)))
+    fail(ml + ": ior " + num(ior) + " must be 0 or finite and >= 1");
+  out.ior = float(ior);
+  out.specular =
+      unit(ext_number(ext, ml, "KHR_materials_specular", "specularFactor", 1.0), "specularFactor");
+  out.specular_color =
+      ext_color(ext, ml, "KHR_materials_specular", "specularColorFactor", 1e30).value_or(vec3(1));
+  out.specular_texture = ext_texture(ext, ml, "KHR_materials_specular", "specularTexture");
+  out.specular_color_texture =
+      ext_texture(ext, ml, "KHR_materials_specular", "specularColorTexture");
+  out.transmission =
+      unit(ext_number(ext, ml, "KHR_materials_transmission", "transmissionFactor", 0.0),
+           "transmissionFactor");
+  out.transmission_texture =
+      ext_texture(ext, ml, "KHR_materials_transmission", "transmissionTexture");
+  // KHR_materials_volume: a thickness above 0 makes the mesh a volume boundary; the thickness
+  // itself (and thicknessTexture) is a rasteriser's estimate of the distance a path tracer
+  // traces, so only its sign is read.
+  const double thickness = ext_number(ext, ml, "KHR_materials_volume", "thicknessFactor", 0.0);
+  if (!(thickness >= 0.0)) fail(ml + ": thicknessFactor " + num(thickness) + " is below 0");
+  out.thin = !(thickness > 0.0);
+  const double distance =
+      ext_number(ext, ml, "KHR_materials_volume", "attenuationDistance", INFINITY);
+  if (!(distance > 0.0)) fail(ml + ": attenuationDistance " + num(distance) + " must be > 0");
+  const vec3 color =
+      ext_color(ext, ml, "KHR_materials_volume", "attenuationColor", 1.0).value_or(vec3(1));
+  for (int c = 0; c < 3; ++c)  // sigma = -ln(c) / d (KHR_materials_volume, "Attenuation")
+    out.attenuation[c] =
+        std::isinf(distance) ? 0.0f : float(-std::log(double(color[c])) / distance);
+  if (out.transmission > 0.0f || out.transmission_texture.present()) {
+    if (!out.thin && out.ior == 0.0f) fail(ml + ": a volume boundary cannot have ior 0");
+    if (out.roughness >= kMinMirrorRoughness || out.metallic_roughness_texture.present())
+      warn(ml + ": roughness " + num(pbr.roughnessFactor) +
+           " with transmission: the transmitted part is rendered as smooth glass");
+    if (!out.thin && ext.count("KHR_materials_specular"))
+      warn(ml + ": KHR_materials_specular does not change a volume boundary (exact Fresnel)");
   }
+
   const double strength =
       ext_number(ext, ml, "KHR_materials_emissive_strength", "emissiveStrength", 1.0);
   if (gm.emissiveFactor.size() != 3) fail(ml + ": emissiveFactor must have 3 numbers");
@@ -83,6 +138,18 @@ Material Loader::convert_material(size_t index) {  // the rules are in the comme
     if (!(e >= 0.0 && strength >= 0.0 && fits_float(e)))
       fail(ml + ": emission (emissiveFactor x emissiveStrength) must be finite and >= 0");
     out.emission[c] = float(e);
+  }
+  out.double_sided = gm.doubleSided;
+  if (gm.alphaMode == "MASK") {
+    out.alpha_mode = AlphaMode::Mask;
+    if (!(gm.alphaCutoff >= 0.0 && fits_float(gm.alphaCutoff)))
+      fail(ml + ": alphaCutoff " + num(gm.alphaCutoff) + " must be finite and >= 0");
+    out.alpha_cutoff = float(gm.alphaCutoff);
+  } else if (gm.alphaMode == "BLEND") {
+    out.alpha_mode = AlphaMode::Blend;
+    warn(ml + ": alphaMode BLEND is rendered opaque (MASK cut-outs are exact)");
+  } else if (!gm.alphaMode.empty() && gm.alphaMode != "OPAQUE") {
+    fail(ml + ": unknown alphaMode '" + one_line(gm.alphaMode) + "'");
   }
   return out;
 }

@@ -1,6 +1,10 @@
 #include "photonbound/image_io.h"
 
+#include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cstring>
 
 #include "photonbound/file_io.h"
 #include "photonbound/text.h"
@@ -73,6 +77,51 @@ ExrImage read_exr(const std::string& path) {
   }
   in->close();
   return image;
+}
+
+namespace {
+
+// A file name whose extension names the format the bytes are in: PNG and JPEG by their
+// signatures, otherwise whatever `name` says.
+std::string format_name(const unsigned char* d, size_t n, const std::string& name) {
+  if (n >= 8 && std::memcmp(d, "\x89PNG\r\n\x1a\n", 8) == 0) return "image.png";
+  if (n >= 3 && d[0] == 0xff && d[1] == 0xd8 && d[2] == 0xff) return "image.jpg";
+  if (n >= 12 && std::memcmp(d, "RIFF", 4) == 0 && std::memcmp(d + 8, "WEBP", 4) == 0)
+    return "image.webp";
+  return name;
+}
+
+}  // namespace
+
+Image decode_image(const unsigned char* data, size_t size, const std::string& name) {
+  OIIO::Filesystem::IOMemReader memory(data, size);
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);  // keep colour as stored, not premultiplied
+  auto in = OIIO::ImageInput::open(format_name(data, size, name), &config, &memory);
+  if (!in) throw ImageError(name + ": cannot decode the image: " + one_line(OIIO::geterror()));
+  const OIIO::ImageSpec& spec = in->spec();
+  Image im;
+  im.name = name;
+  im.width = spec.width;
+  im.height = spec.height;
+  im.channels = std::min(spec.nchannels, 4);
+  const uint64_t texels = uint64_t(std::max(spec.width, 0)) * uint64_t(std::max(spec.height, 0));
+  if (spec.width <= 0 || spec.height <= 0 || im.channels <= 0 || texels > (uint64_t(1) << 28))
+    throw ImageError(name + ": the image is " + std::to_string(spec.width) + "x" +
+                     std::to_string(spec.height) + " with " + std::to_string(spec.nchannels) +
+                     " channels; photonbound reads 1 to 4 channels and up to 2^28 texels");
+  const size_t values = size_t(texels) * size_t(im.channels);
+  bool ok;
+  if (spec.format == OIIO::TypeDesc::UINT8) {
+    im.u8.resize(values);
+    ok = in->read_image(0, 0, 0, im.channels, OIIO::TypeDesc::UINT8, im.u8.data());
+  } else {
+    im.f32.resize(values);
+    ok = in->read_image(0, 0, 0, im.channels, OIIO::TypeDesc::FLOAT, im.f32.data());
+  }
+  if (!ok) throw ImageError(name + ": cannot decode the image: " + one_line(in->geterror()));
+  in->close();
+  return im;
 }
 
 }  // namespace pb

@@ -42,7 +42,8 @@ double total_emitted_power(const Scene& scene) {
   for (const Mesh& m : scene.meshes) {
     const Material& mat = scene.materials[m.material];
     if (!mat.emits()) continue;
-    const dvec3 le(mat.emission);
+    // Textures scale the emission by at most 1: the factor bounds the power.
+    const dvec3 le = dvec3(mat.emission) * (mat.double_sided ? 2.0 : 1.0);
     for (size_t t = 0; t + 2 < m.indices.size(); t += 3) {
       const dvec3 p0(m.positions[m.indices[t]]);
       const double area = 0.5 * glm::length(glm::cross(dvec3(m.positions[m.indices[t + 1]]) - p0,
@@ -101,7 +102,7 @@ bool sample_spherical_triangle(const vec3& v0, const vec3& v1, const vec3& v2, c
   return std::isfinite(dir.x) && std::isfinite(dir.y) && std::isfinite(dir.z);
 }
 
-Lights::Lights(const Scene& scene) : punctual_(scene.lights) {
+Lights::Lights(const Scene& scene) : punctual_(scene.lights), images_(scene.images) {
   for (const Mesh& mesh : scene.meshes) {
     const Material& mat = scene.materials[mesh.material];
     if (!mat.emits()) continue;
@@ -115,16 +116,30 @@ Lights::Lights(const Scene& scene) : punctual_(scene.lights) {
       if (!(tri.area > 0.0f)) continue;
       tri.normal = c / (2.0f * tri.area);
       tri.radiance = mat.emission;
-      triangles_.push_back(tri);
+      tri.select = average(tri.radiance);
+      tri.two_sided = mat.double_sided;
+      if (mat.emissive_texture.present() || mat.masked())
+        add_textured(mesh, mat, uint32_t(t / 3), tri);
+      else
+        triangles_.push_back(tri);
     }
   }
   std::vector<double> weights;
-  auto add = [&](const vec3& power) {
+  auto add = [&](const vec3& power, double weight) {
     total_power_ += power;
-    weights.push_back(double(power.x) + power.y + power.z);
+    weights.push_back(weight);
   };
-  for (const PunctualLight& l : punctual_) add(punctual_power(l));
-  for (const Triangle& t : triangles_) add(lambertian_emitter_power(t.area, t.radiance));
+  for (const PunctualLight& l : punctual_) {
+    const vec3 p = punctual_power(l);
+    add(p, double(p.x) + p.y + p.z);
+  }
+  for (const Triangle& t : triangles_) {
+    const float sides = t.two_sided ? 2.0f : 1.0f;
+    const vec3 p = lambertian_emitter_power(t.area * sides, t.radiance);
+    // Chosen by power; a textured piece by its select radiance, which is never 0 where it emits.
+    add(p, t.source < 0 ? double(p.x) + p.y + p.z
+                        : 3.0 * double(lambertian_emitter_power(t.area * sides, t.select)));
+  }
 
   double sum = 0.0;
   for (double w : weights) sum += w;
@@ -181,9 +196,15 @@ EmittedPhoton Lights::sample_photon(Rng& rng) const {
   // Drawn in this order: the arguments of an earlier call, which GCC evaluated right to left
   // (images stay bit-identical; the order is now explicit for every compiler).
   const float v2 = rng.next_float(), v1 = rng.next_float();
-  ph.dir = sample_cosine_hemisphere(t.normal, v1, v2);
+  float sides = 1.0f;
+  if (t.two_sided) {  // either side with probability 1/2
+    sides = 2.0f;
+    if (rng.next_float() < 0.5f) ph.normal = -ph.normal;
+  }
+  ph.dir = sample_cosine_hemisphere(ph.normal, v1, v2);
   // Cosine-weighted direction and uniform area: flux = Le cos / (pdf_A pdf_w) = pi A Le.
-  ph.flux = t.radiance * (kPi * t.area) / p_pick;
+  const vec3 le = t.source < 0 ? t.radiance : radiance_at(t, b1, b2);
+  ph.flux = le * (kPi * t.area * sides) / p_pick;
   return ph;
 }
 
@@ -197,13 +218,13 @@ float Lights::local_weight(size_t k, const vec3& receiver) const {
   }
   const Triangle& t = triangles_[k - punctual_.size()];
   const vec3 a = t.p0 - receiver, b = a + t.e1, c = a + t.e2;
-  if (glm::dot(a, t.normal) >= 0.0f) return 0.0f;  // receiver behind the one-sided emitter
+  if (!t.two_sided && glm::dot(a, t.normal) >= 0.0f) return 0.0f;  // behind a one-sided emitter
   // Solid angle (Van Oosterom & Strackee 1983): tan(omega / 2) = |a.(b x c)| / denominator.
   const float la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
   const float num = std::fabs(glm::dot(a, glm::cross(b, c)));
   const float den = la * lb * lc + glm::dot(a, b) * lc + glm::dot(a, c) * lb + glm::dot(b, c) * la;
   const float omega = 2.0f * std::atan2(num, den);
-  return average(t.radiance) * std::max(omega, 0.0f);
+  return t.select * std::max(omega, 0.0f);
 }
 
 bool Lights::sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) const {
@@ -248,8 +269,9 @@ bool Lights::sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) co
   }
   const Triangle& t = triangles_[k - punctual_.size()];
   const vec3 p1 = t.p0 + t.e1, p2 = t.p0 + t.e2;
-  // A receiver on the emitter's back side or in its plane sees no light from it.
-  if (glm::dot(receiver - t.p0, t.normal) <= 0.0f) return false;
+  // A receiver on a one-sided emitter's back side, or in its plane, sees no light from it.
+  const float side = glm::dot(receiver - t.p0, t.normal);
+  if (t.two_sided ? side == 0.0f : side <= 0.0f) return false;
   vec3 dir;
   float solid_angle = 0.0f;
   // Solid-angle sampling only pays near the emitter: from farther than a few times its size,
@@ -264,8 +286,18 @@ bool Lights::sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) co
     if (!(dist > 0.0f) || !std::isfinite(dist)) return false;
     out.wi = dir;
     out.distance = dist;
-    out.li = t.radiance * (solid_angle / p_pick);
-    return true;
+    vec3 le = t.radiance;
+    if (t.source >= 0) {  // the point's barycentrics in the piece
+      const vec3 v = receiver + dist * dir - t.p0;
+      const float d00 = glm::dot(t.e1, t.e1), d01 = glm::dot(t.e1, t.e2);
+      const float d11 = glm::dot(t.e2, t.e2), d20 = glm::dot(v, t.e1), d21 = glm::dot(v, t.e2);
+      const float den = d00 * d11 - d01 * d01;
+      const float c1 = std::clamp((d11 * d20 - d01 * d21) / den, 0.0f, 1.0f);
+      const float c2 = std::clamp((d00 * d21 - d01 * d20) / den, 0.0f, 1.0f - c1);
+      le = radiance_at(t, c1, c2);
+    }
+    out.li = le * (solid_angle / p_pick);
+    return max_component(out.li) > 0.0f;
   }
   // Tiny or degenerate solid angle: uniform area sampling (pbrt-v4 does the same).
   const float s = std::sqrt(u1);
@@ -275,11 +307,13 @@ bool Lights::sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) co
   if (!(dist2 > 0.0f)) return false;
   out.distance = std::sqrt(dist2);
   out.wi = d / out.distance;
-  const float cos_light = -glm::dot(out.wi, t.normal);
+  float cos_light = -glm::dot(out.wi, t.normal);
+  if (t.two_sided) cos_light = std::fabs(cos_light);
   if (cos_light <= 0.0f) return false;  // one-sided emitter seen from behind
   // Area sampling converted to solid angle: Le cos_l A / (d^2 p_pick).
-  out.li = t.radiance * (cos_light * t.area / (dist2 * p_pick));
-  return true;
+  const vec3 le = t.source < 0 ? t.radiance : radiance_at(t, 1.0f - s, u2 * s);
+  out.li = le * (cos_light * t.area / (dist2 * p_pick));
+  return t.source < 0 || max_component(out.li) > 0.0f;
 }
 
 }  // namespace pb

@@ -73,6 +73,10 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   pb::ThreadLimit threads(options.threads);
   pb::Renderer renderer(std::move(scene), options);
   if (saved) renderer.restore(saved->render);
+  // Which materials the mirror threshold turns into perfect mirrors (a choice, not a flaw).
+  if (const std::string note = renderer.world().mirror_note();
+      !note.empty() && options.progress != pb::ProgressMode::Never)
+    std::cerr << "photonbound: note: " << options.scene << ": " << note << "\n";
   // The bias term models the radiance as smooth (second order) within the radius. A radius of
   // the scene's size breaks that (the extremes suite measured a bound of 0.128 against an error
   // of ~1 at R = scene size), so say so rather than report a bound that cannot be trusted.

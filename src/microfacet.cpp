@@ -135,10 +135,11 @@ vec3 eval_and_pdf(const MetalRoughBrdf& m, const vec3& wo, const vec3& wi, float
   const float d = ggx_d(h, a);
   const float specular = ggx_visibility(wo.z, wi.z, a) * d;  // glTF specular_brdf
   const float fw = schlick_weight(v_h);
-  const float f0 = dielectric_f0(m.ior);
-  const float fr = f0 + (1.0f - f0) * fw;
-  // glTF appendix B "Metal BRDF and Dielectric BRDF", the full code.
-  const vec3 dielectric = (1.0f - fr) * m.base_color / kPi + vec3(fr * specular);
+  const vec3 f0 = m.dielectric_f0();
+  const vec3 fr = f0 + (vec3(m.dielectric_f90()) - f0) * fw;
+  // glTF appendix B "Metal BRDF and Dielectric BRDF", the full code, with KHR_materials_specular's
+  // RGB Fresnel term (the diffuse base keeps 1 - its largest channel).
+  const vec3 dielectric = (1.0f - max_component(fr)) * m.base_color / kPi + fr * specular;
   const vec3 metal = (m.base_color + (vec3(1.0f) - m.base_color) * fw) * specular;
   if (pdf) {
     const float ps = m.specular_probability(wo);
@@ -161,9 +162,14 @@ float MetalRoughBrdf::pdf(const vec3& wo, const vec3& wi) const {
   return p;
 }
 
+vec3 MetalRoughBrdf::dielectric_f0() const {
+  return glm::min(pb::dielectric_f0(ior) * specular_color, vec3(1.0f)) * specular;
+}
+
 float MetalRoughBrdf::specular_probability(const vec3& wo) const {
-  const float f0 = dielectric_f0(ior);
-  const float s = (1.0f - metallic) * schlick_fresnel(f0, wo.z) +
+  const float f0 = max_component(dielectric_f0());
+  const float f90 = dielectric_f90();
+  const float s = (1.0f - metallic) * (f0 + (f90 - f0) * schlick_weight(wo.z)) +
                   metallic * max_component(schlick_fresnel(base_color, wo.z));
   const float d = (1.0f - metallic) * (1.0f - f0) * max_component(base_color);
   return s + d > 0.0f ? s / (s + d) : 1.0f;

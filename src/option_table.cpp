@@ -287,6 +287,10 @@ std::vector<OptionSpec> make_table() {
   t.push_back(integer(base("--max-depth", "max_depth", "D", render, K::Image,
                            "specular bounces a camera path may take"),
                       &RenderOptions::max_depth, {0, 32}));
+  t.push_back(real(base("--mirror-roughness", "mirror_roughness", "R", render, K::Image,
+                        "GGX lobes with a glTF roughness below R are rendered as perfect mirrors"),
+                   &RenderOptions::mirror_roughness,
+                   {kMinMirrorRoughness, 1, false, false, "", ""}));
   t.push_back(resolution());
   t.push_back(text(base("--camera", "camera", "NAME", render, K::Image,
                         "glTF camera name, \"camera N\" when unnamed"),

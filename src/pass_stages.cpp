@@ -48,9 +48,14 @@ void build_photon_grid(const std::vector<PhotonHit>& hits, std::span<const float
   grid.build(positions, radii);
 }
 
-template <bool kLaplacian>
-void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& grid,
-                    const std::vector<PhotonHit>& hits, PassGather& out) {
+namespace {
+
+// The kernel sums of one point; photon_flux(h) is what a photon brings before the point's f:
+// its power (Lambertian points, whose constant f is multiplied once below) or its power times
+// f(wo, wi) (glossy points, whose f holds the path weight alone).
+template <bool kLaplacian, class PhotonFlux>
+void gather_kernel(const MeasurementPoint& point, double r2, const HashGrid& grid,
+                   const std::vector<PhotonHit>& hits, PhotonFlux&& photon_flux, PassGather& out) {
   const float radius = search_radius(r2);
   const double inv_r2 = 1.0 / r2;
   dvec3 phi(0.0), lap(0.0);
@@ -66,7 +71,7 @@ void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& gr
     if (cos_s <= 0.0f) return;
     // Photon density is flux per area of the true surface; reflected radiance integrates
     // against the shading cosine, hence cos_s / cos_g.
-    const dvec3 flux = dvec3(h.flux) * double(cos_s / cos_g);
+    const dvec3 flux = photon_flux(h) * double(cos_s / cos_g);
     const double t = std::min(1.0, std::sqrt(double(dist2) * inv_r2));
     phi += kernel::weight(t) * flux;
     if constexpr (kLaplacian) lap += kernel::laplacian_weight_r2(t) * flux;
@@ -77,34 +82,85 @@ void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& gr
   out.count += count;
 }
 
+// Walks a GlossyTable alongside the points of its span, in order.
+class GlossyCursor {
+ public:
+  GlossyCursor(const GlossyTable& t, size_t count) : t_(t), end_(t.base + count) {
+    it_ = std::lower_bound(t.entries.begin(), t.entries.end(), t.base,
+                           [](const GlossyPoint& g, size_t i) { return g.point < i; });
+  }
+  // The entry of point k of the span, or null when that point is Lambertian (k ascending).
+  const GlossyPoint* at(size_t k) {
+    const size_t i = t_.base + k;
+    while (it_ != t_.entries.end() && it_->point < i) ++it_;
+    return it_ != t_.entries.end() && it_->point == i && i < end_ ? &*it_ : nullptr;
+  }
+
+ private:
+  GlossyTable t_;
+  size_t end_;
+  std::span<const GlossyPoint>::iterator it_;
+};
+
+}  // namespace
+
+template <bool kLaplacian>
+void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& grid,
+                    const std::vector<PhotonHit>& hits, PassGather& out) {
+  gather_kernel<kLaplacian>(
+      point, r2, grid, hits, [](const PhotonHit& h) { return dvec3(h.flux); }, out);
+}
+
+template <bool kLaplacian>
+void gather_photons(const MeasurementPoint& point, const GlossyPoint& glossy, double r2,
+                    const HashGrid& grid, const std::vector<PhotonHit>& hits, PassGather& out) {
+  gather_kernel<kLaplacian>(
+      point, r2, grid, hits,
+      [&](const PhotonHit& h) { return dvec3(h.flux * glossy.bsdf.eval(glossy.wo, h.wi)); }, out);
+}
+
 template void gather_photons<true>(const MeasurementPoint&, double, const HashGrid&,
                                    const std::vector<PhotonHit>&, PassGather&);
 template void gather_photons<false>(const MeasurementPoint&, double, const HashGrid&,
                                     const std::vector<PhotonHit>&, PassGather&);
+template void gather_photons<true>(const MeasurementPoint&, const GlossyPoint&, double,
+                                   const HashGrid&, const std::vector<PhotonHit>&, PassGather&);
+template void gather_photons<false>(const MeasurementPoint&, const GlossyPoint&, double,
+                                    const HashGrid&, const std::vector<PhotonHit>&, PassGather&);
 
-dvec3 direct_light(const World& world, const MeasurementPoint& point, Rng& rng) {
+dvec3 direct_light(const World& world, const MeasurementPoint& point, const GlossyPoint* glossy,
+                   Rng& rng) {
   DirectSample s;
   if (!world.lights().sample_direct(point.position, rng, s)) return dvec3(0.0);
   const float cos_s = glm::dot(s.wi, point.shading);
   if (cos_s <= 0.0f || glm::dot(s.wi, point.normal) <= 0.0f) return dvec3(0.0);
+  const vec3 f = glossy ? point.f * glossy->bsdf.eval(glossy->wo, s.wi) : point.f;
+  if (glossy && !(max_component(f) > 0.0f)) return dvec3(0.0);  // no shadow ray for nothing
   if (world.occluded(point.position, point.normal, s.wi, s.distance)) return dvec3(0.0);
-  return dvec3(point.f * s.li * cos_s);
+  return dvec3(f * s.li * cos_s);
 }
 
 void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
-                 const HashGrid& grid, const std::vector<PhotonHit>& hits,
+                 const HashGrid& grid, const std::vector<PhotonHit>& hits, GlossyTable glossy,
                  std::span<PassGather> out) {
-  for (size_t k = 0; k < points.size(); ++k)
-    if (max_component(points[k].f) > 0.0f)  // SPPM: a pixel without a visible point this pass
+  GlossyCursor cursor(glossy, points.size());
+  for (size_t k = 0; k < points.size(); ++k) {
+    if (!(max_component(points[k].f) > 0.0f)) continue;  // SPPM: no visible point this pass
+    if (const GlossyPoint* g = cursor.at(k))
+      gather_photons(points[k], *g, states[k].r2, grid, hits, out[k]);
+    else
       gather_photons(points[k], states[k].r2, grid, hits, out[k]);
+  }
 }
 
-void next_event_pass(const World& world, std::span<const MeasurementPoint> points, uint64_t seed,
-                     uint64_t pass, size_t first, std::span<PassGather> out) {
+void next_event_pass(const World& world, std::span<const MeasurementPoint> points,
+                     GlossyTable glossy, uint64_t seed, uint64_t pass, size_t first,
+                     std::span<PassGather> out) {
+  GlossyCursor cursor(glossy, points.size());
   for (size_t k = 0; k < points.size(); ++k) {
     if (!(max_component(points[k].f) > 0.0f)) continue;
     Rng rng(seed, pass, first + k, Stream::DirectLight);
-    out[k].direct += direct_light(world, points[k], rng);
+    out[k].direct += direct_light(world, points[k], cursor.at(k), rng);
   }
 }
 
@@ -129,12 +185,13 @@ void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> poi
     parallel_for(count, kGrain, [&](size_t b, size_t e) {
       const std::span<PassGather> out = sums.subspan(b, e - b);
       std::fill(out.begin(), out.end(), PassGather{});
+      const GlossyTable glossy{in.glossy, first + b};
       gather_pass(points.subspan(first + b, e - b),
                   std::span<const PointState>(states).subspan(first + b, e - b), in.grid, in.hits,
-                  out);
+                  glossy, out);
       if (in.next_event)
-        next_event_pass(in.world, points.subspan(first + b, e - b), in.seed, in.pass, first + b,
-                        out);
+        next_event_pass(in.world, points.subspan(first + b, e - b), glossy, in.seed, in.pass,
+                        first + b, out);
     });
     // A distributed render reduces sums[0, count) across machines here.
     parallel_for(count, kGrain, [&](size_t b, size_t e) {
@@ -148,7 +205,8 @@ void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> poi
 void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
                           std::span<PointState> states, std::span<float> radii,
                           std::span<uint32_t> visible, std::span<MeasurementPoint> points,
-                          std::span<PassGather> sums, PointState* copy) {
+                          std::span<GlossyPoint> glossy, std::span<PassGather> sums,
+                          PointState* copy) {
   constexpr size_t kGrain = 256;  // pixels per parallel task inside a block
   const size_t n = states.size(), block = sums.size();
   for (size_t first = 0; first < n; first += block) {
@@ -156,10 +214,12 @@ void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
     parallel_for(count, kGrain, [&](size_t b, size_t e) {
       const std::span<MeasurementPoint> pts = points.subspan(b, e - b);
       const std::span<PassGather> out = sums.subspan(b, e - b);
-      trace_visible_points(camera, first + b, pts, out);
+      const std::span<GlossyPoint> scratch = glossy.subspan(b, e - b);
+      const size_t n_glossy = trace_visible_points(camera, first + b, pts, scratch, out);
+      const GlossyTable table{scratch.first(n_glossy), 0};  // indices into pts
       gather_pass(pts, std::span<const PointState>(states).subspan(first + b, e - b), in.grid,
-                  in.hits, out);
-      if (in.next_event) next_event_pass(in.world, pts, in.seed, in.pass, first + b, out);
+                  in.hits, table, out);
+      if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, first + b, out);
       for (size_t k = 0; k < pts.size(); ++k)  // saturating: 2^32 - 1 passes is far beyond use
         if (max_component(pts[k].f) > 0.0f && visible[first + b + k] != UINT32_MAX)
           ++visible[first + b + k];

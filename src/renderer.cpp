@@ -59,7 +59,7 @@ double default_initial_radius(const EyePassResult& eye, const World& world) {
 
 Renderer::Renderer(Scene scene, const RenderOptions& options)
     : options_(options),
-      world_(std::move(scene)),
+      world_(std::move(scene), float(options.mirror_roughness)),
       camera_(choose_camera(world_.scene(), options)),
       tracer_(world_, options.direct == DirectMode::Photons) {
   const auto t0 = Clock::now();
@@ -88,7 +88,10 @@ Renderer::Renderer(Scene scene, const RenderOptions& options)
   states_.assign(states, initial);
   radii_.assign(states, search_radius(initial.r2));
   sums_.resize(std::min(kFoldBlock, states_.size()));
-  if (options_.method == Method::SPPM) visible_points_.resize(sums_.size());
+  if (options_.method == Method::SPPM) {
+    visible_points_.resize(sums_.size());
+    visible_glossy_.resize(sums_.size());
+  }
 }
 
 bool Renderer::radii_fixed() const {
@@ -124,13 +127,14 @@ void Renderer::step(std::vector<PointState>* copy) {
   t = Clock::now();
   const bool nee = options_.direct == DirectMode::NextEvent;
   if (copy) copy->resize(n);
-  const PassInputs in{world_, grid_, hits_, params_, options_.seed, pass, nee};
+  const PassInputs in{world_, grid_, hits_, params_, options_.seed, pass, nee, eye_.glossy};
   PointState* const out = copy ? copy->data() : nullptr;
   if (options_.method == Method::PPM) {
     gather_and_fold(in, eye_.points, states_, radii_, sums_, out);
   } else {
     const CameraPathInputs cam{world_, camera_, options_.max_depth, options_.seed, pass};
-    sppm_gather_and_fold(in, cam, states_, radii_, visible_, visible_points_, sums_, out);
+    sppm_gather_and_fold(in, cam, states_, radii_, visible_, visible_points_, visible_glossy_,
+                         sums_, out);
   }
   timings_.gather += seconds_since(t);
 }

@@ -2,14 +2,15 @@
 
 namespace pb {
 
-World::World(Scene scene)
+World::World(Scene scene, float mirror_roughness)
     : scene_(std::move(scene)),
       accel_(scene_),
       lights_(scene_),
       scene_size_(std::max(scene_.bounds.diagonal(), 1e-30f)),
       // Offsets of 1e-5 of the scene keep rays off their own surface without skipping
       // neighbouring geometry; the |p| term in offset() covers float spacing far from 0.
-      epsilon_(1e-5f * scene_size_) {
+      epsilon_(1e-5f * scene_size_),
+      mirror_roughness_(mirror_roughness) {
   size_t triangles = 0;
   for (const Mesh& m : scene_.meshes) triangles += m.indices.size() / 3;
   face_normals_.resize(triangles);
@@ -22,9 +23,21 @@ World::World(Scene scene)
       const vec3& p2 = m.positions[m.indices[3 * t + 2]];
       face_normals_[first + t] = glm::normalize(glm::cross(p1 - p0, p2 - p0));
     }
-    meshes_.push_back({m.positions.data(), m.normals.empty() ? nullptr : m.normals.data(),
-                       m.indices.data(), face_normals_.data() + first,
-                       &scene_.materials[m.material]});
+    const Material& mat = scene_.materials[m.material];
+    const bool textured = mat.base_color_texture.present() ||
+                          mat.metallic_roughness_texture.present() ||
+                          mat.normal_texture.present() || mat.emissive_texture.present() ||
+                          mat.transmission_texture.present() || mat.specular_texture.present() ||
+                          mat.specular_color_texture.present() || mat.masked();
+    auto uv = [&](int set) { return m.texcoords[set].empty() ? nullptr : m.texcoords[set].data(); };
+    meshes_.push_back({m.positions.data(),
+                       m.normals.empty() ? nullptr : m.normals.data(),
+                       m.indices.data(),
+                       face_normals_.data() + first,
+                       &mat,
+                       {uv(0), uv(1)},
+                       m.tangents.empty() ? nullptr : m.tangents.data(),
+                       textured});
     first += n;
   }
 }

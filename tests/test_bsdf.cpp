@@ -381,11 +381,15 @@ TEST(ShadingNormals, AdjointFactorIsRatioOfProjections) {
 // ---------------------------------------------------------------------------------------------
 // Specular branches
 
-Material make_material(Reflection model, vec3 color, float ior = 1.5f) {
-  Material m;
-  m.model = model;
+// The three plain glTF materials these tests exercise: Lambertian (metallic 0, specular 0),
+// a smooth metal (a mirror) and smooth glass bounding a volume.
+enum class Model { Lambertian, Mirror, Dielectric };
+
+Material make_material(Model model, vec3 color, float ior = 1.5f) {
+  Material m = model == Model::Lambertian ? Material::lambertian(color)
+               : model == Model::Mirror   ? Material::metal(color, 0.0f)
+                                          : Material::glass(ior);
   m.base_color = color;
-  m.ior = ior;
   return m;
 }
 
@@ -407,7 +411,7 @@ void expect_mirror_image(const vec3& wo, const vec3& r, const vec3& n, const cha
 }
 
 TEST(SpecularBranches, MirrorReflectsWithBaseColor) {
-  const Material m = make_material(Reflection::Mirror, vec3(0.9f, 0.6f, 0.3f));
+  const Material m = make_material(Model::Mirror, vec3(0.9f, 0.6f, 0.3f));
   const vec3 n(0, 0, 1);
   const Surface s = make_surface(m, n, n);
   for (const vec3& wo : {unit(0.3f, 0.2f, 0.9f), unit(-0.9f, 0.1f, 0.1f), vec3(0, 0, 1)}) {
@@ -432,8 +436,8 @@ TEST(SpecularBranches, DielectricFromOutsideSplitsByFresnel) {
   // (1-F) tint / eta^2 (radiance) or (1-F) tint (importance), eta = 1.5. F is checked against the
   // double-precision textbook reference; float: 2e-5.
   const vec3 n(0, 0, 1);
-  const Material white = make_material(Reflection::Dielectric, vec3(1.0f), 1.5f);
-  const Material tinted = make_material(Reflection::Dielectric, vec3(0.9f, 0.5f, 0.2f), 1.5f);
+  const Material white = make_material(Model::Dielectric, vec3(1.0f), 1.5f);
+  const Material tinted = make_material(Model::Dielectric, vec3(0.9f, 0.5f, 0.2f), 1.5f);
   const Surface sw = make_surface(white, n, n);
   const Surface st = make_surface(tinted, n, n);
   for (int k = 0; k < 89; ++k) {
@@ -466,7 +470,7 @@ TEST(SpecularBranches, DielectricFromInside) {
   // Beyond it exactly one branch, the mirror image about -ng, weight 1. Below it two branches
   // with the radiance transmission weight (1-F) * 1.5^2 and importance weights summing to 1.
   const vec3 n(0, 0, 1);
-  const Material glass = make_material(Reflection::Dielectric, vec3(1.0f), 1.5f);
+  const Material glass = make_material(Model::Dielectric, vec3(1.0f), 1.5f);
   const Surface s = make_surface(glass, n, n);
   const double theta_c = std::asin(1.0 / 1.5);
   for (int k = 0; k < 90; ++k) {
@@ -510,7 +514,7 @@ TEST(SpecularBranches, WhiteDielectricConservesPhotonEnergyWithShadingNormals) {
   const float phi = 20.0f * kPi / 180.0f, th = 60.0f * kPi / 180.0f;
   const vec3 ns(-std::sin(phi), 0.0f, std::cos(phi));
   const vec3 wo(std::sin(th), 0.0f, -std::cos(th));
-  const Material glass = make_material(Reflection::Dielectric, vec3(1.0f), 1.5f);
+  const Material glass = make_material(Model::Dielectric, vec3(1.0f), 1.5f);
   {
     const Surface s = make_surface(glass, ng, ns);
     SpecularBranch br[2];
@@ -552,7 +556,7 @@ TEST(SpecularBranches, TiltedShadingNormalKeepsDirectionsOnCorrectSide) {
   const float a55 = 55.0f * kPi / 180.0f;
   const vec3 wo(-std::sin(a55), 0.0f, std::cos(a55));
   ASSERT_LT(glm::dot(reflect(wo, ns30), ng), 0.0f);  // the naive mirror image is below
-  for (Reflection model : {Reflection::Mirror, Reflection::Dielectric}) {
+  for (Model model : {Model::Mirror, Model::Dielectric}) {
     const Material m = make_material(model, vec3(1.0f), 1.5f);
     const Surface s = make_surface(m, ng, ns30);
     SpecularBranch br[2];
@@ -569,7 +573,7 @@ TEST(SpecularBranches, TiltedShadingNormalKeepsDirectionsOnCorrectSide) {
     vec3 w = random_unit(rng);
     if (std::fabs(glm::dot(w, ng)) < 1e-3f) continue;
     const float side = glm::dot(w, ng) > 0.0f ? 1.0f : -1.0f;
-    for (Reflection model : {Reflection::Mirror, Reflection::Dielectric}) {
+    for (Model model : {Model::Mirror, Model::Dielectric}) {
       const Material m = make_material(model, vec3(1.0f), 1.5f);
       const Surface s = make_surface(m, ng, glm::dot(nsr, ng) > 0.0f ? nsr : -nsr);
       SpecularBranch br[2];

@@ -20,7 +20,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using pb::load_gltf;
-using pb::Reflection;
 using pb::Scene;
 using pb::SceneError;
 using pb::vec3;
@@ -253,7 +252,8 @@ TEST_F(LoaderTest, LoadsMinimalScene) {
   EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 1, 2}));
   ASSERT_EQ(s.materials.size(), 1u);
   EXPECT_EQ(s.materials[m.material].name, "grey");
-  EXPECT_EQ(s.materials[m.material].model, Reflection::Lambertian);
+  EXPECT_EQ(s.materials[m.material].metallic, 0.0f);
+  EXPECT_EQ(s.materials[m.material].roughness, 1.0f);  // glTF's default
   expect_vec(s.materials[m.material].base_color, vec3(0.5f, 0.6f, 0.7f));
   EXPECT_FALSE(s.materials[m.material].emits());
   ASSERT_EQ(s.lights.size(), 1u);
@@ -290,23 +290,28 @@ TEST_F(LoaderTest, LoadsExternalBuffer) {
   EXPECT_EQ(load(g).triangle_count(), 1u);
 }
 
-TEST_F(LoaderTest, MaterialModelsFollowTheRules) {
+TEST_F(LoaderTest, MaterialsKeepGltfParametersAndDefaults) {
   Gltf g = basic();
   const std::vector<std::string> bodies = {
-      "\"name\":\"mirror\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.9,0.8,0.7,1],"
-      "\"roughnessFactor\":0}",
-      "\"name\":\"rough\",\"pbrMetallicRoughness\":{\"metallicFactor\":0.7,\"roughnessFactor\":0."
-      "5}",
-      "\"name\":\"glass\",\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1}"
-      ","
-      "\"KHR_materials_ior\":{\"ior\":1.33}},\"pbrMetallicRoughness\":{\"baseColorFactor\":[1,1,0."
-      "9,1]}",
-      "\"name\":\"glass15\",\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":"
-      "1}}",
-      "\"name\":\"lamp\",\"emissiveFactor\":[1,0.5,0],\"pbrMetallicRoughness\":{\"metallicFactor\":"
-      "0},"
-      "\"extensions\":{\"KHR_materials_emissive_strength\":{\"emissiveStrength\":4}}",
-      "\"name\":\"plain\""};
+      // 0: no pbrMetallicRoughness: glTF's defaults, a rough white metal
+      "\"name\":\"plain\"",
+      // 1: every extension photonbound reads
+      "\"name\":\"all\",\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.9,0.8,0.7,0.5],"
+      "\"metallicFactor\":0.25,\"roughnessFactor\":0.5},\"emissiveFactor\":[1,0.5,0],"
+      "\"doubleSided\":true,\"alphaMode\":\"MASK\",\"alphaCutoff\":0.3,\"extensions\":{"
+      "\"KHR_materials_ior\":{\"ior\":1.33},\"KHR_materials_emissive_strength\":{"
+      "\"emissiveStrength\":4},\"KHR_materials_specular\":{\"specularFactor\":0.5,"
+      "\"specularColorFactor\":[1,2,0.5]},\"KHR_materials_transmission\":{"
+      "\"transmissionFactor\":0.75},\"KHR_materials_volume\":{\"thicknessFactor\":0.1,"
+      "\"attenuationDistance\":2,\"attenuationColor\":[0.5,1,0.25]}}",
+      // 2: transmission without a volume: thin-walled
+      "\"name\":\"thin\",\"pbrMetallicRoughness\":{\"roughnessFactor\":0},\"extensions\":{"
+      "\"KHR_materials_transmission\":{\"transmissionFactor\":1}}",
+      // 3: a volume with thickness 0 is thin-walled too
+      "\"name\":\"zero\",\"pbrMetallicRoughness\":{\"roughnessFactor\":0},\"extensions\":{"
+      "\"KHR_materials_transmission\":{\"transmissionFactor\":1},\"KHR_materials_volume\":{}}",
+      // 4: BLEND is rendered opaque
+      "\"name\":\"blend\",\"alphaMode\":\"BLEND\""};
   for (const std::string& body : bodies) {
     const int mat = g.material(body);
     const int mesh = g.mesh("m" + std::to_string(mat), 0, 2, mat);
@@ -314,43 +319,68 @@ TEST_F(LoaderTest, MaterialModelsFollowTheRules) {
   }
   g.node("\"mesh\":" + std::to_string(g.mesh("nomat", 0, 2)));
   const Scene s = load(g);
-  ASSERT_EQ(s.meshes.size(), 8u);
+  ASSERT_EQ(s.meshes.size(), 7u);
   auto mat = [&](size_t mesh) { return s.materials[s.meshes[mesh].material]; };
-  EXPECT_EQ(mat(0).model, Reflection::Lambertian);
-  EXPECT_EQ(mat(1).model, Reflection::Mirror);
-  expect_vec(mat(1).base_color, vec3(0.9f, 0.8f, 0.7f));
-  EXPECT_EQ(mat(2).model, Reflection::Mirror);
-  EXPECT_TRUE(has_warning(s, "material 'rough': roughness 0.5 treated as a smooth mirror"));
-  EXPECT_FALSE(has_warning(s, "material 'mirror'"));
-  EXPECT_EQ(mat(3).model, Reflection::Dielectric);
-  EXPECT_NEAR(mat(3).ior, 1.33f, 1e-6f);
-  expect_vec(mat(3).base_color, vec3(1, 1, 0.9f));
-  EXPECT_EQ(mat(4).model, Reflection::Dielectric);
-  EXPECT_NEAR(mat(4).ior, 1.5f, 1e-6f);
-  EXPECT_EQ(mat(5).model, Reflection::Lambertian);
-  expect_vec(mat(5).emission, vec3(4, 2, 0));
-  EXPECT_TRUE(mat(5).emits());
-  EXPECT_EQ(mat(6).model, Reflection::Mirror);  // glTF default metallicFactor is 1
-  EXPECT_TRUE(has_warning(s, "material 'plain': roughness 1 treated as a smooth mirror"));
-  EXPECT_EQ(mat(7).name, "default");
-  EXPECT_EQ(mat(7).model, Reflection::Lambertian);
-  expect_vec(mat(7).base_color, vec3(0.8f));
+  const pb::Material plain = mat(1);
+  EXPECT_EQ(plain.metallic, 1.0f);
+  EXPECT_EQ(plain.roughness, 1.0f);
+  expect_vec(plain.base_color, vec3(1.0f));
+  EXPECT_EQ(plain.specular, 1.0f);
+  EXPECT_TRUE(plain.thin);
+  EXPECT_FALSE(plain.double_sided);
+  EXPECT_FALSE(plain.masked());
+  const pb::Material all = mat(2);
+  expect_vec(all.base_color, vec3(0.9f, 0.8f, 0.7f));
+  EXPECT_NEAR(all.alpha, 0.5f, 1e-7f);
+  EXPECT_NEAR(all.metallic, 0.25f, 1e-7f);
+  EXPECT_NEAR(all.roughness, 0.5f, 1e-7f);
+  EXPECT_NEAR(all.ior, 1.33f, 1e-6f);
+  EXPECT_NEAR(all.specular, 0.5f, 1e-7f);
+  expect_vec(all.specular_color, vec3(1, 2, 0.5f));
+  EXPECT_NEAR(all.transmission, 0.75f, 1e-7f);
+  EXPECT_FALSE(all.thin);
+  // sigma = -ln(color) / distance per channel.
+  expect_vec(all.attenuation, vec3(std::log(2.0f) / 2, 0.0f, std::log(4.0f) / 2));
+  expect_vec(all.emission, vec3(4, 2, 0));
+  EXPECT_TRUE(all.double_sided);
+  EXPECT_TRUE(all.masked());
+  EXPECT_NEAR(all.alpha_cutoff, 0.3f, 1e-7f);
+  EXPECT_TRUE(has_warning(s, "material 'all': roughness 0.5 with transmission"));
+  EXPECT_TRUE(has_warning(s, "material 'all': KHR_materials_specular does not change a volume"));
+  EXPECT_TRUE(mat(3).thin);
+  EXPECT_FALSE(has_warning(s, "material 'thin'"));
+  EXPECT_TRUE(mat(4).thin);
+  EXPECT_EQ(mat(5).alpha_mode, pb::AlphaMode::Blend);
+  EXPECT_TRUE(has_warning(s, "material 'blend': alphaMode BLEND is rendered opaque"));
+  EXPECT_EQ(mat(6).name, "default");
+  EXPECT_EQ(mat(6).metallic, 0.0f);
+  EXPECT_EQ(mat(6).specular, 0.0f);  // Lambertian
+  expect_vec(mat(6).base_color, vec3(0.8f));
   EXPECT_TRUE(has_warning(s, "default"));
 }
 
-TEST_F(LoaderTest, TexturesAreIgnoredWithOneWarning) {
-  Gltf g = basic();
-  g.top =
-      "\"images\":[{\"uri\":\"data:image/png;base64,AAAAAAAA\"}],\"textures\":[{\"source\":0}],";
-  g.materials[0] =
-      "{\"pbrMetallicRoughness\":{\"metallicFactor\":0,\"baseColorTexture\":{\"index\":0}},"
-      "\"normalTexture\":{\"index\":0}}";
-  g.node("\"mesh\":" +
-         std::to_string(g.mesh("second", 0, 2, g.material("\"emissiveTexture\":{\"index\":0}"))));
-  const Scene s = load(g);
-  int count = 0;
-  for (const std::string& w : s.warnings) count += w == "textures are not read; factors are used";
-  EXPECT_EQ(count, 1);
+TEST_F(LoaderTest, MaterialFactorsOutOfRangeAreRefused) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"\"pbrMetallicRoughness\":{\"metallicFactor\":1.5}", "metallicFactor 1.5"},
+      {"\"pbrMetallicRoughness\":{\"roughnessFactor\":-0.1}", "roughnessFactor -0.1"},
+      {"\"extensions\":{\"KHR_materials_ior\":{\"ior\":0.5}}", "ior 0.5"},
+      {"\"extensions\":{\"KHR_materials_specular\":{\"specularFactor\":2}}", "specularFactor 2"},
+      {"\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":-1}}",
+       "transmissionFactor -1"},
+      {"\"extensions\":{\"KHR_materials_volume\":{\"attenuationDistance\":0}}",
+       "attenuationDistance 0"},
+      {"\"extensions\":{\"KHR_materials_volume\":{\"attenuationColor\":[2,0,0]}}",
+       "attenuationColor must be 3 numbers in [0, 1]"},
+      {"\"alphaMode\":\"SOMETIMES\"", "unknown alphaMode 'SOMETIMES'"},
+      {"\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":3}}",
+       "texture 3, which does not"},
+  };
+  for (const auto& [body, phrase] : cases) {
+    Gltf g = basic();
+    g.materials[0] = "{\"name\":\"bad\"," + body + "}";
+    expect_error(g, "material 'bad'");
+    expect_error(g, phrase);
+  }
 }
 
 TEST_F(LoaderTest, HierarchyComposesTrsAndMatrix) {
@@ -756,7 +786,7 @@ TEST_F(LoaderTest, IorBelowOne) {
   g.materials[0] =
       "{\"name\":\"odd\",\"extensions\":{\"KHR_materials_transmission\":{\"transmissionFactor\":1},"
       "\"KHR_materials_ior\":{\"ior\":0.9}}}";
-  expect_error(g, "material 'odd': ior 0.9 must be finite and >= 1");
+  expect_error(g, "material 'odd': ior 0.9 must be 0 or finite and >= 1");
 }
 
 TEST_F(LoaderTest, BaseColorAboveOne) {

@@ -260,12 +260,13 @@ def gltf_reading(tmp):
         check(near(prim.normals, [(0, 0, 1)] * 3), f"{name}: world normals {prim.normals}")
         m = prim.material
         check(m.base_color == (0.5, 0.25, 0.125) and m.metallic == 0 and m.roughness == 1 and
-              m.emission == (2, 4, 6) and m.model == "lambertian",
+              m.emission == (2, 4, 6) and m.model == "glossy",
               f"{name}: material 0 read as {vars(m)}")
         d, g = s.materials[1], s.materials[2]
-        check(d.base_color == (1, 1, 1) and d.metallic == 1 and d.model == "mirror" and
-              d.emission == (0, 0, 0), f"{name}: material 1 (all defaults) read as {vars(d)}")
-        check(g.model == "dielectric" and g.ior == 1.3, f"{name}: material 2 read as {vars(g)}")
+        check(d.base_color == (1, 1, 1) and d.metallic == 1 and d.roughness == 1 and
+              d.model == "glossy" and d.emission == (0, 0, 0),
+              f"{name}: material 1 (all defaults) read as {vars(d)}")
+        check(g.model == "thin" and g.ior == 1.3, f"{name}: material 2 read as {vars(g)}")
         (cam,) = s.cameras
         check(near(cam.position, (0, 0, 5)) and near(cam.forward, (-1, 0, 0)) and
               near(cam.up, (0, 1, 0)) and near(cam.right, (0, 0, -1)) and cam.yfov == 0.5 and

@@ -43,6 +43,8 @@ EXT_LIGHTS = "KHR_lights_punctual"
 EXT_TRANSMISSION = "KHR_materials_transmission"
 EXT_IOR = "KHR_materials_ior"
 EXT_STRENGTH = "KHR_materials_emissive_strength"
+EXT_SPECULAR = "KHR_materials_specular"
+EXT_VOLUME = "KHR_materials_volume"
 
 # componentType -> (struct format, bytes, name, divisor of a normalized integer)
 COMPONENTS = {
@@ -333,8 +335,11 @@ class Material:
     """A material with the glTF defaults: base_color (RGB of baseColorFactor, default 1), alpha,
     metallic and roughness (default 1 each), emission = emissiveFactor (default 0) x
     KHR_materials_emissive_strength (default 1), transmission (KHR_materials_transmission,
-    default 0) and ior (KHR_materials_ior, default 1.5). .model is the renderer's reading of it
-    (README "Scenes"): "dielectric", "mirror" or "lambertian"."""
+    default 0), ior (KHR_materials_ior, default 1.5), specular (KHR_materials_specular
+    specularFactor, default 1) and thin (no KHR_materials_volume with a thicknessFactor above 0).
+    .model is the renderer's reading of it (README "Materials"): "lambertian" (metallic 0, no
+    transmission, specular 0), "dielectric" (transmission bounding a volume), "thin"
+    (transmission without a volume) or "glossy" (glTF's metallic-roughness BRDF)."""
 
     def __init__(self, index, json_):
         self.index, self.json = index, json_
@@ -351,12 +356,16 @@ class Material:
         self.emission = tuple(c * self.emissive_strength for c in self.emissive_factor)
         self.transmission = float(ext.get(EXT_TRANSMISSION, {}).get("transmissionFactor", 0.0))
         self.ior = float(ext.get(EXT_IOR, {}).get("ior", 1.5))
+        self.specular = float(ext.get(EXT_SPECULAR, {}).get("specularFactor", 1.0))
+        self.thin = not float(ext.get(EXT_VOLUME, {}).get("thicknessFactor", 0.0)) > 0.0
 
     @property
     def model(self):
         if self.transmission > 0.0:
-            return "dielectric"
-        return "mirror" if self.metallic >= 0.5 else "lambertian"
+            return "thin" if self.thin else "dielectric"
+        if self.metallic == 0.0 and self.specular == 0.0:
+            return "lambertian"
+        return "glossy"
 
 
 class Primitive:

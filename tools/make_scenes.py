@@ -5,13 +5,16 @@ Standard library only, deterministic (identical bytes on every run). After writi
 file is read back with tools/gltf_scene.py (the tools' one glTF reader, also standard library
 only) and validated (JSON / GLB container, accessors, min/max, index ranges, winding against
 normals, closed glass meshes, extensions), and one summary line per scene is printed.
-Conventions: y up, metres, counter-clockwise winding = front face.
+Conventions: y up, metres, counter-clockwise winding = front face. Diffuse surfaces are pure
+Lambertian: metallicFactor 0 and KHR_materials_specular specularFactor 0 (glTF's way to say "no
+specular layer"), which the analytic answers below assume and validate() checks.
 
 Scenes (analytic answers are radiances in the renderer's units):
 
   cornell.gltf       Default scene. 2 m Cornell box (x,z in [-1,1], y in [0,2]) open
                      towards +z, white/red/green walls, 0.3 m ceiling light (radiance 40),
-                     glass sphere (ior 1.5) throwing a caustic on the floor, mirror sphere.
+                     glass sphere (ior 1.5, KHR_materials_volume) throwing a caustic on the
+                     floor, mirror sphere (a smooth metal).
                      No analytic answer; the visual reference.
   plane_point.gltf   Grey Lambertian plane (rho 0.5, 20 x 20 m at y=0, facing +y), point
                      light I = 10 at (0,1,0), camera 3 m above looking down (yfov 0.6).
@@ -61,8 +64,9 @@ from pathlib import Path
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import gltf_scene  # noqa: E402  (the tools' one glTF reader; standard library only)
-from gltf_scene import (EXT_IOR, EXT_LIGHTS, EXT_STRENGTH, EXT_TRANSMISSION, FLOAT,  # noqa: E402
-                        GLB_BIN, GLB_JSON, GLB_MAGIC, TRIANGLES)
+from gltf_scene import (EXT_IOR, EXT_LIGHTS, EXT_SPECULAR, EXT_STRENGTH,  # noqa: E402
+                        EXT_TRANSMISSION, EXT_VOLUME, FLOAT, GLB_BIN, GLB_JSON, GLB_MAGIC,
+                        TRIANGLES)
 from gltf_scene import UNSIGNED_INT as UINT  # noqa: E402
 
 ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
@@ -306,11 +310,15 @@ class GltfBuilder:
 
     # -- materials
     def material(self, name, base_color, metallic=0.0, roughness=1.0, emission=None,
-                 strength=1.0, transmission=None, ior=None):
+                 strength=1.0, transmission=None, ior=None, specular=None, thickness=None):
         m = {"name": name, "pbrMetallicRoughness": {
             "baseColorFactor": list(base_color) + [1.0],
             "metallicFactor": metallic, "roughnessFactor": roughness}}
         ext = {}
+        if specular is not None:
+            ext[EXT_SPECULAR] = {"specularFactor": specular}
+        if thickness is not None:
+            ext[EXT_VOLUME] = {"thicknessFactor": thickness}
         if emission is not None:
             m["emissiveFactor"] = list(emission)
             if strength != 1.0:
@@ -326,16 +334,21 @@ class GltfBuilder:
         return len(self.materials) - 1
 
     def lambertian(self, name, reflectance, radiance=None):
-        """Diffuse; radiance (a number) makes it a white one-sided area light as well."""
+        """Diffuse (metallic 0, KHR_materials_specular specularFactor 0: glTF's way to say "no
+        specular layer"); radiance (a number) makes it a white one-sided area light as well."""
         if radiance is None:
-            return self.material(name, reflectance)
-        return self.material(name, reflectance, emission=(1.0, 1.0, 1.0), strength=radiance)
+            return self.material(name, reflectance, specular=0.0)
+        return self.material(name, reflectance, emission=(1.0, 1.0, 1.0), strength=radiance,
+                             specular=0.0)
 
     def mirror(self, name, tint):
         return self.material(name, tint, metallic=1.0, roughness=0.0)
 
-    def glass(self, name, ior=1.5):
-        return self.material(name, (1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=ior)
+    def glass(self, name, ior=1.5, thickness=1.0):
+        """Smooth glass bounding a volume (KHR_materials_volume: a thicknessFactor above 0; the
+        renderer traces the real thickness)."""
+        return self.material(name, (1.0, 1.0, 1.0), roughness=0.0, transmission=1.0, ior=ior,
+                             thickness=thickness)
 
     # -- meshes, cameras, lights, nodes
     def mesh(self, name, parts):
@@ -442,7 +455,7 @@ def build_cornell():
     red = b.lambertian("red", (0.63, 0.065, 0.05))
     green = b.lambertian("green", (0.14, 0.45, 0.09))
     lamp = b.lambertian("light", (0.0, 0.0, 0.0), radiance=40.0)
-    glass = b.glass("glass", 1.5)
+    glass = b.glass("glass", 1.5, thickness=0.7)
     mirror = b.mirror("mirror", (0.95, 0.95, 0.95))
 
     walls = box_faces((-1.0, 0.0, -1.0), (1.0, 2.0, 1.0), inward=True)  # +z left open
@@ -464,7 +477,7 @@ def build_cornell_heavy():
     red = b.lambertian("red", (0.63, 0.065, 0.05))
     green = b.lambertian("green", (0.14, 0.45, 0.09))
     lamp = b.lambertian("light", (0.0, 0.0, 0.0), radiance=40.0)
-    glass = b.glass("glass", 1.5)
+    glass = b.glass("glass", 1.5, thickness=0.7)
     clay = b.lambertian("clay", (0.7, 0.6, 0.5))
 
     walls = box_faces((-1.0, 0.0, -1.0), (1.0, 2.0, 1.0), inward=True)
@@ -535,7 +548,7 @@ def build_spot():
 def build_glass_slab():
     b = GltfBuilder()
     floor = b.lambertian("floor", (0.8, 0.8, 0.8))
-    glass = b.glass("glass", 1.5)
+    glass = b.glass("glass", 1.5, thickness=0.2)
     lamp = b.lambertian("light", (0.0, 0.0, 0.0), radiance=50.0)
     b.mesh_node("floor", [(horizontal_quad((0.0, 0.0, 0.0), 2.0, 2.0), floor)])
     b.mesh_node("slab", [(box((-0.5, 0.8, -0.5), (0.5, 1.0, 0.5)), glass)])
@@ -648,7 +661,17 @@ def same_content(a, b):
         for x, y in zip(a["cameras"], b["cameras"]))
 
 
+def check_lambertian(s, names=None):
+    """The analytic answers (and the PPM golden checksums) need pure Lambertian surfaces: glTF
+    says so with metallic 0 and KHR_materials_specular specularFactor 0."""
+    for mat, _ in s["prims"]:
+        if (names is None and mat.model != "dielectric") or (names and mat.name in names):
+            check(mat.model == "lambertian", f"material {mat.name} must be Lambertian "
+                  "(metallicFactor 0, KHR_materials_specular specularFactor 0)")
+
+
 def check_cornell(s):
+    check_lambertian(s, ("white", "red", "green", "light"))
     for mat, tris in s["prims"]:
         if mat.name in ("white", "red", "green"):
             check(all(dot(tri_normal(t), sub((0, 1, 0), t[0])) > 0 for t in tris),
@@ -658,12 +681,14 @@ def check_cornell(s):
 
 
 def check_faces_up(s):
+    check_lambertian(s)
     for mat, tris in s["prims"]:
         if mat.model != "dielectric" and not any(mat.emission):
             check(all(near(tri_normal(t), (0, 1, 0)) for t in tris), "floor must face +y")
 
 
 def check_closed_box(s):
+    check_lambertian(s)
     check(abs(closed_volume(s["prims"][0][1]) + 8.0) < 1e-6, "box must be closed, inward")
 
 

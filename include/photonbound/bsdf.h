@@ -1,9 +1,10 @@
-// The three reflection models (scene.h Reflection): the Bsdf every stage asks, and the pure
-// functions it is made of, of directions in world space. Directions point away from the
+// glTF's material at a surface point (README "Materials"): the Bsdf every stage asks, and the
+// pure functions it is made of, of directions in world space. Directions point away from the
 // surface; n is the side the incoming direction is on.
 #pragma once
 
 #include "photonbound/math.h"
+#include "photonbound/microfacet.h"
 #include "photonbound/rng.h"
 #include "photonbound/scene.h"
 
@@ -55,40 +56,87 @@ struct BsdfSample {
   bool delta = false;
 };
 
+// The material's parameters at one surface point: the factors times the textures there.
+struct BsdfParams {
+  vec3 base_color{1.0f};
+  float metallic = 1.0f, roughness = 1.0f, ior = 1.5f;
+  float specular = 1.0f;
+  vec3 specular_color{1.0f};
+  float transmission = 0.0f;
+  bool thin = true;
+  static BsdfParams of(const Material& m);  // the factors alone (no textures)
+};
+
 // A material's scattering at one surface point, as World::surface() makes it: the one thing
 // the eye pass, the photon pass, next-event estimation and the gather ask about a surface.
 // Directions point away from the surface; either side may be hit (the normals are flipped to
 // the side of wo where that matters).
+//
+// glTF's material (appendix B with KHR_materials_specular and KHR_materials_transmission) is
+// linear in its parts, so it is kept as three weighted parts: metal m, opaque dielectric
+// (1 - m)(1 - t) and transmitting dielectric (1 - m) t. The first two are MetalRoughBrdf (GGX
+// and Lambertian, glossy); below the mirror roughness their GGX lobe becomes a perfect mirror
+// (a delta branch) and the opaque part keeps its diffuse base (1 - max F(v.h)) base / pi. The
+// transmitting part is always smooth: reflection and refraction (KHR_materials_volume) or
+// straight transmission (thin-walled), both delta branches. eval() and pdf() are the non-delta
+// parts; delta_branches() the delta ones.
 class Bsdf {
  public:
   Bsdf() = default;
-  Bsdf(const Material& material, const vec3& ng, const vec3& ns);
+  Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns,
+       float mirror_roughness = float(kDefaultMirrorRoughness));
+  Bsdf(const Material& m, const vec3& ng, const vec3& ns,
+       float mirror_roughness = float(kDefaultMirrorRoughness))
+      : Bsdf(BsdfParams::of(m), ng, ns, mirror_roughness) {}
 
-  // Mirrors and smooth dielectrics scatter into isolated directions: no eval, only branches.
-  bool is_delta() const { return model_ != Reflection::Lambertian; }
-  // The Lambertian fast path: f is the constant diffuse_f() for every pair of directions on the
-  // same side, so a gather may sum photon powers first and multiply once (bit for bit what
-  // PPM did before this interface).
-  bool is_lambertian() const { return model_ == Reflection::Lambertian; }
-  vec3 diffuse_f() const { return lambertian(color_); }
+  // Only delta branches (smooth metal, smooth glass): no eval, no visible point.
+  bool is_delta() const { return kind_ == Kind::Delta; }
+  // Delta branches beside a non-delta part (a smooth dielectric coat over its diffuse base).
+  bool has_delta() const { return kind_ == Kind::Delta || has_delta_; }
+  // The Lambertian fast path (metallic 0, no transmission, specular 0): f is the constant
+  // diffuse_f() for every pair of directions on the same side, so a gather may sum photon powers
+  // first and multiply once (bit for bit what PPM did before this interface).
+  bool is_lambertian() const { return kind_ == Kind::Lambertian; }
+  vec3 diffuse_f() const { return lambertian(brdf_.base_color); }
 
-  // f(wo, wi) without the cosine; 0 for delta lobes and for wi on the other side of ng.
+  // f(wo, wi) of the non-delta part, without the cosine; 0 for wi on the other side of ng.
   vec3 eval(const vec3& wo, const vec3& wi) const;
-  // Solid-angle pdf of sample(); 0 for delta lobes.
+  // Solid-angle pdf of sample()'s non-delta draws (times the probability of drawing that part).
   float pdf(const vec3& wo, const vec3& wi) const;
-  // Draws wi (random numbers from rng, as many as the lobe needs); false when the sample is
-  // absorbed (below the true surface) or carries nothing. Delta lobes choose one branch in
-  // proportion to its average throughput.
+  // Draws wi (random numbers from rng, as many as the lobes need, in a fixed order); false when
+  // the sample is absorbed (below the true surface) or carries nothing. With both parts the
+  // delta part is drawn with delta_probability(wo); delta branches are chosen in proportion to
+  // their average throughput.
   bool sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const;
-  // The deterministic branches of a mirror (one) or a smooth dielectric (reflection and, unless
-  // totally internally reflected, refraction). Dielectrics are closed meshes in vacuum: the side
-  // of ng tells whether the path enters (eta = ior) or leaves (eta = 1/ior). Returns the count.
+  // Probability that sample() takes the delta part: 0 without one, 1 without a non-delta part,
+  // otherwise in proportion to estimates of the two parts' albedos (photon weights: the same
+  // for either transport direction).
+  float delta_probability(const vec3& wo) const;
+  // One delta branch, chosen in proportion to the branches' average weights (weight divided by
+  // that probability); draws one number when there are two branches.
+  bool sample_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const;
+  // The deterministic delta branches: the mirror reflection (smooth lobes and the transmitting
+  // part's Fresnel reflection) and the transmission, refracted (KHR_materials_volume; closed
+  // meshes in vacuum: the side of ng tells whether the path enters, eta = ior, or leaves,
+  // eta = 1/ior) or straight through (thin-walled). Returns the count (0, 1 or 2).
   int delta_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) const;
 
  private:
-  Reflection model_ = Reflection::Lambertian;
-  vec3 color_{0.0f};  // reflectance (Lambertian, Mirror) or transmission tint (Dielectric)
-  float ior_ = 1.5f;
+  enum class Kind : uint8_t { Lambertian, Layered, Delta };
+  // eval and pdf of the non-delta part in the shading frame of wo's side (both above it).
+  vec3 eval_local(const vec3& wo, const vec3& wi, float* pdf) const;
+  float non_delta_albedo(float cos_o) const;
+  bool sample_non_delta(const vec3& wo, Rng& rng, BsdfSample& out) const;
+
+  Kind kind_ = Kind::Lambertian;
+  bool smooth_ = false;     // GGX lobes below the mirror roughness: delta branches
+  bool has_delta_ = false;  // Layered with a delta part too
+  bool thin_ = true;
+  // The reflecting parts as one MetalRoughBrdf whose metallic is m / (m + o), scaled by
+  // reflect_ = m + o; the Lambertian kind keeps its reflectance in brdf_.base_color.
+  MetalRoughBrdf brdf_;
+  float reflect_ = 0.0f;
+  float glass_ = 0.0f;  // (1 - m) t
   vec3 ng_{0.0f}, ns_{0.0f};
 };
 

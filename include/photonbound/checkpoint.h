@@ -26,8 +26,9 @@ class StateError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-// 2: PointState without direct_sum (160 B); 3: options as key/value text from the option table.
-inline constexpr uint32_t kStateVersion = 3;
+// 2: PointState without direct_sum (160 B); 3: options as key/value text from the option table;
+// 4: glTF's metallic-roughness materials (a version 3 state was rendered with other ones).
+inline constexpr uint32_t kStateVersion = 4;
 
 struct SavedRender {
   RenderOptions options;    // as rendered (scene path, everything that shapes the image)

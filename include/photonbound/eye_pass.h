@@ -1,5 +1,6 @@
 // Camera pass: one ray through each pixel centre, split deterministically at mirrors and
-// dielectrics (ESTIMATOR.md section 5), ending in measurement points on Lambertian surfaces.
+// dielectrics (ESTIMATOR.md section 5), ending in measurement points on non-delta surfaces (a
+// smooth coat over a diffuse base gives both: a point and the coat's mirror branch).
 #pragma once
 
 #include "photonbound/camera.h"
@@ -18,13 +19,26 @@ struct MeasurementPoint {
   // f = rho / pi. Folding W_k into the point's estimate makes every per-point quantity (X_j, B,
   // S^2) already weighted, so a pixel is the plain sum of its points (ESTIMATOR.md section 5
   // with W_k moved inside), and the point needs one colour instead of two.
+  // On a non-Lambertian surface f is W_k alone, and the point's GlossyPoint holds the rest.
   vec3 f{0.0f};
 };
 static_assert(sizeof(MeasurementPoint) == 48, "the per-point memory budget counts on 48 bytes");
 
+// What a measurement point on a non-Lambertian surface needs beside its MeasurementPoint: the
+// direction toward the camera and the Bsdf, so that the gather evaluates f(wo, wi) per photon
+// and next-event estimation per light sample. Lambertian points (the common case) need none:
+// PPM keeps these in a side table sorted by point index (EyePassResult::glossy), so only
+// glossy points pay for them; SPPM in a per-block scratch array.
+struct GlossyPoint {
+  uint32_t point = 0;  // index of the MeasurementPoint it belongs to (see where it is kept)
+  vec3 wo{0.0f};       // unit, toward the camera
+  Bsdf bsdf;
+};
+
 struct EyePassResult {
   int width = 0, height = 0;
   std::vector<MeasurementPoint> points;  // grouped by pixel, in pixel order
+  std::vector<GlossyPoint> glossy;       // the non-Lambertian points', sorted by point index
   std::vector<uint32_t> pixel_begin;     // points of pixel p: [pixel_begin[p], pixel_begin[p+1])
   std::vector<dvec3> emission;           // Le seen along exact specular chains, per pixel
   // Median over the points of the pixel footprint at the point (camera path length x pixel

@@ -1,5 +1,8 @@
-// EXR reading and writing. The only file that includes OpenImageIO is src/image_io.cpp.
+// EXR reading and writing, and decoding the images of glTF textures. The only file that
+// includes OpenImageIO is src/image_io.cpp.
 #pragma once
+
+#include "photonbound/scene.h"
 
 #include <stdexcept>
 #include <string>
@@ -37,5 +40,12 @@ ExrImage read_exr(const std::string& path);
 // Writes an 8-bit RGB PNG (rgb: 3 bytes per pixel, row-major), atomically like write_exr.
 void write_png(const std::string& path, int width, int height,
                const std::vector<unsigned char>& rgb);
+
+// Decodes an image file held in memory (PNG, JPEG and whatever else OpenImageIO reads; the
+// format is recognised from the bytes, else from `name`'s extension) into texels as stored:
+// 8-bit images as 8-bit values, others as floats in [0, 1], colour not premultiplied by alpha
+// (glTF's images are unassociated). At most 4 channels are kept. Throws ImageError naming
+// `name` when the bytes are not an image it can read, or the image is beyond 2^28 texels.
+Image decode_image(const unsigned char* data, size_t size, const std::string& name);
 
 }  // namespace pb

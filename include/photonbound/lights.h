@@ -5,6 +5,7 @@
 #include "photonbound/rng.h"
 #include "photonbound/scene.h"
 
+#include <span>
 #include <vector>
 
 namespace pb {
@@ -29,7 +30,8 @@ bool sample_spherical_triangle(const vec3& v0, const vec3& v1, const vec3& v2, c
                                float u0, float u1, vec3& dir, float& solid_angle);
 
 // The power formulas the light sampler and the loader's range check share (W per channel).
-// A one-sided Lambertian emitter of radiance Le and area A emits pi A Le.
+// A one-sided Lambertian emitter of radiance Le and area A emits pi A Le; a double-sided one
+// twice that.
 template <class S, class V>
 V lambertian_emitter_power(S area, const V& radiance) {
   return S(kPiD) * area * radiance;
@@ -51,12 +53,30 @@ class Lights {
   bool sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) const;
 
  private:
+  // An emissive triangle, or a piece of a textured one: a textured emitter is cut into n^2
+  // pieces (n from the texels it covers) so that choosing pieces by their power follows the
+  // texture; the radiance at a sampled point is then looked up (radiance_at).
   struct Triangle {
     vec3 p0, e1, e2;
     vec3 normal;  // front side, from the winding
     float area;
-    vec3 radiance;
+    vec3 radiance;           // emitted radiance; textured: its mean over the piece
+    float select = 0.0f;     // radiance the choice weights use: average(radiance), or for a
+                             // textured piece at least a tenth of its brightest texel
+    bool two_sided = false;  // doubleSided: emits from both sides
+    int32_t source = -1;     // textured: index into sources_
   };
+  // Where a textured piece lies in its mesh triangle: the triangle's barycentrics (b1, b2) of
+  // the piece's vertex 0 and the steps along its two edges.
+  struct Source {
+    const Mesh* mesh;
+    const Material* material;
+    uint32_t tri;
+    vec2 b0, d1, d2;
+  };
+  void add_textured(const Mesh& mesh, const Material& mat, uint32_t tri, const Triangle& whole);
+  // The radiance at barycentrics (c1, c2) of piece t (of its vertices 1 and 2).
+  vec3 radiance_at(const Triangle& t, float c1, float c2) const;
   // Emitter k < punctual_.size() is a punctual light, the rest are triangles.
   size_t pick(float u) const;
   // Next-event choice weight of emitter k at a receiver (used for small emitter sets).
@@ -66,6 +86,8 @@ class Lights {
 
   std::vector<PunctualLight> punctual_;
   std::vector<Triangle> triangles_;
+  std::vector<Source> sources_;
+  std::span<const Image> images_;
   std::vector<double> cdf_;
   std::vector<float> probability_;
   vec3 total_power_{0.0f};

@@ -23,6 +23,12 @@ namespace pb {
 // roughness >= 0.032 (alpha >= 1e-3) keeps alpha wo.z >= 1e-6 down to wo.z = 1e-3.
 inline constexpr float kMinGgxAlpha = 1e-4f;
 
+// The renderer's threshold (--mirror-roughness): GGX lobes whose roughness is below it are
+// rendered as perfect mirrors. It may not go below kMinMirrorRoughness (above); README
+// "Materials" says why the default is what it is.
+inline constexpr double kDefaultMirrorRoughness = 0.1;
+inline constexpr double kMinMirrorRoughness = 0.032;
+
 // glTF's remapping of perceptual roughness: alpha = roughness^2 (appendix B "Specular BRDF"),
 // roughness clamped to [0, 1] and alpha raised to kMinGgxAlpha.
 float ggx_alpha(float roughness);
@@ -87,6 +93,10 @@ float dielectric_f0(float ior);
 //   metal      = specular * schlick_fresnel(base_color, v.h)
 //   dielectric = mix(base_color / pi, specular, schlick_fresnel(dielectric_f0(ior), v.h))
 //   material   = mix(dielectric, metal, metallic)
+// with KHR_materials_specular's generalisation of the dielectric's Fresnel term (its README,
+// "Implementation"): F = f0 + (f90 - f0) (1 - v.h)^5, f0 = min(dielectric_f0(ior)
+// specular_color, 1) specular, f90 = specular, dielectric = F specular + (1 - max(F)) base / pi,
+// which is appendix B's dielectric when specular = 1 and specular_color = 1 (the defaults).
 // The spec says (appendix B "Coupling Diffuse and Specular Reflection") that this model is not
 // energy conserving: fresnel_mix weights the diffuse base by 1 - F(v.h) at the half vector of
 // each pair of directions, so a bright dielectric reflects more than it receives at oblique
@@ -94,10 +104,16 @@ float dielectric_f0(float ior);
 // averaged over incidence; tests/test_microfacet.cpp gives the brightest base colour that stays
 // <= 1 per roughness. The metal lobe conserves energy (single scattering loses some when rough).
 struct MetalRoughBrdf {
-  vec3 base_color{1.0f};   // linear RGB in [0, 1]: diffuse colour, and f0 of the metal
-  float metallic = 0.0f;   // [0, 1]: 0 dielectric, 1 metal
-  float roughness = 1.0f;  // [0, 1], perceptual; alpha = roughness^2
-  float ior = 1.5f;        // > 0, index of refraction of the dielectric's specular layer
+  vec3 base_color{1.0f};      // linear RGB in [0, 1]: diffuse colour, and f0 of the metal
+  float metallic = 0.0f;      // [0, 1]: 0 dielectric, 1 metal
+  float roughness = 1.0f;     // [0, 1], perceptual; alpha = roughness^2
+  float ior = 1.5f;           // > 0, index of refraction of the dielectric's specular layer
+  vec3 specular_color{1.0f};  // KHR_materials_specular specularColorFactor (>= 0)
+  float specular = 1.0f;      // KHR_materials_specular specularFactor in [0, 1]; 0: no layer
+
+  // The dielectric layer's Fresnel terms at normal and grazing incidence (above).
+  vec3 dielectric_f0() const;
+  float dielectric_f90() const { return specular; }
 
   // f(wo, wi) without the cosine. Zero unless wo.z > 0 and wi.z > 0. Reciprocal: every term is
   // symmetric in wo and wi, so eval(wo, wi) == eval(wi, wo) bit for bit (unless the compiler
@@ -120,8 +136,8 @@ struct MetalRoughBrdf {
 
   // Probability that sample() takes the specular lobe, from estimates of the two lobes'
   // albedos (Schlick's Fresnel at the macro normal for the specular, (1 - f0) max(base_color)
-  // for the diffuse):
-  //   s = (1 - metallic) F(f0, wo.z) + metallic max(F(base_color, wo.z))
+  // for the diffuse; F and f0 of the dielectric layer are their largest channel):
+  //   s = (1 - metallic) F(f0, f90, wo.z) + metallic max(F(base_color, wo.z))
   //   d = (1 - metallic) (1 - f0) max(base_color)
   //   p_spec = s / (s + d), or 1 when s + d = 0.
   // Either way the mixture density is positive wherever the BRDF is: when p_spec < 1 the

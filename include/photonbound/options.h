@@ -4,6 +4,8 @@
 // state file's options block and resume's list of differences are all made from that table.
 #pragma once
 
+#include "photonbound/microfacet.h"  // kDefaultMirrorRoughness
+
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -39,6 +41,7 @@ struct RenderOptions {
   double alpha = 0.7;
   std::optional<double> radius;  // world units; default from the pixel footprint
   int max_depth = 8;
+  double mirror_roughness = kDefaultMirrorRoughness;
   std::optional<int> width, height;
   std::string camera;  // empty = first perspective camera
   int threads = 0;

@@ -34,25 +34,45 @@ void build_photon_grid(const std::vector<PhotonHit>& hits, std::span<const float
 
 // Adds every photon within search_radius(r2) of the point that arrived on the point's side
 // (ESTIMATOR.md sections 2-3). Without the Laplacian (the bench's "error estimation off"
-// variant) phi_lap_r2 is left alone.
+// variant) phi_lap_r2 is left alone. Lambertian points: the photon powers are summed and f
+// multiplied once.
 template <bool kLaplacian = true>
 void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& grid,
                     const std::vector<PhotonHit>& hits, PassGather& out);
+// The same for a point on a non-Lambertian surface: each photon's power times f(wo, wi_photon),
+// the path weight point.f once.
+template <bool kLaplacian = true>
+void gather_photons(const MeasurementPoint& point, const GlossyPoint& glossy, double r2,
+                    const HashGrid& grid, const std::vector<PhotonHit>& hits, PassGather& out);
 
-// One light sample with a shadow ray: D_j = f Li cos / pdf (ESTIMATOR.md section 4).
-dvec3 direct_light(const World& world, const MeasurementPoint& point, Rng& rng);
+// One light sample with a shadow ray: D_j = f Li cos / pdf (ESTIMATOR.md section 4); with
+// `glossy`, f = point.f x f(wo, wi_light).
+dvec3 direct_light(const World& world, const MeasurementPoint& point, const GlossyPoint* glossy,
+                   Rng& rng);
+inline dvec3 direct_light(const World& world, const MeasurementPoint& point, Rng& rng) {
+  return direct_light(world, point, nullptr, rng);
+}
+
+// The glossy side table of a span of points: entries sorted by GlossyPoint::point, which counts
+// from the span's first point at `base` (entries outside the span are skipped).
+struct GlossyTable {
+  std::span<const GlossyPoint> entries;
+  size_t base = 0;
+};
 
 // Stage 3: adds the photons of the pass at points[k] into out[k] (phi, phi_lap_r2, count).
 // states[k].r2 is the radius of the pass. A point with f = 0 (SPPM: no visible point this
-// pass) gathers nothing and so does not shrink its radius.
+// pass) gathers nothing and so does not shrink its radius. Points in `glossy` evaluate their
+// Bsdf per photon.
 void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
-                 const HashGrid& grid, const std::vector<PhotonHit>& hits,
+                 const HashGrid& grid, const std::vector<PhotonHit>& hits, GlossyTable glossy,
                  std::span<PassGather> out);
 
 // Stage 4: adds one next-event sample at points[k] to out[k].direct, drawn from
 // Rng(seed, pass, first + k, Stream::DirectLight): point (or pixel) first + k's own stream.
-void next_event_pass(const World& world, std::span<const MeasurementPoint> points, uint64_t seed,
-                     uint64_t pass, size_t first, std::span<PassGather> out);
+void next_event_pass(const World& world, std::span<const MeasurementPoint> points,
+                     GlossyTable glossy, uint64_t seed, uint64_t pass, size_t first,
+                     std::span<PassGather> out);
 
 // Stage 5: folds sums[k] into states[k] (accumulate_pass), writes the radius the next grid is
 // built for into radii[k], and with `copy` streams each new state into copy[k] (a checkpoint's
@@ -71,18 +91,21 @@ struct PassInputs {
   const EstimatorParams& params;
   uint64_t seed = 0, pass = 0;
   bool next_event = true;
+  std::span<const GlossyPoint> glossy{};  // PPM: EyePassResult::glossy (indices into the points)
 };
 void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> points,
                      std::span<PointState> states, std::span<float> radii,
                      std::span<PassGather> sums, PointState* copy);
 
 // SPPM (ESTIMATOR.md section 10): the same with the camera stage first, per block of pixels:
-// trace_visible_points into `points` (block-sized scratch) and the sums' emission, gather,
-// next-event samples, count each pixel's passes with a visible point in `visible`, then fold.
+// trace_visible_points into `points` and `glossy` (block-sized scratch) and the sums' emission,
+// gather, next-event samples, count each pixel's passes with a visible point in `visible`, then
+// fold.
 struct CameraPathInputs;
 void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
                           std::span<PointState> states, std::span<float> radii,
                           std::span<uint32_t> visible, std::span<MeasurementPoint> points,
-                          std::span<PassGather> sums, PointState* copy);
+                          std::span<GlossyPoint> glossy, std::span<PassGather> sums,
+                          PointState* copy);
 
 }  // namespace pb

@@ -1,6 +1,7 @@
 // Photon pass: photons leave the lights in proportion to their power and are traced with
-// Russian roulette through the three reflection models; every Lambertian hit that counts
-// (after the first bounce when direct light comes from next-event estimation) is recorded.
+// Russian roulette through the materials' Bsdfs; every hit on a surface with a non-delta part
+// that counts (after the first bounce when direct light comes from next-event estimation) is
+// recorded.
 #pragma once
 
 #include "photonbound/world.h"

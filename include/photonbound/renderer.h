@@ -118,6 +118,7 @@ class Renderer {
   std::vector<PassGather> sums_;                  // one fold block's pass sums (pass_stages.h)
   std::vector<uint32_t> visible_;                 // SPPM: passes with a visible point, per pixel
   std::vector<MeasurementPoint> visible_points_;  // SPPM: one fold block's, reused
+  std::vector<GlossyPoint> visible_glossy_;       // SPPM: their Bsdfs where not Lambertian
   WorkCounters work_;
   double initial_radius_ = 0.0;
   PhaseTimings timings_;

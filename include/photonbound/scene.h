@@ -11,29 +11,105 @@
 
 namespace pb {
 
-// The three reflection models photonbound supports (README "Materials").
-enum class Reflection : uint8_t {
-  Lambertian,  // f = base_color / pi
-  Mirror,      // ideal specular reflection tinted by base_color
-  Dielectric,  // smooth glass: Fresnel reflection + refraction, transmission tinted by base_color
+// glTF's texture wrap modes (sampler wrapS / wrapT).
+enum class Wrap : uint8_t { Repeat, ClampToEdge, MirroredRepeat };
+
+// A decoded image (glTF "image"): texels row by row from the top (glTF's uv (0, 0) is the
+// image's top-left corner), `channels` per texel, as 8-bit values or as floats in [0, 1].
+struct Image {
+  std::string name;  // for messages: the uri, or "image N"
+  int width = 0, height = 0, channels = 0;
+  std::vector<uint8_t> u8;  // 8-bit images (PNG, JPEG)
+  std::vector<float> f32;   // everything else (16-bit PNG, float formats)
 };
 
+// A glTF textureInfo resolved for lookups: the image, the sampler's wrap modes and filter, the
+// texture coordinate set and KHR_texture_transform as an affine map of the coordinates:
+// (s, t) = (m[0] u + m[1] v + m[2], m[3] u + m[4] v + m[5]).
+struct TextureRef {
+  int32_t image = -1;  // index into Scene::images; -1: no texture
+  uint8_t texcoord = 0;
+  Wrap wrap_s = Wrap::Repeat, wrap_t = Wrap::Repeat;
+  bool nearest = false;  // sampler magFilter NEAREST; otherwise bilinear
+  float m[6] = {1.0f, 0.0f, 0.0f, 0.0f, 1.0f, 0.0f};
+  bool present() const { return image >= 0; }
+};
+
+enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
+
+// glTF 2.0's metallic-roughness material with the extensions photonbound reads, as the file
+// gives it (factors with glTF's defaults; each texture multiplies its factor). World::surface()
+// evaluates the textures at a hit and makes the Bsdf from the result (README "Materials").
 struct Material {
   std::string name;
-  Reflection model = Reflection::Lambertian;
-  vec3 base_color{0.8f};  // reflectance (Lambertian, Mirror) or transmission tint (Dielectric)
-  float ior = 1.5f;       // Dielectric only
-  vec3 emission{0.0f};    // emitted radiance, front side only (winding order); 0 = not a light
+  vec3 base_color{1.0f};  // baseColorFactor.rgb, linear
+  float alpha = 1.0f;     // baseColorFactor.a
+  float metallic = 1.0f, roughness = 1.0f;
+  float ior = 1.5f;           // KHR_materials_ior
+  float specular = 1.0f;      // KHR_materials_specular specularFactor
+  vec3 specular_color{1.0f};  // KHR_materials_specular specularColorFactor
+  float transmission = 0.0f;  // KHR_materials_transmission transmissionFactor
+  bool thin = true;           // no KHR_materials_volume (or thicknessFactor 0)
+  vec3 attenuation{0.0f};     // KHR_materials_volume: Beer-Lambert coefficient, 1/length
+  vec3 emission{0.0f};        // emissiveFactor x KHR_materials_emissive_strength
+  bool double_sided = false;  // doubleSided: an emitter emits from both sides
+  AlphaMode alpha_mode = AlphaMode::Opaque;
+  float alpha_cutoff = 0.5f;
+  float normal_scale = 1.0f;              // normalTexture.scale
+  TextureRef base_color_texture;          // sRGB; alpha in A
+  TextureRef metallic_roughness_texture;  // B metal, G rough (linear)
+  TextureRef normal_texture;              // tangent-space normal (linear)
+  TextureRef emissive_texture;            // sRGB
+  TextureRef transmission_texture;        // R (linear)
+  TextureRef specular_texture;            // A (linear)
+  TextureRef specular_color_texture;      // sRGB
+
+  // Emits somewhere: the factor is positive (an emissive texture may still be black in places).
   bool emits() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
+  // Rays pass through where the base colour's alpha is below the cutoff (alphaMode MASK).
+  bool masked() const { return alpha_mode == AlphaMode::Mask; }
+
+  // Plain materials for tests and defaults: a Lambertian (metallic 0 and KHR_materials_specular
+  // specularFactor 0: glTF's way to say "no specular layer"), a smooth metal, smooth glass.
+  static Material lambertian(const vec3& rho);
+  static Material metal(const vec3& base, float roughness);
+  static Material glass(float ior, bool thin = false);
 };
+
+inline Material Material::lambertian(const vec3& rho) {
+  Material m;
+  m.base_color = rho;
+  m.metallic = 0.0f;
+  m.specular = 0.0f;
+  return m;
+}
+inline Material Material::metal(const vec3& base, float roughness) {
+  Material m;
+  m.base_color = base;
+  m.roughness = roughness;
+  return m;
+}
+inline Material Material::glass(float ior, bool thin) {
+  Material m;
+  m.metallic = 0.0f;
+  m.roughness = 0.0f;
+  m.transmission = 1.0f;
+  m.ior = ior;
+  m.thin = thin;
+  return m;
+}
 
 struct Mesh {
   std::string name;             // glTF mesh name (or "mesh <index>") for messages
   std::vector<vec3> positions;  // world space
   std::vector<vec3> normals;    // world space, unit length; empty when the file has none
   // TEXCOORD_0 and TEXCOORD_1 as the file gives them (dequantised), one per position; empty
-  // when absent. Read for the texture work to come; nothing uses them yet.
+  // when absent.
   std::vector<vec2> texcoords[2];
+  // Tangent frames for the normal texture, one per position: xyz unit (world space), w = +-1 the
+  // bitangent's sign (glTF TANGENT: bitangent = cross(normal, xyz) w). The file's TANGENT, or
+  // made from the normal texture's coordinates; empty when the material has no normal texture.
+  std::vector<glm::vec4> tangents;
   std::vector<uint32_t> indices;  // three per triangle, degenerate triangles already removed
   uint32_t material = 0;          // index into Scene::materials
 };
@@ -68,11 +144,12 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<PunctualLight> lights;
   std::vector<Camera> cameras;        // every perspective camera, in node order
+  std::vector<Image> images;          // the decoded images the materials use
   Bounds bounds;                      // of all triangle vertices
   uint64_t degenerate_triangles = 0;  // skipped at load time
   std::vector<std::string> warnings;  // each once, for the user
-  // Identity of the loaded content (the file's bytes and every buffer it loads), which resume
-  // compares: an edited external .bin must not continue a render of the old one.
+  // Identity of the loaded content (the file's bytes, every buffer and image it loads), which
+  // resume compares: an edited external .bin must not continue a render of the old one.
   uint64_t content_hash = 0;
 
   size_t triangle_count() const {

@@ -6,7 +6,9 @@
 #include "photonbound/lights.h"
 #include "photonbound/scene.h"
 #include "photonbound/surface.h"
+#include "photonbound/texture.h"
 
+#include <string>
 #include <vector>
 
 namespace pb {
@@ -15,7 +17,7 @@ namespace pb {
 // point into it, so a World is neither copied nor moved.
 class World {
  public:
-  explicit World(Scene scene);
+  explicit World(Scene scene, float mirror_roughness = float(kDefaultMirrorRoughness));
   World(const World&) = delete;
   World& operator=(const World&) = delete;
 
@@ -24,29 +26,34 @@ class World {
   const Lights& lights() const { return lights_; }
   float scene_size() const { return scene_size_; }
 
-  // The hit's position, normals and material. Inline: it runs once per photon bounce.
-  Surface surface(const Hit& hit) const {
-    const MeshView& mesh = meshes_[hit.mesh];
-    const uint32_t* tri = mesh.indices + 3 * size_t(hit.prim);
-    const uint32_t i0 = tri[0], i1 = tri[1], i2 = tri[2];
-    const float w = 1.0f - hit.u - hit.v;
-    Surface s;
-    // Barycentric interpolation is more accurate than origin + t dir far from the origin.
-    s.position = w * mesh.positions[i0] + hit.u * mesh.positions[i1] + hit.v * mesh.positions[i2];
-    s.ng = mesh.face_normals[hit.prim];
-    s.ns = s.ng;
-    if (mesh.normals) {
-      const vec3 n = w * mesh.normals[i0] + hit.u * mesh.normals[i1] + hit.v * mesh.normals[i2];
-      const float len = glm::length(n);
-      if (len > 0.0f) {
-        s.ns = n / len;
-        if (glm::dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
-      }
-    }
-    s.material = mesh.material;
-    s.bsdf = Bsdf(*mesh.material, s.ng, s.ns);
-    return s;
+  // The hit's position, normals, texture coordinates and material, and the Bsdf made from the
+  // material's factors and textures there (src/surface.cpp). Runs once per photon bounce.
+  Surface surface(const Hit& hit) const;
+
+  // Radiance the surface emits toward wo: the material's emission (texture included) on its
+  // front side, or on both sides when the material is doubleSided.
+  vec3 emitted(const Surface& s, const vec3& wo) const {
+    const Material& m = *s.material;
+    if (!m.emits() || (!m.double_sided && glm::dot(wo, s.ng) <= 0.0f)) return vec3(0.0f);
+    if (!m.emissive_texture.present() && !m.masked()) return m.emission;
+    return emission_at(scene_.images, m, s.uv);
   }
+
+  // Beer-Lambert transmittance exp(-sigma t) of the segment of length t that ended at s, when it
+  // ran inside the volume s bounds (s seen from its back side, KHR_materials_volume); else 1.
+  // Volumes are bounded by their own closed mesh: a segment inside is one that reaches its
+  // inside surface.
+  vec3 transmittance(const Surface& s, const vec3& wo, float t) const {
+    const Material& m = *s.material;
+    if (m.thin || m.transmission <= 0.0f || glm::dot(wo, s.ng) >= 0.0f) return vec3(1.0f);
+    return glm::exp(-m.attenuation * t);
+  }
+
+  // The roughness below which GGX lobes are perfect mirrors (--mirror-roughness).
+  float mirror_roughness() const { return mirror_roughness_; }
+  // "materials 'a', 'b': roughness below R ... rendered as perfect mirrors", or "" when no
+  // material has a lobe that smooth (the note the command line prints).
+  std::string mirror_note() const;
 
   // Start point for a ray leaving p in direction dir: moved off the surface along ng, to dir's
   // side, by an amount that scales with the scene and with |p| (float spacing).
@@ -76,6 +83,9 @@ class World {
     const uint32_t* indices;
     const vec3* face_normals;
     const Material* material;
+    const vec2* texcoords[2];   // null when the mesh has none
+    const glm::vec4* tangents;  // null without a normal texture
+    bool textured;              // the material has a texture (or a MASK cut-out)
   };
 
   const Scene scene_;
@@ -85,6 +95,7 @@ class World {
   Lights lights_;
   float scene_size_;
   float epsilon_;
+  float mirror_roughness_;
 };
 
 }  // namespace pb

@@ -1,0 +1,88 @@
+// The light sampler's textured emitters (lights.h): an emissive triangle whose radiance follows
+// an emissive texture (or a MASK cut-out) is cut into pieces chosen by their power, and the
+// radiance of a sampled point is looked up, so emission and next-event estimation stay
+// unbiased while their choice follows the texture.
+#include "photonbound/lights.h"
+
+#include "photonbound/texture.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pb {
+
+namespace {
+
+// Pieces per side: about two texels per piece, at most 32 x 32 pieces per triangle.
+constexpr int kMaxSplit = 32;
+
+}  // namespace
+
+vec3 Lights::radiance_at(const Triangle& t, float c1, float c2) const {
+  const Source& src = sources_[size_t(t.source)];
+  const vec2 b = src.b0 + c1 * src.d1 + c2 * src.d2;  // barycentrics in the mesh triangle
+  const vec2 uv[2] = {mesh_uv(*src.mesh, src.tri, 0, b.x, b.y),
+                      mesh_uv(*src.mesh, src.tri, 1, b.x, b.y)};
+  return emission_at(images_, *src.material, uv);
+}
+
+void Lights::add_textured(const Mesh& mesh, const Material& mat, uint32_t tri,
+                          const Triangle& whole) {
+  const TextureRef& ref =
+      mat.emissive_texture.present() ? mat.emissive_texture : mat.base_color_texture;  // alpha
+  const bool coloured = mat.emissive_texture.present();
+  auto st_at = [&](vec2 b) {
+    const vec2 uv[2] = {mesh_uv(mesh, tri, 0, b.x, b.y), mesh_uv(mesh, tri, 1, b.x, b.y)};
+    return texture_coords(ref, uv);
+  };
+  int n = 1;
+  if (ref.present()) {
+    const Image& im = images_[size_t(ref.image)];
+    const vec2 s0 = st_at(vec2(0.0f)), s1 = st_at(vec2(1.0f, 0.0f)), s2 = st_at(vec2(0.0f, 1.0f));
+    const vec2 a = s1 - s0, c = s2 - s0;
+    const double texels = 0.5 * std::fabs(double(a.x) * c.y - double(a.y) * c.x) *
+                          double(im.width) * double(im.height);
+    if (std::isfinite(texels))
+      n = int(std::clamp(std::ceil(std::sqrt(texels / 2.0)), 1.0, double(kMaxSplit)));
+  }
+  const float step = 1.0f / float(n);
+  // Piece with vertex 0 at barycentrics b0 and edges d1, d2 (as oriented as the triangle).
+  auto piece = [&](vec2 b0, vec2 d1, vec2 d2) {
+    Triangle t = whole;
+    t.p0 = whole.p0 + b0.x * whole.e1 + b0.y * whole.e2;
+    t.e1 = d1.x * whole.e1 + d1.y * whole.e2;
+    t.e2 = d2.x * whole.e1 + d2.y * whole.e2;
+    t.area = whole.area / float(n * n);
+    t.source = int32_t(sources_.size());
+    sources_.push_back({&mesh, &mat, tri, b0, d1, d2});
+    // Mean radiance: the midpoint rule on the piece's four halves (centroids below).
+    const vec2 mid[4] = {
+        {1 / 6.0f, 1 / 6.0f}, {2 / 3.0f, 1 / 6.0f}, {1 / 6.0f, 2 / 3.0f}, {1 / 3.0f, 1 / 3.0f}};
+    vec3 mean(0.0f);
+    for (const vec2& m : mid) mean += 0.25f * radiance_at(t, m.x, m.y);
+    // A bound that is positive wherever the piece may emit: its brightest texel (filters
+    // included), or the factor when the texture only cuts out.
+    float bound = max_component(mat.emission);
+    if (coloured) {
+      const vec2 p[3] = {st_at(b0), st_at(b0 + d1), st_at(b0 + d2)};
+      const vec2 lo = glm::min(p[0], glm::min(p[1], p[2]));
+      const vec2 hi = glm::max(p[0], glm::max(p[1], p[2]));
+      bound *= max_texel(images_[size_t(ref.image)], ref, lo, hi, true);
+    }
+    t.radiance = mean;
+    t.select = std::max(average(mean), 0.1f * bound);
+    if (t.select > 0.0f) {
+      triangles_.push_back(t);
+    } else {
+      sources_.pop_back();  // never emits: no piece
+    }
+  };
+  for (int a = 0; a < n; ++a)
+    for (int b = 0; a + b < n; ++b) {
+      piece(vec2(float(a), float(b)) * step, vec2(step, 0.0f), vec2(0.0f, step));
+      if (a + b + 1 < n)  // the inverted piece of the same lattice cell
+        piece(vec2(float(a + 1), float(b + 1)) * step, vec2(-step, 0.0f), vec2(0.0f, -step));
+    }
+}
+
+}  // namespace pb

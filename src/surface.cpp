@@ -1,0 +1,110 @@
+// World::surface(): a hit's geometry, texture coordinates and Bsdf (glTF's factors times its
+// textures, and the normal texture), and the note about lobes rendered as mirrors.
+#include "photonbound/world.h"
+
+#include <algorithm>
+#include <cstdio>
+
+namespace pb {
+
+namespace {
+
+// The tangent-space normal of a normal texture (glTF 2.0 "normalTexture": RGB in [0, 1] maps to
+// [-1, 1], X and Y scaled by normal_scale) in the frame (tangent, bitangent, ns); ns when the
+// frame or the result is degenerate or the result falls below the true surface.
+vec3 mapped_normal(const vec3& ns, const vec3& ng, const glm::vec4& tangent, const vec3& tex,
+                   float scale) {
+  vec3 t = vec3(tangent) - glm::dot(vec3(tangent), ns) * ns;  // Gram-Schmidt against ns
+  const float len = glm::length(t);
+  if (!(len > 1e-6f)) return ns;
+  t /= len;
+  const vec3 b = glm::cross(ns, t) * (tangent.w < 0.0f ? -1.0f : 1.0f);
+  const vec3 c = 2.0f * tex - 1.0f;
+  const vec3 n = (c.x * scale) * t + (c.y * scale) * b + c.z * ns;
+  const float nl = glm::length(n);
+  if (!(nl > 0.0f)) return ns;
+  const vec3 unit = n / nl;
+  return glm::dot(unit, ng) > 1e-3f ? unit : ns;
+}
+
+}  // namespace
+
+Surface World::surface(const Hit& hit) const {
+  const MeshView& mesh = meshes_[hit.mesh];
+  const uint32_t* tri = mesh.indices + 3 * size_t(hit.prim);
+  const uint32_t i0 = tri[0], i1 = tri[1], i2 = tri[2];
+  const float w = 1.0f - hit.u - hit.v;
+  Surface s;
+  // Barycentric interpolation is more accurate than origin + t dir far from the origin.
+  s.position = w * mesh.positions[i0] + hit.u * mesh.positions[i1] + hit.v * mesh.positions[i2];
+  s.ng = mesh.face_normals[hit.prim];
+  s.ns = s.ng;
+  if (mesh.normals) {
+    const vec3 n = w * mesh.normals[i0] + hit.u * mesh.normals[i1] + hit.v * mesh.normals[i2];
+    const float len = glm::length(n);
+    if (len > 0.0f) {
+      s.ns = n / len;
+      if (glm::dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
+    }
+  }
+  const Material& m = *mesh.material;
+  s.material = &m;
+  if (!mesh.textured) {
+    s.bsdf = Bsdf(m, s.ng, s.ns, mirror_roughness_);
+    return s;
+  }
+  for (int set = 0; set < 2; ++set) {
+    const vec2* uv = mesh.texcoords[set];
+    if (uv) s.uv[set] = w * uv[i0] + hit.u * uv[i1] + hit.v * uv[i2];
+  }
+  // glTF 2.0 "Metallic-Roughness Material": each texture multiplies its factor; colour textures
+  // are sRGB, the others linear; metalness in B, roughness in G.
+  const std::span<const Image> images = scene_.images;
+  BsdfParams p = BsdfParams::of(m);
+  p.base_color *= vec3(lookup(images, m.base_color_texture, s.uv, true));
+  const glm::vec4 mr = lookup(images, m.metallic_roughness_texture, s.uv, false);
+  p.metallic *= mr.z;   // B: metalness
+  p.roughness *= mr.y;  // G: roughness
+  p.transmission *= lookup(images, m.transmission_texture, s.uv, false).x;
+  p.specular *= lookup(images, m.specular_texture, s.uv, false).w;
+  p.specular_color *= vec3(lookup(images, m.specular_color_texture, s.uv, true));
+  if (mesh.tangents && m.normal_texture.present()) {
+    const glm::vec4 t =
+        w * mesh.tangents[i0] + hit.u * mesh.tangents[i1] + hit.v * mesh.tangents[i2];
+    const vec3 tex = vec3(lookup(images, m.normal_texture, s.uv, false));
+    s.ns = mapped_normal(s.ns, s.ng, t, tex, m.normal_scale);
+  }
+  s.bsdf = Bsdf(p, s.ng, s.ns, mirror_roughness_);
+  return s;
+}
+
+std::string World::mirror_note() const {
+  std::string names;
+  size_t count = 0;
+  for (const Material& m : scene_.materials) {
+    float lowest = m.roughness;
+    if (m.metallic_roughness_texture.present()) {
+      // The smallest roughness the texture holds (G channel).
+      const Image& im = scene_.images[size_t(m.metallic_roughness_texture.image)];
+      float g = 1.0f;
+      for (int y = 0; y < im.height; ++y)
+        for (int x = 0; x < im.width; ++x) g = std::min(g, texel(im, x, y, false).y);
+      lowest *= g;
+    }
+    // A GGX lobe that reflects: the metal, or the specular layer of the opaque dielectric
+    // (glass transmits through smooth branches at any roughness; Lambertians have no layer).
+    const bool textured = m.metallic_roughness_texture.present() ||
+                          m.transmission_texture.present() || m.specular_texture.present();
+    const bool lobe = m.metallic > 0.0f || (m.specular > 0.0f && m.transmission < 1.0f) || textured;
+    if (!lobe || !(lowest < mirror_roughness_)) continue;
+    if (++count <= 4) names += std::string(names.empty() ? "" : ", ") + "'" + m.name + "'";
+  }
+  if (count == 0) return "";
+  if (count > 4) names += " and " + std::to_string(count - 4) + " more";
+  char threshold[32];
+  std::snprintf(threshold, sizeof threshold, "%g", double(mirror_roughness_));
+  return std::string(count == 1 ? "material " : "materials ") + names + ": roughness below " +
+         threshold + " (--mirror-roughness) is rendered as a perfect mirror";
+}
+
+}  // namespace pb
