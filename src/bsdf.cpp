@@ -278,7 +278,7 @@ int Bsdf::delta_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) 
     const float mu = brdf_.metallic;
     const vec3 f0 = brdf_.dielectric_f0();
     const vec3 fd = f0 + (vec3(brdf_.dielectric_f90()) - f0) * schlick_weight(cos_i);
-    mirror = reflect_ * ((1.0f - mu) * fd + mu * brdf_.base_color);
+    mirror = reflect_ * ((1.0f - mu) * fd + mu * schlick_fresnel(brdf_.base_color, cos_i));
   }
   if (glass_ <= 0.0f) {
     if (!(max_component(mirror) > 0.0f)) return 0;

@@ -410,7 +410,9 @@ void expect_mirror_image(const vec3& wo, const vec3& r, const vec3& n, const cha
   EXPECT_NEAR(glm::length(r), 1.0f, 1e-5f) << what;
 }
 
-TEST(SpecularBranches, MirrorReflectsWithBaseColor) {
+TEST(SpecularBranches, MirrorReflectsWithSchlicksFresnelOfBaseColor) {
+  // glTF appendix B's metal at h = n: F = base + (1 - base) (1 - cos)^5, base colour at normal
+  // incidence, white at grazing. Float: 1e-6.
   const Material m = make_material(Model::Mirror, vec3(0.9f, 0.6f, 0.3f));
   const vec3 n(0, 0, 1);
   const Surface s = make_surface(m, n, n);
@@ -418,7 +420,9 @@ TEST(SpecularBranches, MirrorReflectsWithBaseColor) {
     for (Transport mode : {Transport::Radiance, Transport::Importance}) {
       SpecularBranch br[2];
       ASSERT_EQ(s.bsdf.delta_branches(wo, mode, br), 1);
-      EXPECT_EQ(br[0].weight, m.base_color);
+      const double w5 = std::pow(1.0 - double(wo.z), 5.0);
+      for (int c = 0; c < 3; ++c)
+        EXPECT_NEAR(br[0].weight[c], m.base_color[c] + (1.0 - m.base_color[c]) * w5, 1e-6);
       expect_mirror_image(wo, br[0].dir, n, "mirror");
       EXPECT_GT(glm::dot(br[0].dir, n), 0.0f);
     }
