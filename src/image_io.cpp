@@ -97,6 +97,9 @@ Image decode_image(const unsigned char* data, size_t size, const std::string& na
   OIIO::Filesystem::IOMemReader memory(data, size);
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);  // keep colour as stored, not premultiplied
+  // With a configuration the readers take the proxy from it (ioproxy_retrieve_from_config).
+  OIIO::Filesystem::IOProxy* proxy = &memory;
+  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
   auto in = OIIO::ImageInput::open(format_name(data, size, name), &config, &memory);
   if (!in) throw ImageError(name + ": cannot decode the image: " + one_line(OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();

@@ -13,6 +13,13 @@
   tools_test.py bad-input --photonbound EXE  missing files, wrong channels, bad options and
                                              unreadable glTF end with one line on stderr and a
                                              non-zero exit
+  tools_test.py corpus --photonbound EXE     tools/make_corpus.py's Blender-style files (rough
+                                             metals, textures with transforms, emissive
+                                             textures, thin and volumetric glass, a double-sided
+                                             emitter, a cut-out) render with exit 0 under both
+                                             methods, print exactly the warnings make_corpus.py
+                                             expects, and give finite images whose mean
+                                             radiance lies in the expected range
 """
 
 import argparse
@@ -358,14 +365,47 @@ def bad_gltf(tmp, out):
               f"{what}: the message does not name the file: {p.stderr.strip()!r}")
 
 
+def corpus(exe, tmp):
+    import make_corpus  # noqa: E402  (numpy and OpenImageIO, like the other tools)
+    folder = os.path.join(tmp, "corpus")
+    p = run_tool("make_corpus.py", folder)
+    check(p.returncode == 0, f"make_corpus.py failed: {p.stderr.strip()}")
+    if p.returncode != 0:
+        return
+    for name, (warnings, (lo, hi)) in make_corpus.CORPUS.items():
+        path = os.path.join(folder, name)
+        for method in ("sppm", "ppm"):
+            out = os.path.join(tmp, f"{name}.{method}.exr")
+            r = subprocess.run([exe, "render", path, "-o", out, "--passes", "6", "--resolution",
+                                "48x48", "--photons-per-pass", "20000", "--method", method,
+                                "--quiet"], capture_output=True, text=True)
+            what = f"{name} ({method})"
+            check(r.returncode == 0, f"{what}: exit {r.returncode}: {r.stderr.strip()}")
+            if r.returncode != 0:
+                continue
+            prefix = f"photonbound: warning: {path}: "
+            got = [l[len(prefix):] for l in r.stderr.splitlines() if l.startswith(prefix)]
+            other = [l for l in r.stderr.splitlines() if not l.startswith(prefix)]
+            check(got == warnings, f"{what}: warnings {got}, expected {warnings}")
+            check(not other, f"{what}: unexpected output {other}")
+            rgb = pbtools.read_exr(out).rgb()
+            check(bool(np.all(np.isfinite(rgb)) and np.all(rgb >= 0)),
+                  f"{what}: radiance not finite and >= 0")
+            mean = float(rgb.mean())
+            centre = float(rgb[20:28, 20:28].mean())
+            print(f"{what}: mean radiance {mean:.4g}, centre {centre:.4g}")
+            check(lo <= mean <= hi, f"{what}: mean radiance {mean:.4g} outside [{lo}, {hi}]")
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("mode", choices=["smoke", "bad-input"])
+    ap.add_argument("mode", choices=["smoke", "bad-input", "corpus"])
     ap.add_argument("--photonbound", required=True)
     args = ap.parse_args()
     tmp = tempfile.mkdtemp(prefix=f"pb_tools_{args.mode}_")
     try:
-        (smoke if args.mode == "smoke" else bad_input)(args.photonbound, tmp)
+        {"smoke": smoke, "bad-input": bad_input, "corpus": corpus}[args.mode](args.photonbound,
+                                                                             tmp)
     finally:
         shutil.rmtree(tmp, ignore_errors=True)
     if failures:

@@ -26,6 +26,11 @@ Scenes (analytic answers are radiances in the renderer's units):
                      The same scene as binary GLB, with an external buffer, and through a
                      node hierarchy (TRS parent/child whose product is the identity; light
                      and camera placed with "matrix"). Must render identically.
+  glossy_plane.gltf  plane_point with glTF's metallic-roughness BRDF on the plane (base colour
+                     0.6, metallic 0.5, roughness 0.4). Only direct light exists, so exactly
+                       L(x) = f(wo, wi) * 10 * cos(theta) / d^2,  d^2 = x^2 + 1 + z^2,
+                     f glTF's appendix B at wo (toward the camera) and wi (toward the light);
+                     a highlight about 4x the diffuse level under the light.
   closed_box.gltf    Closed cube [-1,1]^3, walls facing inward, one material: Lambertian
                      rho 0.5 emitting Le 1.0. Camera inside at (0,0,0.9) looking -z.
                      Exactly L = Le / (1 - rho) = 2.0 everywhere, in every direction
@@ -513,6 +518,16 @@ def build_plane_point():
     return b
 
 
+def build_glossy_plane():
+    """plane_point with glTF's metallic-roughness BRDF on the plane instead of a Lambertian."""
+    b = GltfBuilder()
+    glossy = b.material("glossy", (0.6, 0.6, 0.6), metallic=0.5, roughness=0.4)
+    b.mesh_node("plane", [(horizontal_quad((0.0, 0.0, 0.0), 10.0, 10.0), glossy)])
+    b.node("point", light=b.point_light("point", 10.0), translation=(0.0, 1.0, 0.0))
+    b.camera_node("camera", **PLANE_CAMERA)
+    return b
+
+
 def build_nested():
     b = GltfBuilder()
     parts, light = plane_point_parts(b)
@@ -749,6 +764,7 @@ OUTPUTS = [  # (file name, builder, writer)
     ("plane_point_external.gltf", build_plane_point, GltfBuilder.write_gltf_external),
     ("glass_slab.gltf", build_glass_slab, GltfBuilder.write_gltf),
     ("nested.gltf", build_nested, GltfBuilder.write_gltf),
+    ("glossy_plane.gltf", build_glossy_plane, GltfBuilder.write_gltf),
 ]
 
 
