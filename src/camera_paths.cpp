@@ -28,7 +28,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first,
       const Surface s = in.world.surface(hit);
       const vec3 wo = -dir;
       const bool front = glm::dot(wo, s.ng) > 0.0f;
-      weight *= in.world.transmittance(s, wo, hit.t);  // inside an absorbing volume
+      weight *= in.world.transmittance(s, wo, origin);  // inside an absorbing volume
       if (s.material->emits()) emission += dvec3(weight * in.world.emitted(s, wo));
       // Stop here (the non-delta part) or follow a delta branch: 1 - p_delta and p_delta.
       const float p_delta = s.bsdf.delta_probability(wo);

@@ -39,7 +39,7 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
     const Surface s = world.surface(hit);
     const vec3 wo = -v.dir;
     // Inside an absorbing volume the segment's transmittance weighs what it reaches.
-    const vec3 weight = v.weight * world.transmittance(s, wo, hit.t);
+    const vec3 weight = v.weight * world.transmittance(s, wo, v.origin);
     // Emission seen along the chain is exact for this ray (front side unless double-sided).
     if (s.material->emits()) out.emission += dvec3(weight * world.emitted(s, wo));
     const float length = v.length + hit.t;

@@ -13,7 +13,8 @@ namespace pb {
 
 namespace {
 
-// Pieces per side: about two texels per piece, at most 32 x 32 pieces per triangle.
+// Pieces per side: n = 2 sqrt(texels covered), so a piece covers about a quarter of a texel
+// (the choice follows the texture to the texel), at most 32 x 32 pieces per triangle.
 constexpr int kMaxSplit = 32;
 
 }  // namespace
@@ -43,7 +44,7 @@ void Lights::add_textured(const Mesh& mesh, const Material& mat, uint32_t tri,
     const double texels = 0.5 * std::fabs(double(a.x) * c.y - double(a.y) * c.x) *
                           double(im.width) * double(im.height);
     if (std::isfinite(texels))
-      n = int(std::clamp(std::ceil(std::sqrt(texels / 2.0)), 1.0, double(kMaxSplit)));
+      n = int(std::clamp(std::ceil(2.0 * std::sqrt(texels)), 1.0, double(kMaxSplit)));
   }
   const float step = 1.0f / float(n);
   // Piece with vertex 0 at barycentrics b0 and edges d1, d2 (as oriented as the triangle).

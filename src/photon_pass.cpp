@@ -62,7 +62,7 @@ void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, std::vect
     const bool front = glm::dot(wo, s.ng) > 0.0f;
     const vec3 ng = front ? s.ng : -s.ng;
     const vec3 ns = front ? s.ns : -s.ns;
-    flux *= world_.transmittance(s, wo, hit.t);  // Beer-Lambert inside an absorbing volume
+    flux *= world_.transmittance(s, wo, origin);  // Beer-Lambert inside an absorbing volume
     // Every surface with a non-delta part keeps the photon (glossy points evaluate f per photon).
     if (!s.bsdf.is_delta() && (bounce >= 1 || deposit_first_hit_))
       out.push_back({s.position, wo, ng, flux});

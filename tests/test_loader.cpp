@@ -1,6 +1,7 @@
 // glTF loader tests. Every test writes its own small glTF into a temporary directory; only
 // SmokeLoadsShippedScenes reads scenes/ (and skips when it is empty).
 #include "photonbound/gltf_loader.h"
+#include "photonbound/image_io.h"
 #include "photonbound/world.h"
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <limits>
 #include <optional>
 #include <random>
@@ -381,6 +383,148 @@ TEST_F(LoaderTest, MaterialFactorsOutOfRangeAreRefused) {
     expect_error(g, "material 'bad'");
     expect_error(g, phrase);
   }
+}
+
+// The bytes of an 8-bit RGB PNG of w x h texels (texel k has R = 40 k mod 256, G = 255 - k,
+// B = 7), written by image_io.h.
+std::vector<unsigned char> png_bytes(int w, int h, const fs::path& dir, int seed = 0) {
+  std::vector<unsigned char> rgb;
+  for (int k = 0; k < w * h; ++k)
+    rgb.insert(rgb.end(), {uint8_t(40 * k + seed), uint8_t(255 - k), 7});
+  const fs::path p = dir / ("tmp_" + std::to_string(seed) + ".png");
+  pb::write_png(p.string(), w, h, rgb);
+  std::ifstream f(p, std::ios::binary);
+  std::vector<unsigned char> out{std::istreambuf_iterator<char>(f), {}};
+  fs::remove(p);
+  return out;
+}
+
+// basic() with TEXCOORD_0 and _1 on its triangle and `material` as its material.
+Gltf textured(const std::string& images, const std::string& material) {
+  Gltf g = basic();
+  const int uv0 = g.accessor(g.view(std::vector<float>{0, 0, 1, 0, 0, 1}), 5126, 3, "VEC2");
+  const int uv1 =
+      g.accessor(g.view(std::vector<float>{0.5f, 0.5f, 1, 0.5f, 0.5f, 1}), 5126, 3, "VEC2");
+  g.meshes[0] =
+      "{\"name\":\"tri\",\"primitives\":[{\"attributes\":{\"POSITION\":0,\"NORMAL\":1,"
+      "\"TEXCOORD_0\":" +
+      std::to_string(uv0) + ",\"TEXCOORD_1\":" + std::to_string(uv1) +
+      "},\"indices\":2,\"material\":0}]}";
+  g.materials[0] = "{\"name\":\"tex\"," + material + "}";
+  g.top = images;
+  return g;
+}
+
+TEST_F(LoaderTest, TexturesAreDecodedWithSamplersAndTransforms) {
+  // One embedded PNG (a data URI) used by four textures: decoded once. Sampler 0 clamps S,
+  // mirrors T and filters NEAREST; KHR_texture_transform sets the matrix and texCoord.
+  const std::vector<unsigned char> png = png_bytes(3, 2, dir_);
+  const std::string images =
+      "\"images\":[{\"uri\":\"data:image/png;base64," + base64(png) +
+      "\"}],\"samplers\":[{\"magFilter\":9728,\"wrapS\":33071,\"wrapT\":33648}],"
+      "\"textures\":[{\"source\":0,\"sampler\":0},{\"source\":0}],";
+  const std::string xf =
+      "\"extensions\":{\"KHR_texture_transform\":{\"offset\":[0.5,0.25],\"rotation\":0.3,"
+      "\"scale\":[2,4],\"texCoord\":1}}";
+  const Scene s = load(textured(
+      images,
+      "\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0," + xf +
+          "},"
+          "\"metallicRoughnessTexture\":{\"index\":1}},\"normalTexture\":{\"index\":1,\"scale\":0."
+          "5},"
+          "\"emissiveFactor\":[1,1,1],\"emissiveTexture\":{\"index\":1,\"texCoord\":1},"
+          "\"extensions\":{\"KHR_materials_specular\":{\"specularColorTexture\":{\"index\":0}}}"));
+  ASSERT_EQ(s.images.size(), 1u);
+  EXPECT_EQ(s.images[0].width, 3);
+  EXPECT_EQ(s.images[0].height, 2);
+  EXPECT_EQ(s.images[0].u8[3], 40);  // texel 1, R
+  const pb::Material& m = s.materials[s.meshes[0].material];
+  const pb::TextureRef& b = m.base_color_texture;
+  EXPECT_EQ(b.image, 0);
+  EXPECT_EQ(b.wrap_s, pb::Wrap::ClampToEdge);
+  EXPECT_EQ(b.wrap_t, pb::Wrap::MirroredRepeat);
+  EXPECT_TRUE(b.nearest);
+  EXPECT_EQ(b.texcoord, 1);
+  const float c = std::cos(0.3f), sn = std::sin(0.3f);
+  const float want[6] = {2 * c, 4 * sn, 0.5f, -2 * sn, 4 * c, 0.25f};
+  for (int k = 0; k < 6; ++k) EXPECT_NEAR(b.m[k], want[k], 1e-6f) << k;
+  EXPECT_EQ(m.metallic_roughness_texture.wrap_s, pb::Wrap::Repeat);  // no sampler: REPEAT
+  EXPECT_FALSE(m.metallic_roughness_texture.nearest);
+  EXPECT_EQ(m.emissive_texture.texcoord, 1);
+  EXPECT_NEAR(m.normal_scale, 0.5f, 1e-7f);
+  EXPECT_TRUE(m.specular_color_texture.present());
+  EXPECT_FALSE(m.transmission_texture.present());
+  // A normal texture and no TANGENT: tangents are made from TEXCOORD_0 (u along +x here).
+  ASSERT_EQ(s.meshes[0].tangents.size(), 3u);
+  for (const glm::vec4& t : s.meshes[0].tangents) {
+    EXPECT_NEAR(t.x, 1.0f, 1e-5f);
+    EXPECT_EQ(std::fabs(t.w), 1.0f);
+  }
+  ASSERT_EQ(s.meshes[0].texcoords[1].size(), 3u);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+}
+
+TEST_F(LoaderTest, ImagesInBufferViewsAndTheirErrors) {
+  // A GLB's image in a bufferView is read from the buffer (its range checked); a bufferView
+  // past the buffer, undecodable bytes, a missing file and an absent image are refused, naming
+  // the image.
+  Gltf g = textured("", "\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}");
+  const std::vector<unsigned char> png = png_bytes(2, 2, dir_);
+  const int view = g.view(png);
+  g.top = "\"images\":[{\"bufferView\":" + std::to_string(view) +
+          ",\"mimeType\":\"image/png\"}],\"textures\":[{\"source\":0}],";
+  const Scene s = load_gltf(write("scene.glb", g.glb()));
+  ASSERT_EQ(s.images.size(), 1u);
+  EXPECT_EQ(s.images[0].width, 2);
+  g.views[size_t(view)] = "{\"buffer\":0,\"byteOffset\":0,\"byteLength\":999999}";
+  expect_error(write("long.glb", g.glb()), "image 0");
+  Gltf junk = textured(
+      "\"images\":[{\"uri\":\"data:image/png;base64,AAAAAAAA\"}],"
+      "\"textures\":[{\"source\":0}],",
+      "\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}");
+  expect_error(junk, "image 0: ");
+  expect_error(junk, "cannot decode the image");
+  Gltf missing = textured("\"images\":[{\"uri\":\"nowhere.png\"}],\"textures\":[{\"source\":0}],",
+                          "\"emissiveTexture\":{\"index\":0}");
+  expect_error(missing, "image 'nowhere.png' has no data");
+  Gltf absent = textured("\"textures\":[{\"source\":4}],", "\"emissiveTexture\":{\"index\":0}");
+  expect_error(absent, "image 4, which does not exist");
+  // Unused images are never decoded: junk nobody uses loads.
+  Gltf unused = textured("\"images\":[{\"uri\":\"data:image/png;base64,AAAAAAAA\"}],",
+                         "\"doubleSided\":false");
+  EXPECT_TRUE(load(unused).images.empty());
+}
+
+TEST_F(LoaderTest, ExternalImagesArePartOfTheSceneIdentity) {
+  // Editing an external texture changes Scene::content_hash (resume refuses the old state).
+  write("wood.png", png_bytes(2, 2, dir_, 0));
+  const Gltf g = textured("\"images\":[{\"uri\":\"wood.png\"}],\"textures\":[{\"source\":0}],",
+                          "\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":0}}");
+  const uint64_t before = load(g).content_hash;
+  EXPECT_EQ(load(g).content_hash, before);
+  write("wood.png", png_bytes(2, 2, dir_, 1));
+  EXPECT_NE(load(g).content_hash, before);
+}
+
+TEST_F(LoaderTest, FileTangentsAreTransformedAndTexturesWithoutImagesWarn) {
+  // TANGENT through a mirroring node transform: xyz by the linear part, w flipped.
+  Gltf g =
+      textured("\"images\":[{\"uri\":\"data:image/png;base64," + base64(png_bytes(1, 1, dir_)) +
+                   "\"}],\"textures\":[{\"source\":0},{\"extensions\":{"
+                   "\"KHR_texture_basisu\":{\"source\":0}}}],",
+               "\"normalTexture\":{\"index\":0},\"emissiveFactor\":[1,1,1],"
+               "\"emissiveTexture\":{\"index\":1}");
+  const int tan =
+      g.accessor(g.view(std::vector<float>{0, 1, 0, 1, 0, 1, 0, 1, 0, 1, 0, -1}), 5126, 3, "VEC4");
+  g.meshes[0].insert(g.meshes[0].find("\"NORMAL\""), "\"TANGENT\":" + std::to_string(tan) + ",");
+  g.nodes[0] = "{\"mesh\":0,\"scale\":[-1,2,1]}";
+  const Scene s = load(g);
+  ASSERT_EQ(s.meshes[0].tangents.size(), 3u);
+  expect_vec(vec3(s.meshes[0].tangents[0]), vec3(0, 1, 0));  // (0, 1, 0) scaled by 2, unit
+  EXPECT_EQ(s.meshes[0].tangents[0].w, -1.0f);
+  EXPECT_EQ(s.meshes[0].tangents[2].w, 1.0f);
+  EXPECT_TRUE(has_warning(s, "has no image photonbound can decode"));
+  EXPECT_FALSE(s.materials[0].emissive_texture.present());
 }
 
 TEST_F(LoaderTest, HierarchyComposesTrsAndMatrix) {

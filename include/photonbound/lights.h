@@ -44,7 +44,8 @@ class Lights {
  public:
   explicit Lights(const Scene& scene);
 
-  // Total emitted power per channel (W, in the image's radiance units times m^2 sr).
+  // Total emitted power per channel (W, in the image's radiance units times m^2 sr); textured
+  // emitters by the midpoint rule on their pieces (photon fluxes carry the exact radiance).
   vec3 total_power() const { return total_power_; }
   size_t emitter_count() const { return probability_.size(); }
 

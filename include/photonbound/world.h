@@ -39,14 +39,14 @@ class World {
     return emission_at(scene_.images, m, s.uv);
   }
 
-  // Beer-Lambert transmittance exp(-sigma t) of the segment of length t that ended at s, when it
-  // ran inside the volume s bounds (s seen from its back side, KHR_materials_volume); else 1.
-  // Volumes are bounded by their own closed mesh: a segment inside is one that reaches its
-  // inside surface.
-  vec3 transmittance(const Surface& s, const vec3& wo, float t) const {
+  // Beer-Lambert transmittance exp(-sigma d) of the segment from `from` (the surface point it
+  // left, not the ray's offset origin) to s, when it ran inside the volume s bounds (s seen from
+  // its back side, KHR_materials_volume); else 1. Volumes are bounded by their own closed mesh:
+  // a segment inside is one that reaches its inside surface.
+  vec3 transmittance(const Surface& s, const vec3& wo, const vec3& from) const {
     const Material& m = *s.material;
     if (m.thin || m.transmission <= 0.0f || glm::dot(wo, s.ng) >= 0.0f) return vec3(1.0f);
-    return glm::exp(-m.attenuation * t);
+    return glm::exp(-m.attenuation * glm::distance(from, s.position));
   }
 
   // The roughness below which GGX lobes are perfect mirrors (--mirror-roughness).

@@ -1,0 +1,328 @@
+// glTF's materials in whole renders of small in-memory scenes, against answers computed by hand:
+// thin and volumetric glass (Fresnel and Beer-Lambert transmittance), double-sided emitters,
+// alphaMode MASK cut-outs for camera rays, shadow rays and photons, a base colour texture with
+// KHR_texture_transform, a normal texture, and glTF's default material (a rough metal).
+#include "photonbound/renderer.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+namespace pb {
+namespace {
+
+// Builds meshes in world space; each is one material.
+struct SceneBuilder {
+  Scene s;
+  uint32_t material(const Material& m) {
+    s.materials.push_back(m);
+    return uint32_t(s.materials.size() - 1);
+  }
+  // Quad c +- u +- v, front u x v, uv (0, 0) at c - u + v, u to c + u, v to c - v.
+  Mesh& quad(vec3 c, vec3 u, vec3 v, uint32_t mat) {
+    Mesh m;
+    m.positions = {c - u - v, c + u - v, c + u + v, c - u + v};
+    m.normals.assign(4, glm::normalize(glm::cross(u, v)));
+    m.texcoords[0] = {vec2(0, 1), vec2(1, 1), vec2(1, 0), vec2(0, 0)};
+    m.indices = {0, 1, 2, 0, 2, 3};
+    m.material = mat;
+    s.meshes.push_back(m);
+    return s.meshes.back();
+  }
+  // Closed box [lo, hi], faces outward.
+  void box(vec3 lo, vec3 hi, uint32_t mat) {
+    const vec3 c = 0.5f * (lo + hi), h = 0.5f * (hi - lo);
+    for (int axis = 0; axis < 3; ++axis)
+      for (float sign : {1.0f, -1.0f}) {
+        vec3 n(0.0f), u(0.0f), v(0.0f);
+        n[axis] = sign;
+        u[(axis + 1) % 3] = h[(axis + 1) % 3];
+        v[(axis + 2) % 3] = h[(axis + 2) % 3];
+        if (glm::dot(glm::cross(u, v), n) < 0.0f) std::swap(u, v);
+        quad(c + n * h[axis], u, v, mat);
+      }
+  }
+  void camera(vec3 position, vec3 forward, vec3 up, float yfov) {
+    Camera c;
+    c.position = position;
+    c.forward = glm::normalize(forward);
+    c.up = glm::normalize(up);
+    c.right = glm::cross(c.forward, c.up);
+    c.yfov = yfov;
+    s.cameras.push_back(c);
+  }
+  Scene done() {
+    for (const Mesh& m : s.meshes)
+      for (const vec3& p : m.positions) s.bounds.extend(p);
+    s.source = "in memory";
+    return s;
+  }
+};
+
+RenderOptions options(int size, Method method = Method::PPM) {
+  RenderOptions o;
+  o.method = method;
+  o.width = o.height = size;
+  o.passes = 1;
+  o.photons_per_pass = 2000;
+  o.max_depth = 32;
+  o.progress = ProgressMode::Never;
+  return o;
+}
+
+// Pixel radiances after `passes` passes.
+std::vector<float> render(Scene scene, const RenderOptions& o, uint64_t passes = 1) {
+  Renderer r(std::move(scene), o);
+  for (uint64_t p = 0; p < passes; ++p) r.step();
+  FilmImage img;
+  r.develop(&img);
+  return img.radiance;
+}
+
+Material emitter(vec3 le, bool double_sided = false) {
+  Material m = Material::lambertian(vec3(0.0f));
+  m.emission = le;
+  m.double_sided = double_sided;
+  return m;
+}
+
+TEST(MaterialRender, VolumetricGlassSlabTransmitsByFresnelAndBeerLambert) {
+  // The centre pixel looks along -z at normal incidence through a slab (z in [-1.2, -1], ior 1.5,
+  // base b, attenuation colour c at distance 0.1, so tau = c^(0.2 / 0.1) per crossing) at an
+  // emitter of radiance 1. The PPM camera path sums every internal bounce (depth 32):
+  //   T = b^2 (1 - R)^2 tau / (1 - R^2 tau^2),  R = 0.04.
+  SceneBuilder b;
+  Material glass = Material::glass(1.5f, false);
+  glass.base_color = vec3(0.9f, 0.8f, 0.7f);
+  const vec3 c(0.5f, 0.25f, 1.0f);
+  glass.attenuation = -glm::log(c) / 0.1f;
+  b.box(vec3(-1, -1, -1.2f), vec3(1, 1, -1), b.material(glass));
+  b.quad(vec3(0, 0, -3), vec3(4, 0, 0), vec3(0, 4, 0), b.material(emitter(vec3(1.0f))));
+  b.camera(vec3(0, 0, 2), vec3(0, 0, -1), vec3(0, 1, 0), 0.5f);
+  const std::vector<float> l = render(b.done(), options(1));
+  for (int ch = 0; ch < 3; ++ch) {
+    const double base = glass.base_color[ch], tau = double(c[ch]) * c[ch], r = 0.04;
+    const double t = base * base * (1 - r) * (1 - r) * tau / (1 - r * r * tau * tau);
+    EXPECT_NEAR(l[size_t(ch)], t, 2e-6) << "channel " << ch;
+  }
+}
+
+TEST(MaterialRender, ThinGlassTransmitsOnceStraightThrough) {
+  // A thin-walled pane (no volume): the ray goes straight through once, T = b (1 - 0.04), and
+  // no attenuation applies (a thin wall has no inside).
+  SceneBuilder b;
+  Material thin = Material::glass(1.5f, true);
+  thin.base_color = vec3(0.9f, 0.8f, 0.7f);
+  thin.attenuation = vec3(5.0f);  // ignored: thin
+  b.quad(vec3(0, 0, -1), vec3(1, 0, 0), vec3(0, 1, 0), b.material(thin));
+  b.quad(vec3(0, 0, -3), vec3(4, 0, 0), vec3(0, 4, 0), b.material(emitter(vec3(2.0f))));
+  b.camera(vec3(0, 0, 2), vec3(0, 0, -1), vec3(0, 1, 0), 0.5f);
+  const std::vector<float> l = render(b.done(), options(1));
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(l[size_t(ch)], 2.0 * thin.base_color[ch] * 0.96, 2e-6);
+}
+
+TEST(MaterialRender, DoubleSidedEmitterIsSeenFromBehind) {
+  // The camera (at z = -2) looks at the emitter's back: its front faces +z, away from it.
+  for (bool both : {false, true}) {
+    SceneBuilder b;
+    b.quad(vec3(0, 0, 0), vec3(1, 0, 0), vec3(0, 1, 0), b.material(emitter(vec3(3.0f), both)));
+    b.quad(vec3(0, 0, 3), vec3(4, 0, 0), vec3(0, 4, 0),
+           b.material(Material::lambertian(vec3(0.5f))));
+    b.camera(vec3(0, 0, -2), vec3(0, 0, 1), vec3(0, 1, 0), 0.5f);
+    for (Method m : {Method::PPM, Method::SPPM}) {
+      const std::vector<float> l = render(b.done(), options(1, m), 2);
+      EXPECT_NEAR(l[0], both ? 3.0f : 0.0f, 1e-6f) << "double-sided " << both;
+    }
+  }
+}
+
+// Lambertian plane y = 0 (rho 0.5) under a point light of intensity 10 at height 1, a camera 3 m
+// above looking down; an occluder at y = 0.5 between them (2 x 2 texels, left column alpha 0,
+// right alpha 1, NEAREST, cutoff 0.5).
+Scene masked_scene(bool masked) {
+  SceneBuilder b;
+  b.quad(vec3(0), vec3(5, 0, 0), vec3(0, 0, -5), b.material(Material::lambertian(vec3(0.5f))));
+  Material leaf = Material::lambertian(vec3(0.3f));
+  leaf.alpha_mode = masked ? AlphaMode::Mask : AlphaMode::Opaque;
+  leaf.base_color_texture.image = 0;
+  leaf.base_color_texture.nearest = true;
+  b.quad(vec3(0, 0.5f, 0), vec3(0.5f, 0, 0), vec3(0, 0, -0.5f), b.material(leaf));
+  b.s.images.push_back(Image{"alpha", 2, 1, 4, {200, 200, 200, 0, 200, 200, 200, 255}, {}});
+  PunctualLight l;
+  l.position = vec3(0, 1, 0);
+  l.intensity = vec3(10.0f);
+  b.s.lights.push_back(l);
+  b.camera(vec3(0, 3, 0), vec3(0, -1, 0), vec3(0, 0, -1), 0.6f);
+  return b.done();
+}
+
+TEST(MaterialRender, MaskCutOutsPassCameraRaysShadowRaysAndPhotons) {
+  // Plane points (x, 0, z) with x < 0, |z| < 0.5 see the light through the transparent left
+  // column of the occluder (the segment to the light crosses y = 0.5 at x / 2); their radiance is
+  // the unoccluded 5 / (pi d^3). With x > 0 the segment crosses the opaque column: shadow (0 with
+  // next-event estimation). Camera rays pass the left column to the plane.
+  const RenderOptions o = options(8);
+  Renderer r(masked_scene(true), o);
+  r.step();
+  int lit = 0, dark = 0;
+  for (size_t k = 0; k < r.eye().points.size(); ++k) {
+    const MeasurementPoint& p = r.eye().points[k];
+    if (std::fabs(p.position.y) > 1e-4f) continue;  // on the occluder
+    const double d =
+        std::sqrt(double(p.position.x) * p.position.x + 1 + p.position.z * p.position.z);
+    const PointEstimate e = estimate(r.states()[k], 1, double(o.photons_per_pass));
+    const bool through = p.position.x < 0.0f && std::fabs(p.position.z) < 0.5f;
+    const bool blocked = p.position.x > 0.0f && std::fabs(p.position.z) < 0.5f;
+    if (through) {
+      EXPECT_NEAR(e.radiance.x, 5.0 / (kPiD * d * d * d), 1e-5) << p.position.x;
+      ++lit;
+    }
+    if (blocked) {
+      EXPECT_EQ(e.radiance.x, 0.0) << p.position.x;
+      ++dark;
+    }
+  }
+  EXPECT_GT(lit, 0);
+  EXPECT_GT(dark, 0);
+  // The camera sees the plane through the cut-out: more plane points than without the mask.
+  Renderer opaque(masked_scene(false), o);
+  size_t on_plane_masked = 0, on_plane_opaque = 0;
+  for (const MeasurementPoint& p : r.eye().points)
+    on_plane_masked += std::fabs(p.position.y) < 1e-4f;
+  for (const MeasurementPoint& p : opaque.eye().points)
+    on_plane_opaque += std::fabs(p.position.y) < 1e-4f;
+  EXPECT_GT(on_plane_masked, on_plane_opaque);
+  // Photons pass too: with all light from photons the plane behind the cut-out is lit (within
+  // 20% after 20 passes of 20000 photons: kernel estimate, radius from the default) and the
+  // shadowed half gets nothing.
+  RenderOptions po = options(8);
+  po.direct = DirectMode::Photons;
+  po.photons_per_pass = 20000;
+  Renderer pr(masked_scene(true), po);
+  for (int i = 0; i < 20; ++i) pr.step();
+  double through_sum = 0.0, exact_sum = 0.0, blocked_sum = 0.0;
+  for (size_t k = 0; k < pr.eye().points.size(); ++k) {
+    const MeasurementPoint& p = pr.eye().points[k];
+    if (std::fabs(p.position.y) > 1e-4f || std::fabs(p.position.z) > 0.4f) continue;
+    const double d =
+        std::sqrt(double(p.position.x) * p.position.x + 1 + p.position.z * p.position.z);
+    const double l = estimate(pr.states()[k], 20, double(po.photons_per_pass)).radiance.x;
+    if (p.position.x < -0.1f) {
+      through_sum += l;
+      exact_sum += 5.0 / (kPiD * d * d * d);
+    } else if (p.position.x > 0.1f) {
+      blocked_sum += l;
+    }
+  }
+  EXPECT_NEAR(through_sum, exact_sum, 0.2 * exact_sum);
+  EXPECT_LT(blocked_sum, 0.05 * exact_sum);
+}
+
+TEST(MaterialRender, BaseColourTextureWithTransformAtThePoints) {
+  // A Lambertian plane with a 2 x 2 NEAREST texture under KHR_texture_transform offset (0.5, 0):
+  // a point's reflectance is the sRGB-decoded texel at (u + 0.5, v), so L = tex / pi x 10 cos /
+  // d^2 exactly with next-event estimation.
+  SceneBuilder b;
+  Material m = Material::lambertian(vec3(1.0f));
+  m.base_color_texture.image = 0;
+  m.base_color_texture.nearest = true;
+  set_texture_transform(m.base_color_texture, vec2(0.5f, 0.0f), 0.0f, vec2(1.0f));
+  b.quad(vec3(0), vec3(1, 0, 0), vec3(0, 0, -1), b.material(m));
+  b.s.images.push_back(Image{"c", 2, 2, 3, {255, 0, 0, 0, 255, 0, 0, 0, 255, 128, 128, 128}, {}});
+  PunctualLight light;
+  light.position = vec3(0, 1, 0);
+  light.intensity = vec3(10.0f);
+  b.s.lights.push_back(light);
+  b.camera(vec3(0, 3, 0), vec3(0, -1, 0), vec3(0, 0, -1), 0.6f);
+  const RenderOptions o = options(8);
+  Renderer r(b.done(), o);
+  r.step();
+  const Image& im = r.world().scene().images[0];
+  ASSERT_EQ(r.eye().points.size(), 64u);
+  for (size_t k = 0; k < 64; ++k) {
+    const vec3 p = r.eye().points[k].position;
+    // The quad spans x, z in [-1, 1]; u = (x + 1) / 2 and v = (z + 1) / 2 (v toward +z).
+    const float s = (p.x + 1) / 2 + 0.5f, t = (p.z + 1) / 2;
+    const int tx = int(std::floor((s - std::floor(s)) * 2)), ty = std::min(1, int(t * 2));
+    const glm::vec4 rho = texel(im, tx, ty, true);
+    const double d = std::sqrt(double(p.x) * p.x + 1 + p.z * p.z);
+    const PointEstimate e = estimate(r.states()[k], 1, double(o.photons_per_pass));
+    for (int c = 0; c < 3; ++c)
+      EXPECT_NEAR(e.radiance[c], rho[c] / kPiD * 10 / (d * d * d), 1e-5) << k << " " << c;
+  }
+}
+
+TEST(MaterialRender, NormalTextureTiltsTheShadingNormal) {
+  // A constant normal texture (0.5 + 0.5 sin 30, 0.5, 0.5 + 0.5 cos 30: 30 degrees toward the
+  // tangent) on a plane whose tangent is +x: the shading normal is (sin 30, cos 30, 0) and the
+  // Lambertian radiance under the light is rho / pi x 10 max(0, ns.wi) / d^2 (next-event).
+  SceneBuilder b;
+  Material m = Material::lambertian(vec3(0.5f));
+  m.normal_texture.image = 0;
+  const float s30 = 0.5f, c30 = std::sqrt(3.0f) / 2;
+  b.s.images.push_back(Image{"n", 1, 1, 3, {}, {0.5f + 0.5f * s30, 0.5f, 0.5f + 0.5f * c30}});
+  Mesh& plane = b.quad(vec3(0), vec3(1, 0, 0), vec3(0, 0, -1), b.material(m));
+  plane.tangents.assign(4, glm::vec4(1, 0, 0, 1));
+  PunctualLight light;
+  light.position = vec3(0, 1, 0);
+  light.intensity = vec3(10.0f);
+  b.s.lights.push_back(light);
+  b.camera(vec3(0, 3, 0), vec3(0, -1, 0), vec3(0, 0, -1), 0.6f);
+  const RenderOptions o = options(8);
+  Renderer r(b.done(), o);
+  r.step();
+  const vec3 ns(s30, c30, 0.0f);
+  for (size_t k = 0; k < r.eye().points.size(); ++k) {
+    const vec3 p = r.eye().points[k].position;
+    EXPECT_NEAR(glm::dot(r.eye().points[k].shading, ns), 1.0f, 1e-5f);
+    const vec3 to = vec3(0, 1, 0) - p;
+    const double d2 = glm::dot(to, to),
+                 cos = std::max(0.0, double(glm::dot(to, ns)) / std::sqrt(d2));
+    const PointEstimate e = estimate(r.states()[k], 1, double(o.photons_per_pass));
+    EXPECT_NEAR(e.radiance.x, 0.5 / kPiD * 10 * cos / d2, 1e-5) << k;
+  }
+}
+
+// glTF appendix B in double (test_microfacet.cpp's reference, repeated for the plane).
+double gltf_f(const dvec3& v, const dvec3& l, double base, double metallic, double rough) {
+  const dvec3 n(0, 1, 0), h = glm::normalize(v + l);
+  const double a = std::max(rough * rough, 1e-4), a2 = a * a;
+  const double nh = glm::dot(n, h), nl = glm::dot(n, l), nv = glm::dot(n, v);
+  const double D = a2 / (kPiD * std::pow(nh * nh * (a2 - 1) + 1, 2));
+  const double V =
+      1 / (2 * (nv * std::sqrt(a2 + (1 - a2) * nl * nl) + nl * std::sqrt(a2 + (1 - a2) * nv * nv)));
+  const double w = std::pow(1 - std::fabs(glm::dot(v, h)), 5), fd = 0.04 + 0.96 * w;
+  const double dielectric = (1 - fd) * base / kPiD + fd * D * V;
+  const double metal = (base + (1 - base) * w) * D * V;
+  return (1 - metallic) * dielectric + metallic * metal;
+}
+
+TEST(MaterialRender, DefaultMaterialIsARoughWhiteMetal) {
+  // Material{} is glTF's default (no pbrMetallicRoughness): metallic 1, roughness 1, white. On a
+  // plane under a point light it reflects glTF's rough metal lobe (next-event: exact), not black.
+  SceneBuilder b;
+  b.quad(vec3(0), vec3(5, 0, 0), vec3(0, 0, -5), b.material(Material{}));
+  PunctualLight light;
+  light.position = vec3(0, 1, 0);
+  light.intensity = vec3(10.0f);
+  b.s.lights.push_back(light);
+  b.camera(vec3(0.5f, 3, 0), vec3(0, -1, 0), vec3(0, 0, -1), 0.6f);
+  const RenderOptions o = options(8);
+  Renderer r(b.done(), o);
+  r.step();
+  ASSERT_EQ(r.eye().points.size(), 64u);  // a visible point on every pixel: not a mirror
+  ASSERT_EQ(r.eye().glossy.size(), 64u);
+  for (size_t k = 0; k < 64; ++k) {
+    const dvec3 p(r.eye().points[k].position);
+    const dvec3 v = glm::normalize(dvec3(0.5, 3, 0) - p), to = dvec3(0, 1, 0) - p;
+    const double d2 = glm::dot(to, to);
+    const dvec3 l = to / std::sqrt(d2);
+    const double want = gltf_f(v, l, 1.0, 1.0, 1.0) * 10 * l.y / d2;
+    const PointEstimate e = estimate(r.states()[k], 1, double(o.photons_per_pass));
+    EXPECT_GT(want, 0.01);
+    EXPECT_NEAR(e.radiance.x, want, 1e-4 * want) << k;
+  }
+}
+
+}  // namespace
+}  // namespace pb
