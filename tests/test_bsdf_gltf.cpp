@@ -89,14 +89,16 @@ TEST(GltfBsdf, LambertianFastPathNeedsSpecularZero) {
   // Smooth metal and glass are delta only; a smooth coat over a diffuse base has both parts.
   EXPECT_TRUE(Bsdf(Material::metal(vec3(0.9f), 0.0f), n, n).is_delta());
   EXPECT_TRUE(Bsdf(Material::glass(1.5f), n, n).is_delta());
-  const Bsdf coat(params(vec3(0.5f), 0.0f, 0.05f), n, n);
+  const Bsdf coat(params(vec3(0.5f), 0.0f, 0.02f), n, n);
   EXPECT_FALSE(coat.is_delta());
   EXPECT_TRUE(coat.has_delta());
   const float pd = coat.delta_probability(glm::normalize(vec3(0.3f, 0, 1)));
   EXPECT_GT(pd, 0.0f);
   EXPECT_LT(pd, 1.0f);
-  // The mirror threshold decides: roughness 0.05 is glossy with a threshold of 0.032.
-  EXPECT_FALSE(Bsdf(params(vec3(0.5f), 0.0f, 0.05f), n, n, 0.032f).has_delta());
+  // The mirror threshold decides: roughness 0.05 is a coat with a threshold of 0.1, glossy with
+  // the default (0.032).
+  EXPECT_TRUE(Bsdf(params(vec3(0.5f), 0.0f, 0.05f), n, n, 0.1f).has_delta());
+  EXPECT_FALSE(Bsdf(params(vec3(0.5f), 0.0f, 0.05f), n, n).has_delta());
 }
 
 TEST(GltfBsdf, EvalIsMetalRoughInTheShadingFrame) {
@@ -137,7 +139,7 @@ TEST(GltfBsdf, ReciprocalInWorldSpace) {
   for (int k = 0; k < 20000; ++k) {
     vec3 ng, ns;
     random_normals(rng, ng, ns);
-    const float rough = k % 3 == 0 ? 0.05f : 0.1f + 0.9f * rng.next_float();
+    const float rough = k % 3 == 0 ? 0.02f : 0.1f + 0.9f * rng.next_float();
     const Bsdf bsdf(params(vec3(rng.next_float(), rng.next_float(), rng.next_float()),
                            k % 4 == 0 ? 0.0f : rng.next_float(), rough),
                     ng, ns);
@@ -160,7 +162,7 @@ std::vector<Case> cases() {
   return {{"dielectric r0.5", params(vec3(0.7f, 0.4f, 0.2f), 0.0f, 0.5f)},
           {"metal r0.3", params(vec3(0.95f, 0.64f, 0.54f), 1.0f, 0.3f)},
           {"mixture r0.7", params(vec3(0.5f), 0.5f, 0.7f)},
-          {"smooth coat r0.05", params(vec3(0.6f, 0.3f, 0.3f), 0.0f, 0.05f)},
+          {"smooth coat r0.02", params(vec3(0.6f, 0.3f, 0.3f), 0.0f, 0.02f)},
           {"glossy + thin glass", params(vec3(0.8f), 0.2f, 0.4f, 0.5f, true)},
           {"glossy + volume glass", params(vec3(0.9f), 0.0f, 0.6f, 0.6f, false)},
           {"lambertian", params(vec3(0.5f), 0.0f, 1.0f, 0.0f, true, 0.0f)}};
@@ -201,7 +203,8 @@ TEST(GltfBsdf, SampleWeightIsEvalCosOverPdfAndDeltaDrawsAreBranches) {
       ++continuous;
     }
     EXPECT_GT(continuous, 1000) << c.name;
-    if (c.p.transmission > 0.0f || c.p.roughness < 0.1f) EXPECT_GT(delta, 500) << c.name;
+    if (c.p.transmission > 0.0f || c.p.roughness < kDefaultMirrorRoughness)
+      EXPECT_GT(delta, 500) << c.name;
   }
 }
 
@@ -310,7 +313,7 @@ TEST(GltfBsdf, WhiteFurnacePerRoughness) {
   const vec3 ng = glm::normalize(vec3(0.3f, 0.1f, -1.0f));
   const Basis f(ng);
   std::printf("roughness  wo.z   quadrature  monte carlo  (white metal)\n");
-  for (float r : {0.05f, 0.1f, 0.15f, 0.2f, 0.3f, 0.5f, 0.7f, 1.0f}) {
+  for (float r : {0.02f, 0.05f, 0.1f, 0.15f, 0.2f, 0.3f, 0.5f, 0.7f, 1.0f}) {
     const Bsdf bsdf(params(vec3(1.0f), 1.0f, r), ng, ng);
     for (double mu : {1.0, 0.7, 0.4, 0.2}) {
       const vec3 wo = f.world(std::acos(mu), 0.4);
@@ -362,7 +365,7 @@ TEST(GltfBsdf, PhotonsCarryTheAdjoint) {
   const Basis fg(ng);
   const vec3 wo = fg.world(0.8, 2.5);
   for (const BsdfParams& p :
-       {params(vec3(0.8f), 0.3f, 0.5f), params(vec3(0.6f, 0.5f, 0.4f), 0.0f, 0.05f)}) {
+       {params(vec3(0.8f), 0.3f, 0.5f), params(vec3(0.6f, 0.5f, 0.4f), 0.0f, 0.02f)}) {
     const Bsdf bsdf(p, ng, ns);
     double sum = 0.0, sum2 = 0.0;
     const int n = 400000;

@@ -26,8 +26,8 @@ inline constexpr float kMinGgxAlpha = 1e-4f;
 // The renderer's threshold (--mirror-roughness): GGX lobes whose roughness is below it are
 // rendered as perfect mirrors. It may not go below kMinMirrorRoughness (above); README
 // "Materials" says why the default is what it is.
-inline constexpr double kDefaultMirrorRoughness = 0.1;
 inline constexpr double kMinMirrorRoughness = 0.032;
+inline constexpr double kDefaultMirrorRoughness = kMinMirrorRoughness;
 
 // glTF's remapping of perceptual roughness: alpha = roughness^2 (appendix B "Specular BRDF"),
 // roughness clamped to [0, 1] and alpha raised to kMinGgxAlpha.
