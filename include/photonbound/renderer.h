@@ -98,6 +98,7 @@ class Renderer {
   FilmSettings film_settings() const;
   const PhaseTimings& timings() const { return timings_; }
   const World& world() const { return world_; }
+  const PinholeCamera& camera() const { return camera_; }
   double initial_radius() const { return initial_radius_; }
 
  private:
