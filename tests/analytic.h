@@ -169,7 +169,8 @@ inline TerminationRow termination_run(const std::string& name, RenderOptions o) 
   size_t n = 0;
   for (size_t p = 0; p < truth.size(); ++p) {
     if (std::isnan(truth[p])) continue;
-    for (int c = 0; c < 3; ++c) sum += std::fabs(double(img.radiance[3 * p + size_t(c)]) - truth[p]);
+    for (int c = 0; c < 3; ++c)
+      sum += std::fabs(double(img.radiance[3 * p + size_t(c)]) - truth[p]);
     n += 3;
   }
   row.actual = n ? sum / double(n) : 0.0;
