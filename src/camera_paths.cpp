@@ -44,6 +44,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first,
         point.shading = front ? s.ns : -s.ns;
         const bool lambertian = s.bsdf.is_lambertian();
         point.f = lambertian ? w * s.bsdf.diffuse_f() : w;
+        point.triangle = in.world.triangle_index(hit);
         if (!(max_component(point.f) > 0.0f)) {
           point.f = vec3(0.0f);
         } else if (!lambertian) {

@@ -51,6 +51,7 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
       p.shading = front ? s.ns : -s.ns;
       const bool lambertian = s.bsdf.is_lambertian();
       p.f = lambertian ? weight * s.bsdf.diffuse_f() : weight;
+      p.triangle = world.triangle_index(hit);
       if (max_component(p.f) > 0.0f) {
         if (!lambertian) out.glossy.push_back({uint32_t(out.points.size()), wo, s.bsdf});
         out.points.push_back(p);

@@ -141,15 +141,19 @@ dvec3 direct_light(const World& world, const MeasurementPoint& point, const Glos
 }
 
 void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
-                 const HashGrid& grid, const std::vector<PhotonHit>& hits, GlossyTable glossy,
-                 std::span<PassGather> out) {
+                 const HashGrid& grid, const std::vector<PhotonHit>& hits,
+                 const BoundaryIndex* boundary, GlossyTable glossy, std::span<PassGather> out) {
   GlossyCursor cursor(glossy, points.size());
   for (size_t k = 0; k < points.size(); ++k) {
-    if (!(max_component(points[k].f) > 0.0f)) continue;  // SPPM: no visible point this pass
+    const MeasurementPoint& p = points[k];
+    if (!(max_component(p.f) > 0.0f)) continue;  // SPPM: a pixel without a visible point
     if (const GlossyPoint* g = cursor.at(k))
-      gather_photons(points[k], *g, states[k].r2, grid, hits, out[k]);
+      gather_photons(p, *g, states[k].r2, grid, hits, out[k]);
     else
-      gather_photons(points[k], states[k].r2, grid, hits, out[k]);
+      gather_photons(p, states[k].r2, grid, hits, out[k]);
+    if (boundary)
+      out[k].disc =
+          boundary->moments(p.triangle, p.position, p.normal, search_radius(states[k].r2));
   }
 }
 
@@ -188,7 +192,7 @@ void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> poi
       const GlossyTable glossy{in.glossy, first + b};
       gather_pass(points.subspan(first + b, e - b),
                   std::span<const PointState>(states).subspan(first + b, e - b), in.grid, in.hits,
-                  glossy, out);
+                  in.boundary, glossy, out);
       if (in.next_event)
         next_event_pass(in.world, points.subspan(first + b, e - b), glossy, in.seed, in.pass,
                         first + b, out);
@@ -218,7 +222,7 @@ void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
       const size_t n_glossy = trace_visible_points(camera, first + b, pts, scratch, out);
       const GlossyTable table{scratch.first(n_glossy), 0};  // indices into pts
       gather_pass(pts, std::span<const PointState>(states).subspan(first + b, e - b), in.grid,
-                  in.hits, table, out);
+                  in.hits, in.boundary, table, out);
       if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, first + b, out);
       for (size_t k = 0; k < pts.size(); ++k)  // saturating: 2^32 - 1 passes is far beyond use
         if (max_component(pts[k].f) > 0.0f && visible[first + b + k] != UINT32_MAX)

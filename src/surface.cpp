@@ -78,6 +78,12 @@ Surface World::surface(const Hit& hit) const {
   return s;
 }
 
+bool World::may_hold_points(const Material& m) const {
+  if (m.metallic_roughness_texture.present() || m.transmission_texture.present()) return true;
+  const vec3 n(0.0f, 0.0f, 1.0f);
+  return !Bsdf(m, n, n, mirror_roughness_).is_delta();
+}
+
 std::string World::mirror_note() const {
   std::string names;
   size_t count = 0;

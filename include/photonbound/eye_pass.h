@@ -21,8 +21,9 @@ struct MeasurementPoint {
   // with W_k moved inside), and the point needs one colour instead of two.
   // On a non-Lambertian surface f is W_k alone, and the point's GlossyPoint holds the rest.
   vec3 f{0.0f};
+  uint32_t triangle = 0;  // World::triangle_index of the hit: the boundary index's key
 };
-static_assert(sizeof(MeasurementPoint) == 48, "the per-point memory budget counts on 48 bytes");
+static_assert(sizeof(MeasurementPoint) == 52, "the per-point memory budget counts on 52 bytes");
 
 // What a measurement point on a non-Lambertian surface needs beside its MeasurementPoint: the
 // direction toward the camera and the Bsdf, so that the gather evaluates f(wo, wi) per photon

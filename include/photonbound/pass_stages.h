@@ -10,6 +10,7 @@
 // 5: a distributed render reduces exactly that array across machines before folding it.
 #pragma once
 
+#include "photonbound/boundary.h"
 #include "photonbound/estimator.h"
 #include "photonbound/eye_pass.h"
 #include "photonbound/hash_grid.h"
@@ -63,10 +64,11 @@ struct GlossyTable {
 // Stage 3: adds the photons of the pass at points[k] into out[k] (phi, phi_lap_r2, count).
 // states[k].r2 is the radius of the pass. A point with f = 0 (SPPM: no visible point this
 // pass) gathers nothing and so does not shrink its radius. Points in `glossy` evaluate their
-// Bsdf per photon.
+// Bsdf per photon. With `boundary`, also the kernel's moments over the reachable part of each
+// point's disc (ESTIMATOR.md section 11); without, every disc counts as whole.
 void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
-                 const HashGrid& grid, const std::vector<PhotonHit>& hits, GlossyTable glossy,
-                 std::span<PassGather> out);
+                 const HashGrid& grid, const std::vector<PhotonHit>& hits,
+                 const BoundaryIndex* boundary, GlossyTable glossy, std::span<PassGather> out);
 
 // Stage 4: adds one next-event sample at points[k] to out[k].direct, drawn from
 // Rng(seed, pass, first + k, Stream::DirectLight): point (or pixel) first + k's own stream.
@@ -89,6 +91,7 @@ struct PassInputs {
   const HashGrid& grid;
   const std::vector<PhotonHit>& hits;
   const EstimatorParams& params;
+  const BoundaryIndex* boundary = nullptr;
   uint64_t seed = 0, pass = 0;
   bool next_event = true;
   std::span<const GlossyPoint> glossy{};  // PPM: EyePassResult::glossy (indices into the points)
