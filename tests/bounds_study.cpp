@@ -26,8 +26,10 @@ void coverage_table() {
       "| scene | direct | passes | confidence | mean actual error | mean bound | bound / actual | "
       "coverage |\n");
   std::printf("|---|---|---|---|---|---|---|---|\n");
-  const std::pair<const char*, DirectMode> cases[] = {
-      {"plane", DirectMode::Photons}, {"box", DirectMode::Photons}, {"box", DirectMode::NextEvent}};
+  const std::pair<const char*, DirectMode> cases[] = {{"plane", DirectMode::Photons},
+                                                      {"glossy", DirectMode::Photons},
+                                                      {"box", DirectMode::Photons},
+                                                      {"box", DirectMode::NextEvent}};
   for (const auto& [name, mode] : cases) {
     std::vector<analytic::CoverageRow> pooled;
     for (uint64_t seed = 1; seed <= 4; ++seed) {

@@ -199,9 +199,10 @@ TEST(SlowCoverage, SyntheticDensityBoundsCoverNominalConfidence) {
 // answer analytic::glossy_plane), all light from photons, 64 x 64 pixels: coverage at 50% and
 // 90% confidence after 16, 64 and 256 passes, with PPM's fixed points (the glossy side table)
 // and SPPM's per-pass visible points (their block scratch; pixel averages against the exact
-// pixel average). The criterion is the plane's in test_slow_bounds.cpp: at or above nominal
-// minus 5 points (neighbouring pixels share photons; 5 points are two binomial standard errors
-// of 400 independent pixels at 50%).
+// pixel average). The criterion is issue 17's: within 3 points of nominal either way (measured
+// 0.49-0.52 at 50% and 0.895-0.906 at 90%); the 12288 pixel-channels of one render share
+// photons between neighbours, so 3 points are about 1.2 binomial standard errors of 400
+// independent pixels at 50%, and a fixed seed makes the check deterministic.
 TEST(SlowCoverage, GlossyVisiblePointsBoundsCoverNominalConfidence) {
   for (Method method : {Method::PPM, Method::SPPM}) {
     RenderOptions o = test::quick_options("glossy_plane.gltf", 64, 256);
@@ -215,7 +216,7 @@ TEST(SlowCoverage, GlossyVisiblePointsBoundsCoverNominalConfidence) {
           method == Method::PPM ? "ppm" : "sppm", (unsigned long long)r.passes,
           100.0 * r.confidence, r.accuracy.coverage, r.accuracy.mean_abs_error,
           r.accuracy.mean_bound, r.accuracy.mean_bound / r.accuracy.mean_abs_error);
-      EXPECT_GE(r.accuracy.coverage, r.confidence - 0.05)
+      EXPECT_NEAR(r.accuracy.coverage, r.confidence, 0.03)
           << "after " << r.passes << " passes at " << r.confidence;
       EXPECT_GT(r.accuracy.samples, 4000u);
     }

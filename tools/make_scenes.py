@@ -30,7 +30,7 @@ Scenes (analytic answers are radiances in the renderer's units):
                      0.6, metallic 0.5, roughness 0.4). Only direct light exists, so exactly
                        L(x) = f(wo, wi) * 10 * cos(theta) / d^2,  d^2 = x^2 + 1 + z^2,
                      f glTF's appendix B at wo (toward the camera) and wi (toward the light);
-                     a highlight about 4x the diffuse level under the light.
+                     L = 10.86 at the image centre (the highlight), 0.220 at its corners.
   closed_box.gltf    Closed cube [-1,1]^3, walls facing inward, one material: Lambertian
                      rho 0.5 emitting Le 1.0. Camera inside at (0,0,0.9) looking -z.
                      Exactly L = Le / (1 - rho) = 2.0 everywhere, in every direction
