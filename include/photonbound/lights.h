@@ -47,6 +47,9 @@ class Lights {
   size_t emitter_count() const { return probability_.size(); }
 
   EmittedPhoton sample_photon(Rng& rng) const;
+  // The largest channel of the power any emitted photon can carry (before the division by the
+  // photons per pass): emitter power over its choice probability.
+  float max_photon_flux() const { return max_photon_flux_; }
   // False when the sample cannot contribute (back side of a one-sided emitter, outside a cone).
   bool sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) const;
 
@@ -69,6 +72,7 @@ class Lights {
   std::vector<double> cdf_;
   std::vector<float> probability_;
   vec3 total_power_{0.0f};
+  float max_photon_flux_ = 0.0f;
 };
 
 }  // namespace pb
