@@ -147,6 +147,20 @@ vec3 Bsdf::eval(const vec3& wo, const vec3& wi) const {
   return eval_local(f.local(wo), f.local(wi), nullptr);
 }
 
+vec3 Bsdf::max_f(const vec3& wo) const {
+  if (kind_ == Kind::Lambertian) return diffuse_f();
+  if (kind_ == Kind::Delta) return vec3(0.0f);
+  const float mu = brdf_.metallic;
+  const vec3 diffuse = (1.0f - mu) / kPi * brdf_.base_color;  // 1 - max F <= 1
+  if (smooth_) return reflect_ * diffuse;
+  // GGX: F D V with F <= 1, D <= 1 / (pi alpha^2) (at h = n) and V = 1 / (2 (zi so + zo si))
+  // <= 1 / (2 zo alpha), since si = sqrt(zi^2 + alpha^2 (1 - zi^2)) >= alpha (microfacet.h).
+  const float a = ggx_alpha(brdf_.roughness);
+  const float zo = std::max(std::fabs(glm::dot(wo, ns_)), kMinCosine);
+  const float spec = 1.0f / (2.0f * kPi * a * a * a * zo);
+  return reflect_ * (diffuse + vec3(spec));
+}
+
 float Bsdf::pdf(const vec3& wo, const vec3& wi) const {
   if (kind_ == Kind::Delta) return 0.0f;
   const vec3 ns = glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_;

@@ -154,6 +154,23 @@ Lights::Lights(const Scene& scene) : punctual_(scene.lights), images_(scene.imag
     probability_[k] = float(weights[k] / sum);
   }
   cdf_.back() = 1.0;
+  // Per emitter: flux per photon = power / probability (sample_photon); a spot's photons carry
+  // up to its intensity times the cone's solid angle.
+  for (size_t k = 0; k < weights.size(); ++k) {
+    if (!(probability_[k] > 0.0f)) continue;
+    vec3 peak(0.0f);
+    if (k < punctual_.size()) {
+      const PunctualLight& l = punctual_[k];
+      peak = l.kind == PunctualKind::Point ? 4.0f * kPi * l.intensity
+                                           : l.intensity * (2.0f * kPi * (1.0f - l.cos_outer));
+    } else {
+      const Triangle& t = triangles_[k - punctual_.size()];
+      // A textured piece's photons carry the radiance where they start: at most its peak.
+      const vec3 le = t.source < 0 ? t.radiance : vec3(t.peak);
+      peak = lambertian_emitter_power(t.area * (t.two_sided ? 2.0f : 1.0f), le);
+    }
+    max_photon_flux_ = std::max(max_photon_flux_, max_component(peak) / probability_[k]);
+  }
 }
 
 size_t Lights::pick(float u) const {

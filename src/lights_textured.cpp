@@ -72,6 +72,7 @@ void Lights::add_textured(const Mesh& mesh, const Material& mat, uint32_t tri,
     }
     t.radiance = mean;
     t.select = std::max(average(mean), 0.1f * bound);
+    t.peak = bound;
     if (t.select > 0.0f) {
       triangles_.push_back(t);
     } else {

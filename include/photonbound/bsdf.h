@@ -101,6 +101,9 @@ class Bsdf {
 
   // f(wo, wi) of the non-delta part, without the cosine; 0 for wi on the other side of ng.
   vec3 eval(const vec3& wo, const vec3& wi) const;
+  // An upper bound of eval(wo, wi) over every wi: what one photon can bring at a glossy point
+  // (the sparse-photon bound, ESTIMATOR.md section 12).
+  vec3 max_f(const vec3& wo) const;
   // Solid-angle pdf of sample()'s non-delta draws (times the probability of drawing that part).
   float pdf(const vec3& wo, const vec3& wi) const;
   // Draws wi (random numbers from rng, as many as the lobes need, in a fixed order); false when

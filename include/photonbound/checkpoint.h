@@ -27,7 +27,8 @@ class StateError : public std::runtime_error {
 };
 
 // 2: PointState without direct_sum (160 B); 3: options as key/value text from the option table;
-// 4: glTF's metallic-roughness materials (a version 3 state was rendered with other ones).
+// 4: glTF's metallic-roughness materials (a version 3 state was rendered with other ones), the
+// sparse-photon bound's SPPM kernel masses, largest photon power and glossy caps.
 inline constexpr uint32_t kStateVersion = 4;
 
 struct SavedRender {

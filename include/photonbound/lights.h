@@ -50,6 +50,9 @@ class Lights {
   size_t emitter_count() const { return probability_.size(); }
 
   EmittedPhoton sample_photon(Rng& rng) const;
+  // The largest channel of the power any emitted photon can carry (before the division by the
+  // photons per pass): emitter power over its choice probability.
+  float max_photon_flux() const { return max_photon_flux_; }
   // False when the sample cannot contribute (back side of a one-sided emitter, outside a cone).
   bool sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) const;
 
@@ -64,6 +67,7 @@ class Lights {
     vec3 radiance;           // emitted radiance; textured: its mean over the piece
     float select = 0.0f;     // radiance the choice weights use: average(radiance), or for a
                              // textured piece at least a tenth of its brightest texel
+    float peak = 0.0f;       // textured: the largest channel its radiance can reach
     bool two_sided = false;  // doubleSided: emits from both sides
     int32_t source = -1;     // textured: index into sources_
   };
@@ -92,6 +96,7 @@ class Lights {
   std::vector<double> cdf_;
   std::vector<float> probability_;
   vec3 total_power_{0.0f};
+  float max_photon_flux_ = 0.0f;
 };
 
 }  // namespace pb

@@ -34,6 +34,9 @@ struct RenderState {
   double initial_radius = 0.0;
   std::vector<PointState> states;  // PPM: one per measurement point; SPPM: one per pixel
   std::vector<uint32_t> visible;   // SPPM: passes with a visible point, per pixel
+  std::vector<float> min_mass;     // SPPM: smallest kernel mass of a visible point, per pixel
+  double max_photon_power = 0.0;   // largest channel of a photon's power seen (section 12)
+  std::vector<float> glossy_f;     // SPPM: largest f a glossy visible point had, per pixel
 };
 
 // Wall-clock seconds spent in each phase, accumulated over all passes (for the benchmark).
@@ -83,7 +86,7 @@ class Renderer {
   // True when no radius can shrink any more (alpha = 1, or every radius at its floor).
   bool radii_fixed() const;
 
-  // Which states make up each pixel.
+  // Which states make up each pixel (of the current states).
   PixelLayout layout() const;
   // Radiance and bounds of the current states, or of a snapshot's; the film when wanted.
   FilmSummary develop(FilmImage* image = nullptr) const;
@@ -104,8 +107,26 @@ class Renderer {
   const BoundaryIndex& boundary() const { return boundary_; }
 
  private:
-  ExrImage image(const RunInfo& run, const WorkCounters& work, double initial_radius,
-                 const std::vector<PointState>& states, const std::vector<uint32_t>& visible) const;
+  // The current state or a snapshot's, without copying either.
+  struct View {
+    const WorkCounters& work;
+    double initial_radius;
+    const std::vector<PointState>& states;
+    const std::vector<uint32_t>& visible;
+    const std::vector<float>& min_mass;
+    double max_photon_power;
+    const std::vector<float>& glossy_f;
+  };
+  View view() const {
+    return {work_, initial_radius_, states_, visible_, min_mass_, max_photon_power_, glossy_f_};
+  }
+  static View view(const RenderState& s) {
+    return {s.work,     s.initial_radius,   s.states,  s.visible,
+            s.min_mass, s.max_photon_power, s.glossy_f};
+  }
+  PixelLayout layout(const View& v) const;
+  FilmSummary develop(const View& v, FilmImage* image) const;
+  ExrImage image(const RunInfo& run, const View& v) const;
 
   const RenderOptions options_;
   World world_;
@@ -118,9 +139,15 @@ class Renderer {
   BoundaryIndex boundary_;  // where surfaces end, for discs up to the initial radius
   std::vector<PhotonHit> hits_;
   std::vector<vec3> hit_positions_;
-  std::vector<float> radii_;                      // search_radius(r2) per point, for the grid build
-  std::vector<PassGather> sums_;                  // one fold block's pass sums (pass_stages.h)
-  std::vector<uint32_t> visible_;                 // SPPM: passes with a visible point, per pixel
+  std::vector<float> radii_;       // search_radius(r2) per point, for the grid build
+  std::vector<PassGather> sums_;   // one fold block's pass sums (pass_stages.h)
+  std::vector<uint32_t> visible_;  // SPPM: passes with a visible point, per pixel
+  std::vector<float> min_mass_;    // SPPM: smallest kernel mass seen, per pixel
+  double max_photon_power_ = 0.0;  // emitted or stored, the largest channel
+  vec3 max_f_{0.0f};               // largest BRDF a Lambertian point can have
+  std::vector<float> glossy_f_;    // SPPM: largest glossy f seen, per pixel
+  // PPM with glossy points: the points with f times Bsdf::max_f for the sparse-photon bound.
+  std::vector<MeasurementPoint> capped_points_;
   std::vector<MeasurementPoint> visible_points_;  // SPPM: one fold block's, reused
   std::vector<GlossyPoint> visible_glossy_;       // SPPM: their Bsdfs where not Lambertian
   WorkCounters work_;
