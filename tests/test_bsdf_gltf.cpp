@@ -131,6 +131,30 @@ TEST(GltfBsdf, EvalIsMetalRoughInTheShadingFrame) {
   EXPECT_GT(tested, 3000);
 }
 
+TEST(GltfBsdf, MaxFBoundsEveryValue) {
+  // Bsdf::max_f(wo) (the sparse-photon bound's cap) is at least eval(wo, wi) for every wi:
+  // random materials and geometries, random directions and directions next to the mirror one.
+  Rng rng(309, 0, 0, Stream::Test);
+  for (int k = 0; k < 2000; ++k) {
+    vec3 ng, ns;
+    random_normals(rng, ng, ns);
+    const float rough = k % 4 == 0 ? 0.02f : 0.033f + 0.967f * rng.next_float();
+    const Bsdf bsdf(params(vec3(rng.next_float(), rng.next_float(), rng.next_float()),
+                           rng.next_float(), rough, k % 5 == 0 ? 0.5f : 0.0f),
+                    ng, ns);
+    const vec3 wo = random_unit(rng);
+    const vec3 cap = bsdf.max_f(wo);
+    const vec3 n = glm::dot(wo, ng) > 0.0f ? ns : -ns;
+    const vec3 mirror = reflect(wo, n);
+    for (int i = 0; i < 200; ++i) {
+      const vec3 wi = i % 2 ? random_unit(rng)
+                            : glm::normalize(mirror + (0.5f * rough * rough) * random_unit(rng));
+      const vec3 f = bsdf.eval(wo, wi);
+      for (int c = 0; c < 3; ++c) ASSERT_LE(f[c], cap[c] * (1.0f + 1e-5f)) << k;
+    }
+  }
+}
+
 TEST(GltfBsdf, ReciprocalInWorldSpace) {
   // f(wo, wi) = f(wi, wo) for glossy lobes and for the diffuse base of a smooth coat, whose
   // Fresnel weight uses the pair's half vector: relative 1e-5 (FMA contraction), 1e-9 absolute.
