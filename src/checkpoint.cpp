@@ -44,6 +44,7 @@ class Reader {
       : path_(path), data_(bytes.data()), end_(end) {}
   void raw(void* p, size_t n) {
     if (n > end_ - pos_) throw StateError(path_ + ": truncated state file");
+    if (n == 0) return;  // an empty vector's data() may be null, which memcpy may not take
     std::memcpy(p, data_ + pos_, n);
     pos_ += n;
   }

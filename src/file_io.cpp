@@ -77,6 +77,7 @@ Checksum::Checksum(uint64_t total_size) {
 }
 
 void Checksum::add(const void* data, size_t n) {
+  if (n == 0) return;  // an empty piece's data() may be null, which memcpy may not take
   const char* p = static_cast<const char*>(data);
   if (fill_ > 0) {  // complete the word a previous piece left open
     const size_t take = std::min(n, 8 - fill_);

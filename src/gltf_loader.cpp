@@ -246,7 +246,8 @@ Scene load_gltf_bytes(const std::string& path, const std::vector<unsigned char>&
   Checksum hash(total);
   hash.add(bytes.data(), bytes.size());
   for (const tinygltf::Buffer& b : model.buffers) hash.add(b.data.data(), b.data.size());
-  for (const tinygltf::Image& im : model.images) hash.add(im.image.data(), im.image.size());
+  for (const tinygltf::Image& im : model.images)
+    if (!im.image.empty()) hash.add(im.image.data(), im.image.size());
   scene.content_hash = hash.finish();
   return scene;
 }

@@ -338,7 +338,8 @@ TEST(MaterialRender, GlossyCoatedAndTexturedImagesAreBitIdenticalAcrossThreadCou
     b.quad(vec3(0, 1, -2), vec3(2, 0, 0), vec3(0, 1, 0), b.material(coat));
     Material lamp = emitter(vec3(4.0f), true);
     lamp.emissive_texture.image = 0;
-    b.s.images.push_back(Image{"e", 2, 2, 3, {255, 255, 255, 30, 30, 30, 90, 0, 200, 0, 255, 0}, {}});
+    b.s.images.push_back(
+        Image{"e", 2, 2, 3, {255, 255, 255, 30, 30, 30, 90, 0, 200, 0, 255, 0}, {}});
     b.quad(vec3(0, 1.8f, -0.5f), vec3(0.4f, 0, 0), vec3(0, 0, 0.4f), b.material(lamp));
     Material glass = Material::glass(1.5f, false);
     glass.attenuation = vec3(0.5f, 1.0f, 2.0f);
