@@ -231,9 +231,11 @@ void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
         if (visible[pixel] != UINT32_MAX) ++visible[pixel];  // saturating: far beyond use
         min_mass[pixel] = std::min(min_mass[pixel], float(out[k].disc.mass));
       }
-      for (const GlossyPoint& g : table.entries) {
+      for (const GlossyPoint& g : table.entries) {  // only while the cap can still matter
+        const size_t pixel = first + b + g.point;
+        if (states[pixel].photons >= kMinPhotonsForBound) continue;
         const float f = max_component(pts[g.point].f * g.bsdf.max_f(g.wo));
-        glossy_f[first + b + g.point] = std::max(glossy_f[first + b + g.point], f);
+        glossy_f[pixel] = std::max(glossy_f[pixel], f);
       }
     });
     // A distributed render reduces sums[0, count) across machines here.
