@@ -75,4 +75,28 @@ ExrImage read_exr(const std::string& path) {
   return image;
 }
 
+RgbImage read_rgb_image(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw ImageError(path + ": cannot read image: " + one_line(OIIO::geterror()));
+  const OIIO::ImageSpec& spec = in->spec();
+  const size_t pixels = size_t(spec.width) * size_t(spec.height);
+  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 || pixels > (size_t(1) << 28))
+    throw ImageError(path + ": " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                     " pixels of " + std::to_string(spec.nchannels) +
+                     " channels is not an environment map (at most 2^28 pixels)");
+  const int channels = std::min(spec.nchannels, 3);
+  std::vector<float> data(pixels * size_t(channels));
+  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, data.data()))
+    throw ImageError(path + ": cannot read pixels: " + one_line(in->geterror()));
+  in->close();
+  RgbImage out;
+  out.width = spec.width;
+  out.height = spec.height;
+  out.rgb.resize(3 * pixels);
+  for (size_t p = 0; p < pixels; ++p)
+    for (size_t c = 0; c < 3; ++c)
+      out.rgb[3 * p + c] = data[p * size_t(channels) + (channels == 3 ? c : 0)];
+  return out;
+}
+
 }  // namespace pb

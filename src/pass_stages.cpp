@@ -84,10 +84,10 @@ template void gather_photons<false>(const MeasurementPoint&, double, const HashG
 
 dvec3 direct_light(const World& world, const MeasurementPoint& point, Rng& rng) {
   DirectSample s;
-  if (!world.lights().sample_direct(point.position, rng, s)) return dvec3(0.0);
+  if (!world.lights().sample_direct(point.position, point.shading, rng, s)) return dvec3(0.0);
   const float cos_s = glm::dot(s.wi, point.shading);
   if (cos_s <= 0.0f || glm::dot(s.wi, point.normal) <= 0.0f) return dvec3(0.0);
-  if (world.occluded(point.position, point.normal, s.wi, s.distance)) return dvec3(0.0);
+  if (world.occluded(point.position, s.wi, s.distance, s.margin)) return dvec3(0.0);
   return dvec3(point.f * s.li * cos_s);
 }
 

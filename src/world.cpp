@@ -6,10 +6,7 @@ World::World(Scene scene)
     : scene_(std::move(scene)),
       accel_(scene_),
       lights_(scene_),
-      scene_size_(std::max(scene_.bounds.diagonal(), 1e-30f)),
-      // Offsets of 1e-5 of the scene keep rays off their own surface without skipping
-      // neighbouring geometry; the |p| term in offset() covers float spacing far from 0.
-      epsilon_(1e-5f * scene_size_) {
+      scene_size_(std::max(scene_.bounds.diagonal(), 1e-30f)) {
   size_t triangles = 0;
   for (const Mesh& m : scene_.meshes) triangles += m.indices.size() / 3;
   face_normals_.resize(triangles);

@@ -15,20 +15,21 @@ using namespace pb::test;
 void quantised(const std::string& file) {
   Doc d;
   d.require({"KHR_mesh_quantization"});
-  const std::vector<int16_t> pos = {-32768, -32768, 0, 0, 32767, -32768, 0, 0,
-                                    32767,  32767,  0, 0, -32768, 32767, 0, 0};
+  const std::vector<int16_t> pos = {-32768, -32768, 0, 0, 32767,  -32768, 0, 0,
+                                    32767,  32767,  0, 0, -32768, 32767,  0, 0};
   const std::vector<int8_t> nor = {0, 0, 127, 0, 0, 0, 127, 0, 0, 0, 127, 0, 0, 0, 127, 0};
   const std::vector<uint16_t> uv = {0, 0, 65535, 0, 65535, 65535, 0, 65535};
   const std::vector<uint8_t> idx = {0, 1, 2, 0, 2, 3};
   const json norm = json{{"normalized", true}};
-  d.mesh_node(json{{"attributes",
-                    json{{"POSITION", d.accessor(d.view(pos, json{{"byteStride", 8}}), kShort, 4,
-                                                 "VEC3", norm)},
-                         {"NORMAL", d.accessor(d.view(nor, json{{"byteStride", 4}}), 5120, 4,
-                                               "VEC3", norm)},
-                         {"TEXCOORD_0", d.accessor(d.view(uv), kUShort, 4, "VEC2", norm)}}},
-                   {"indices", d.accessor(d.view(idx), 5121, 6, "SCALAR")}},
-              json{{"matrix", {2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 0, 0, -1, 1}}});
+  d.mesh_node(
+      json{
+          {"attributes",
+           json{{"POSITION",
+                 d.accessor(d.view(pos, json{{"byteStride", 8}}), kShort, 4, "VEC3", norm)},
+                {"NORMAL", d.accessor(d.view(nor, json{{"byteStride", 4}}), 5120, 4, "VEC3", norm)},
+                {"TEXCOORD_0", d.accessor(d.view(uv), kUShort, 4, "VEC2", norm)}}},
+          {"indices", d.accessor(d.view(idx), 5121, 6, "SCALAR")}},
+      json{{"matrix", {2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 0, 0, -1, 1}}});
   d.write(file);
 }
 
@@ -40,12 +41,12 @@ void sparse(const std::string& file) {
                                 {"indices", json{{"bufferView", iv}, {"componentType", component}}},
                                 {"values", json{{"bufferView", vv}}}}}};
   };
-  const int pos = d.accessor(d.view(quad), kFloat, 4, "VEC3",
-                             sp(1, d.view(std::vector<uint8_t>{2}), 5121,
-                                d.view(std::vector<float>{1.5f, 1.5f, 0.25f})));
-  const int uv = d.accessor(-1, kFloat, 4, "VEC2",
-                            sp(2, d.view(std::vector<uint16_t>{1, 2}), kUShort,
-                               d.view(std::vector<float>{1, 0, 1, 1})));
+  const int pos = d.accessor(
+      d.view(quad), kFloat, 4, "VEC3",
+      sp(1, d.view(std::vector<uint8_t>{2}), 5121, d.view(std::vector<float>{1.5f, 1.5f, 0.25f})));
+  const int uv = d.accessor(
+      -1, kFloat, 4, "VEC2",
+      sp(2, d.view(std::vector<uint16_t>{1, 2}), kUShort, d.view(std::vector<float>{1, 0, 1, 1})));
   const int idx = d.accessor(-1, kUInt, 6, "SCALAR",
                              sp(4, d.view(std::vector<uint32_t>{1, 2, 4, 5}), kUInt,
                                 d.view(std::vector<uint32_t>{1, 2, 2, 3})));

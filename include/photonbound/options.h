@@ -4,6 +4,7 @@
 // state file's options block and resume's list of differences are all made from that table.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -41,6 +42,14 @@ struct RenderOptions {
   int max_depth = 8;
   std::optional<int> width, height;
   std::string camera;  // empty = first perspective camera
+  // The view (view.h): each replaces the camera's own, or the default view's when the file has
+  // no camera.
+  std::optional<std::array<double, 3>> look_from, look_at, up;
+  std::optional<double> fov;  // vertical field of view, degrees
+  // The environment light (scene_setup.h): "" for none, or the default sky when the scene has
+  // no light; a colour "V" or "R,G,B"; or an .exr / .hdr equirectangular map.
+  std::string environment;
+  double environment_scale = 1.0;
   int threads = 0;
   uint64_t seed = 1;
   DirectMode direct = DirectMode::NextEvent;
@@ -93,6 +102,11 @@ struct OptionSpec {
 const std::vector<OptionSpec>& option_table();
 const OptionSpec* find_option(std::string_view flag_or_switch);  // null when unknown
 const OptionSpec& option(std::string_view key);                  // by key; throws when unknown
+
+// --environment's text (accepted by the option table): true when it names a map file (.exr or
+// .hdr, any case); otherwise its colour, grey "V" repeated.
+bool environment_is_map(const std::string& text);
+std::array<double, 3> environment_colour(const std::string& text);
 
 // The state file a render writes: --state, or the output path with its extension replaced by
 // ".pbstate".
