@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 namespace pb {
 namespace {
@@ -71,6 +72,8 @@ TEST(View, DefaultViewFramesTheBounds) {
         reach = std::max({reach, std::fabs(px - 0.5f * float(w)) / half,
                           std::fabs(py - 0.5f * float(h)) / half});
       }
+      std::printf("bounds %g..%g at %dx%d: the farthest corner reaches %.2f of the half-side\n",
+                  double(lo.x), double(hi.x), w, h, double(reach));
       EXPECT_GE(reach, 0.5f);
       // From +Z and above (model-viewer's default orbit), looking at the centre.
       const vec3 f = cam.direction(0.5f * float(w), 0.5f * float(h));
