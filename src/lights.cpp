@@ -205,8 +205,8 @@ EmittedPhoton Lights::sample_photon(Rng& rng) const {
 }
 
 EmittedPhoton Lights::from_disc(const vec3& travel, float u0, float u1) const {
-  // Uniform on the disc of radius r centred r before the scene's centre (concentric mapping is
-  // not needed: the disc is sampled by area, r sqrt(u0) and 2 pi u1).
+  // Uniform by area (radius r sqrt(u0), angle 2 pi u1) on the disc of radius r facing the light,
+  // r before the scene's centre: outside the bounding sphere, covering all of it.
   vec3 t, b;
   orthonormal_basis(travel, t, b);
   const float rho = radius_ * std::sqrt(u0), phi = 2.0f * kPi * u1;

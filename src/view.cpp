@@ -96,13 +96,13 @@ PinholeCamera choose_camera(const Scene& scene, const RenderOptions& o) {
   if (!(glm::length(forward) > 0.0))
     throw UsageError(std::string(o.look_at ? "--look-at" : "--look-from") +
                      ": the view direction is zero (the camera is at the point it looks at)");
-  const bool reoriented = o.look_at || o.look_from;
   if (o.up) {
     if (!orient(c, forward, dvec3(to_vec3(*o.up))))
       throw UsageError("--up: lies along the view direction");
-  } else if (!orient(c, forward, reoriented && !file ? dvec3(0, 1, 0) : dvec3(c.up)) &&
-             !orient(c, forward, dvec3(0, 1, 0))) {
-    orient(c, forward, dvec3(0, 0, -1));  // straight down or up: the image's top toward -Z
+  } else if (!orient(c, forward, dvec3(c.up)) && !orient(c, forward, dvec3(0, 1, 0))) {
+    // The camera's up (the default view's is +Y), else +Y, else, looking straight along it, -Z
+    // toward the image's top.
+    orient(c, forward, dvec3(0, 0, -1));
   }
   return PinholeCamera(c, w, h);
 }
