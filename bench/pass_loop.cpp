@@ -31,7 +31,7 @@ void gather_on(const pb::World& world, const pb::EyePassResult& eye, const pb::H
                const std::vector<pb::PhotonHit>& hits, const pb::EstimatorParams& params,
                uint64_t pass, std::vector<pb::PointState>& states, std::vector<float>& radii,
                std::vector<pb::PassGather>& sums) {
-  const pb::PassInputs in{world, grid, hits, params, kSeed, pass, true};
+  const pb::PassInputs in{world, grid, hits, params, nullptr, kSeed, pass, true};
   pb::gather_and_fold(in, eye.points, states, radii, sums, nullptr);
 }
 

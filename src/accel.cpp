@@ -116,4 +116,32 @@ bool Accel::occluded(const vec3& o, const vec3& d, float tnear, float tfar) cons
   return ray.tfar < 0.0f;
 }
 
+namespace {
+
+struct SphereQuery {
+  Accel::SphereVisit visit;
+  void* user;
+};
+
+bool on_query_primitive(RTCPointQueryFunctionArguments* args) {
+  const SphereQuery* q = static_cast<const SphereQuery*>(args->userPtr);
+  q->visit(q->user, args->geomID, args->primID);
+  return false;  // the radius is unchanged
+}
+
+}  // namespace
+
+void Accel::query_sphere(const vec3& center, float radius, SphereVisit visit, void* user) const {
+  RTCPointQuery query;
+  query.x = center.x;
+  query.y = center.y;
+  query.z = center.z;
+  query.time = 0.0f;
+  query.radius = radius;
+  RTCPointQueryContext context;
+  rtcInitPointQueryContext(&context);
+  SphereQuery q{visit, user};
+  rtcPointQuery(impl_->scene, &query, &context, on_query_primitive, &q);
+}
+
 }  // namespace pb

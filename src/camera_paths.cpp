@@ -36,6 +36,7 @@ void trace_visible_points(const CameraPathInputs& in, size_t first,
         point.normal = front ? s.ng : -s.ng;
         point.shading = front ? s.ns : -s.ns;
         point.f = weight * s.bsdf.diffuse_f();
+        point.triangle = in.world.triangle_index(hit);
         if (!(max_component(point.f) > 0.0f)) point.f = vec3(0.0f);
         break;
       }

@@ -28,23 +28,40 @@ void accumulate_pass(PointState& s, const PassGather& g, const EstimatorParams& 
   const double r2_pass = s.r2;  // R_j: the radius every deposit of this pass was made with
   const double inv_area = 1.0 / (kPiD * r2_pass * params.photons_per_pass);
 
+  // Where the disc reaches past the end of the surface (section 11): the kernel sum is divided
+  // by the kernel's mass c on the surface; the Laplacian sample loses the truncated Laplacian
+  // kernel's response l0 L / R^2 to the constant part and is rescaled by its second moment; and
+  // the bias, (R^2 / 4c) tr(M2) Lap for an isotropic Hessian, is 0.5 k2 Lap R_b^2 with the
+  // effective R_b^2 = R^2 tr(M2) / (2 k2 c), which the moments stream in place of R_j^2. The
+  // whole disc (every interior point) takes the plain path, bit for bit.
+  dvec3 phi = g.phi, lap = g.phi_lap_r2 / r2_pass;  // w_lap carries 1 / R_j^2
+  double r2_bias = r2_pass;
+  if (!g.disc.full) {
+    const double c = std::max(g.disc.mass, kMinKernelMass);
+    phi = g.phi / c;
+    // A disc cut to a sliver leaves the Laplacian kernel little sensitivity to curvature:
+    // its second moment is kept at least a sixteenth of the whole disc's.
+    lap = (lap - (g.disc.lap_mass / r2_pass) * phi) * (4.0 / std::max(g.disc.lap_second, 0.25));
+    r2_bias = r2_pass * g.disc.second / (2.0 * kernel::kSecondMoment * c);
+  }
+
   // Per-pass sample X_j = D_j + phi_j / (pi R_j^2 M_e) (section 4), streamed into bivariate
   // Welford moments with R_j^2: C_xy += (x - mean_x_old)(y - mean_y_new).
-  const dvec3 x = g.direct + g.phi * inv_area;
+  const dvec3 x = g.direct + phi * inv_area;
   const double inv_i = 1.0 / double(pass);
   const dvec3 dx = x - s.mean_x;
-  const double dr = r2_pass - s.mean_r2;
+  const double dr = r2_bias - s.mean_r2;
   s.mean_x += dx * inv_i;
   s.mean_r2 += dr * inv_i;
   s.c_xx += dx * (x - s.mean_x);
-  s.c_xr += dx * (r2_pass - s.mean_r2);
-  s.c_rr += dr * (r2_pass - s.mean_r2);
+  s.c_xr += dx * (r2_bias - s.mean_r2);
+  s.c_rr += dr * (r2_bias - s.mean_r2);
   s.photons += g.count;
 
   // PPM update (section 3, HOJ08): only photons that could contribute shrink the radius.
   const double applied = ppm_radius_update(s.n, s.r2, double(g.count), params.alpha, params.min_r2);
-  s.tau = (s.tau + g.phi) * applied;
-  s.tau_lap = (s.tau_lap + g.phi_lap_r2 / r2_pass) * applied;  // w_lap carries 1 / R_j^2
+  s.tau = (s.tau + phi) * applied;
+  s.tau_lap = (s.tau_lap + lap) * applied;
 }
 
 dvec3 photon_radiance(const PointState& s, uint64_t passes, double photons_per_pass) {
@@ -69,6 +86,12 @@ PointEstimate estimate(const PointState& s, uint64_t passes, double photons_per_
     // Retroactive correction X'_j = X_j - a R_j^2 with the newest a (section 4).
     const dvec3 s2 = glm::max(dvec3(0.0), (s.c_xx - 2.0 * a * s.c_xr + a * a * s.c_rr) / (i - 1.0));
     e.variance = s2 / i;
+    // Var(B) from the variance of the mean by the kernels' noise ratio; the radius shrank over
+    // the passes, and the Laplacian's noise grows as 1/R^3 against the estimate's 1/R, so the
+    // ratio is scaled by (mean R^2 / R^2)^2 (section 6b). An upper estimate where next-event
+    // noise is part of the variance.
+    const double shrink = s.mean_r2 / s.r2;
+    e.bias_variance = kBiasNoiseRatio * shrink * shrink * e.variance;
   }
   return e;
 }

@@ -53,6 +53,7 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
       p.normal = front ? s.ng : -s.ng;
       p.shading = front ? s.ns : -s.ns;
       p.f = v.weight * s.bsdf.diffuse_f();
+      p.triangle = world.triangle_index(hit);
       if (max_component(p.f) > 0.0f) {
         out.points.push_back(p);
         out.footprints.push_back(length * camera.pixel_angle());

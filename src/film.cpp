@@ -11,6 +11,7 @@ namespace {
 
 struct PixelResult {
   dvec3 radiance{0.0}, bias{0.0}, variance{0.0};
+  dvec3 bias_variance{0.0};  // of the bias estimate (ESTIMATOR.md section 6b)
   double photons = 0.0;
   float radius = 0.0f;
   bool exact = false;  // PPM: no point, so nothing random (background, exact emission)
@@ -28,6 +29,7 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
     r.radiance = e.radiance;
     r.bias = e.bias;
     r.variance = e.variance;
+    r.bias_variance = e.bias_variance;
     r.photons = double(states[pixel].photons);
     r.radius = float(std::sqrt(states[pixel].r2));
     // A pixel that never had a visible point has no photon part to wait for: its samples are
@@ -43,12 +45,51 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
     r.radiance += e.radiance;
     r.bias += e.bias;
     r.variance += e.variance;
+    r.bias_variance += e.bias_variance;
     r.photons += double(states[k].photons);
     if (r.exact) r.radius = float(std::sqrt(states[k].r2));
     r.exact = false;
     r.known = r.known && e.known;
   }
   return r;
+}
+
+// Empirical-Bayes prior of the bias (ESTIMATOR.md section 6b): per pixel and channel, the
+// variance tau^2 of the true bias around it, estimated over the (2W+1)^2 window of known
+// pixels as mean(B^2) - mean(Var B) (the estimates' own noise taken out), never below 0.
+// Summed-area tables keep it linear in the pixel count.
+constexpr int kPriorWindow = 4;
+
+std::vector<dvec3> bias_prior(const std::vector<PixelResult>& results, int width, int height) {
+  const size_t w1 = size_t(width) + 1;
+  std::vector<dvec3> b2((size_t(height) + 1) * w1, dvec3(0.0)), v(b2.size(), dvec3(0.0));
+  std::vector<double> n(b2.size(), 0.0);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const PixelResult& r = results[size_t(y) * size_t(width) + size_t(x)];
+      const size_t at = size_t(y + 1) * w1 + size_t(x + 1), up = size_t(y) * w1 + size_t(x + 1);
+      const bool use = r.known && !r.exact;
+      b2[at] = (use ? r.bias * r.bias : dvec3(0.0)) + b2[at - 1] + b2[up] - b2[up - 1];
+      v[at] = (use ? r.bias_variance : dvec3(0.0)) + v[at - 1] + v[up] - v[up - 1];
+      n[at] = (use ? 1.0 : 0.0) + n[at - 1] + n[up] - n[up - 1];
+    }
+  std::vector<dvec3> tau2(size_t(width) * size_t(height), dvec3(0.0));
+  parallel_for(size_t(height), 16, [&](size_t y0, size_t y1) {
+    for (size_t y = y0; y < y1; ++y)
+      for (size_t x = 0; x < size_t(width); ++x) {
+        const size_t xa = x >= kPriorWindow ? x - kPriorWindow : 0;
+        const size_t ya = y >= kPriorWindow ? y - kPriorWindow : 0;
+        const size_t xb = std::min(x + kPriorWindow + 1, size_t(width));
+        const size_t yb = std::min(y + kPriorWindow + 1, size_t(height));
+        auto box = [&](const auto& t) {
+          return t[yb * w1 + xb] - t[ya * w1 + xb] - t[yb * w1 + xa] + t[ya * w1 + xa];
+        };
+        const double count = box(n);
+        if (count > 0.0)
+          tau2[y * size_t(width) + x] = glm::max(dvec3(0.0), (box(b2) - box(v)) / count);
+      }
+  });
+  return tau2;
 }
 
 }  // namespace
@@ -110,6 +151,7 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
     image->radius.assign(pixels, 0.0f);
   }
 
+  const std::vector<dvec3> tau2 = bias_prior(results, eye.width, eye.height);
   double bound_sum = 0.0, noise_sum = 0.0, bias_sum = 0.0, bias_metric_sum = 0.0;
   uint64_t known = 0, below = 0;
   for (size_t p = 0; p < pixels; ++p) {
@@ -120,7 +162,18 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
       // PPM pixels without points see only background or exact emission: bound 0.
       const dvec3 sd = glm::sqrt(r.variance);
       noise = r.exact ? dvec3(0.0) : t * sd;
-      for (int c = 0; c < 3; ++c) bound[c] = r.exact ? 0.0 : quantile(r.bias[c], sd[c]);
+      // The bias is known only through its noisy estimate B: given the prior of the
+      // neighbourhood, the error's bias part is B shrunk by w = tau^2 / (tau^2 + Var B), with
+      // the posterior's variance w Var B added to the noise (section 6b).
+      for (int c = 0; c < 3; ++c) {
+        if (r.exact) {
+          bound[c] = 0.0;
+          continue;
+        }
+        const double vb = r.bias_variance[c], prior = tau2[p][c];
+        const double w = vb > 0.0 ? prior / (prior + vb) : 1.0;
+        bound[c] = quantile(w * r.bias[c], std::sqrt(r.variance[c] + w * vb));
+      }
       dvec3 metric = bound, bias_metric = glm::abs(r.bias);
       if (s.metric == ErrorMetric::Relative) {
         const dvec3 denominator = glm::max(r.radiance, dvec3(std::max(sum.relative_floor, 1e-300)));

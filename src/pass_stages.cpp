@@ -93,10 +93,15 @@ dvec3 direct_light(const World& world, const MeasurementPoint& point, Rng& rng) 
 
 void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
                  const HashGrid& grid, const std::vector<PhotonHit>& hits,
-                 std::span<PassGather> out) {
-  for (size_t k = 0; k < points.size(); ++k)
-    if (max_component(points[k].f) > 0.0f)  // SPPM: a pixel without a visible point this pass
-      gather_photons(points[k], states[k].r2, grid, hits, out[k]);
+                 const BoundaryIndex* boundary, std::span<PassGather> out) {
+  for (size_t k = 0; k < points.size(); ++k) {
+    const MeasurementPoint& p = points[k];
+    if (!(max_component(p.f) > 0.0f)) continue;  // SPPM: a pixel without a visible point
+    gather_photons(p, states[k].r2, grid, hits, out[k]);
+    if (boundary)
+      out[k].disc =
+          boundary->moments(p.triangle, p.position, p.normal, search_radius(states[k].r2));
+  }
 }
 
 void next_event_pass(const World& world, std::span<const MeasurementPoint> points, uint64_t seed,
@@ -131,7 +136,7 @@ void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> poi
       std::fill(out.begin(), out.end(), PassGather{});
       gather_pass(points.subspan(first + b, e - b),
                   std::span<const PointState>(states).subspan(first + b, e - b), in.grid, in.hits,
-                  out);
+                  in.boundary, out);
       if (in.next_event)
         next_event_pass(in.world, points.subspan(first + b, e - b), in.seed, in.pass, first + b,
                         out);
@@ -158,7 +163,7 @@ void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
       const std::span<PassGather> out = sums.subspan(b, e - b);
       trace_visible_points(camera, first + b, pts, out);
       gather_pass(pts, std::span<const PointState>(states).subspan(first + b, e - b), in.grid,
-                  in.hits, out);
+                  in.hits, in.boundary, out);
       if (in.next_event) next_event_pass(in.world, pts, in.seed, in.pass, first + b, out);
       for (size_t k = 0; k < pts.size(); ++k)  // saturating: 2^32 - 1 passes is far beyond use
         if (max_component(pts[k].f) > 0.0f && visible[first + b + k] != UINT32_MAX)

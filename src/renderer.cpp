@@ -69,6 +69,9 @@ Renderer::Renderer(Scene scene, const RenderOptions& options)
   params_.min_r2 = r_min * r_min;
   initial_radius_ =
       options_.radius ? std::max(*options_.radius, r_min) : default_initial_radius(eye_, world_);
+  // Radii only shrink: segments farther than the initial radius (as a float, what queries use)
+  // from a triangle never matter to its points.
+  boundary_ = BoundaryIndex(world_, std::nextafter(float(initial_radius_), INFINITY));
   PointState initial;
   initial.r2 = initial_radius_ * initial_radius_;
   states_.assign(states, initial);
@@ -110,7 +113,7 @@ void Renderer::step(std::vector<PointState>* copy) {
   t = Clock::now();
   const bool nee = options_.direct == DirectMode::NextEvent;
   if (copy) copy->resize(n);
-  const PassInputs in{world_, grid_, hits_, params_, options_.seed, pass, nee};
+  const PassInputs in{world_, grid_, hits_, params_, &boundary_, options_.seed, pass, nee};
   PointState* const out = copy ? copy->data() : nullptr;
   if (options_.method == Method::PPM) {
     gather_and_fold(in, eye_.points, states_, radii_, sums_, out);

@@ -1,5 +1,7 @@
 #include "photonbound/world.h"
 
+#include <algorithm>
+
 namespace pb {
 
 World::World(Scene scene)
@@ -19,11 +21,27 @@ World::World(Scene scene)
       const vec3& p2 = m.positions[m.indices[3 * t + 2]];
       face_normals_[first + t] = glm::normalize(glm::cross(p1 - p0, p2 - p0));
     }
+    first_triangle_.push_back(uint32_t(first));
     meshes_.push_back({m.positions.data(), m.normals.empty() ? nullptr : m.normals.data(),
                        m.indices.data(), face_normals_.data() + first,
                        &scene_.materials[m.material]});
     first += n;
   }
+  first_triangle_.push_back(uint32_t(first));
+}
+
+uint32_t World::mesh_of(uint32_t t) const {
+  const auto it = std::upper_bound(first_triangle_.begin(), first_triangle_.end(), t);
+  return uint32_t(it - first_triangle_.begin()) - 1;
+}
+
+void World::triangle(uint32_t t, vec3& a, vec3& b, vec3& c) const {
+  const uint32_t m = mesh_of(t);
+  const MeshView& mv = meshes_[m];
+  const uint32_t* tri = mv.indices + 3 * size_t(t - first_triangle_[m]);
+  a = mv.positions[tri[0]];
+  b = mv.positions[tri[1]];
+  c = mv.positions[tri[2]];
 }
 
 }  // namespace pb

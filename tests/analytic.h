@@ -44,23 +44,54 @@ struct Accuracy {
   size_t samples = 0;
 };
 
-inline Accuracy measure(const Renderer& r, const std::function<double(const vec3&)>& exact,
-                        double confidence) {
+// The exact value of every pixel, what the render estimates: PPM, the exact answer at the
+// pixel's (first) measurement point (NaN without one: an exact pixel); SPPM, the average of the
+// exact answer over the pixel's area (ESTIMATOR.md section 10), from sub x sub stratified
+// camera rays (0 where a ray misses: black background).
+inline std::vector<double> pixel_truth(const Renderer& r,
+                                       const std::function<double(const vec3&)>& exact,
+                                       int sub = 16) {
+  const EyePassResult& eye = r.eye();
+  const size_t pixels = size_t(eye.width) * size_t(eye.height);
+  std::vector<double> truth(pixels, std::nan(""));
+  if (r.options().method == Method::PPM) {
+    for (size_t p = 0; p < pixels; ++p)
+      if (eye.pixel_begin[p] != eye.pixel_begin[p + 1])
+        truth[p] = exact(eye.points[eye.pixel_begin[p]].position);
+    return truth;
+  }
+  for (size_t p = 0; p < pixels; ++p) {
+    const int x = int(p % size_t(eye.width)), y = int(p / size_t(eye.width));
+    double sum = 0.0;
+    for (int j = 0; j < sub; ++j)
+      for (int i = 0; i < sub; ++i) {
+        const vec3 d = r.camera().direction(float(x) + (float(i) + 0.5f) / float(sub),
+                                            float(y) + (float(j) + 0.5f) / float(sub));
+        Hit hit;
+        if (r.world().accel().intersect(r.camera().origin(), d, 0.0f, INFINITY, hit))
+          sum += exact(r.world().surface(hit).position);
+      }
+    truth[p] = sum / double(sub * sub);
+  }
+  return truth;
+}
+
+// Actual error and coverage against per-pixel exact values (pixel_truth), over pixel-channels
+// with a known bound.
+inline Accuracy measure(const Renderer& r, const std::vector<double>& truth, double confidence) {
   FilmSettings s = r.film_settings();
   s.confidence = confidence;
   FilmImage img;
-  develop(r.eye(), r.states(), r.passes(), s, &img);
+  develop(r.layout(), r.states(), r.passes(), s, &img);
   Accuracy a;
   double err_sum = 0.0, bound_sum = 0.0;
   size_t covered = 0;
-  for (size_t p = 0; p + 1 < r.eye().pixel_begin.size(); ++p) {
-    const uint32_t k = r.eye().pixel_begin[p];
-    if (k == r.eye().pixel_begin[p + 1]) continue;  // no measurement point: exact pixel
-    const double truth = exact(r.eye().points[k].position);
+  for (size_t p = 0; p < truth.size(); ++p) {
+    if (std::isnan(truth[p])) continue;  // no measurement point: exact pixel
     for (int c = 0; c < 3; ++c) {
       const double bound = img.bound[3 * p + size_t(c)];
       if (!std::isfinite(bound)) continue;
-      const double err = std::fabs(double(img.radiance[3 * p + size_t(c)]) - truth);
+      const double err = std::fabs(double(img.radiance[3 * p + size_t(c)]) - truth[p]);
       err_sum += err;
       bound_sum += bound;
       covered += err <= bound;
@@ -73,6 +104,11 @@ inline Accuracy measure(const Renderer& r, const std::function<double(const vec3
     a.coverage = double(covered) / double(a.samples);
   }
   return a;
+}
+
+inline Accuracy measure(const Renderer& r, const std::function<double(const vec3&)>& exact,
+                        double confidence) {
+  return measure(r, pixel_truth(r, exact), confidence);
 }
 
 }  // namespace pb::analytic
@@ -94,10 +130,11 @@ inline std::vector<CoverageRow> coverage_run(const std::string& name, RenderOpti
   const Case sc = by_name(name);
   const pb::Scene scene = load_gltf(o.scene);
   Renderer r(scene, o);
+  const std::vector<double> truth = pixel_truth(r, sc.exact);
   std::vector<CoverageRow> rows;
   for (uint64_t n : checkpoints) {
     while (r.passes() < n) r.step();
-    for (double c : confidences) rows.push_back({name, n, c, measure(r, sc.exact, c)});
+    for (double c : confidences) rows.push_back({name, n, c, measure(r, truth, c)});
   }
   return rows;
 }
@@ -126,14 +163,14 @@ inline TerminationRow termination_run(const std::string& name, RenderOptions o) 
   row.mean_bound = report.summary.mean_bound;
   row.stop_reason = stop_text(report.stop);
   FilmImage img;
-  develop(r.eye(), r.states(), r.passes(), r.film_settings(), &img);
+  r.develop(&img);
+  const std::vector<double> truth = pixel_truth(r, sc.exact);
   double sum = 0.0;
   size_t n = 0;
-  for (size_t p = 0; p + 1 < r.eye().pixel_begin.size(); ++p) {
-    const uint32_t k = r.eye().pixel_begin[p];
-    if (k == r.eye().pixel_begin[p + 1]) continue;
-    const double truth = sc.exact(r.eye().points[k].position);
-    for (int c = 0; c < 3; ++c) sum += std::fabs(double(img.radiance[3 * p + size_t(c)]) - truth);
+  for (size_t p = 0; p < truth.size(); ++p) {
+    if (std::isnan(truth[p])) continue;
+    for (int c = 0; c < 3; ++c)
+      sum += std::fabs(double(img.radiance[3 * p + size_t(c)]) - truth[p]);
     n += 3;
   }
   row.actual = n ? sum / double(n) : 0.0;

@@ -1,6 +1,7 @@
 // Prints the README's evidence for the error bounds: coverage against the exact answers of the
 // analytic scenes, and renders to halving target errors (specified vs actual error).
-// Run: build/tests/bounds_study  (about a few minutes on 2 cores)
+// Run: build/tests/bounds_study [all|coverage|termination|stopping] [ppm|sppm]
+// (a few minutes on 2 cores)
 #include "analytic.h"
 #include "render_fixture.h"
 
@@ -10,8 +11,17 @@ namespace {
 
 using namespace pb;
 
+Method g_method = Method::PPM;  // `bounds_study TABLE sppm` studies SPPM
+
+RenderOptions study_options(const std::string& scene, int size, uint64_t passes) {
+  RenderOptions o = test::quick_options(scene, size, passes);
+  o.method = g_method;
+  return o;
+}
+
 void coverage_table() {
-  std::printf("### Coverage against the exact answer (64x64, 4 seeds pooled)\n\n");
+  std::printf("### Coverage against the exact answer (%s, 64x64, 4 seeds pooled)\n\n",
+              g_method == Method::PPM ? "PPM" : "SPPM");
   std::printf(
       "| scene | direct | passes | confidence | mean actual error | mean bound | bound / actual | "
       "coverage |\n");
@@ -21,10 +31,10 @@ void coverage_table() {
   for (const auto& [name, mode] : cases) {
     std::vector<analytic::CoverageRow> pooled;
     for (uint64_t seed = 1; seed <= 4; ++seed) {
-      RenderOptions o = test::quick_options(analytic::by_name(name).file, 64, 256);
+      RenderOptions o = study_options(analytic::by_name(name).file, 64, 256);
       o.direct = mode;
       o.seed = seed;
-      const auto rows = analytic::coverage_run(name, o, {16, 64, 256}, {0.5, 0.9});
+      const auto rows = analytic::coverage_run(name, o, {16, 64, 256}, {0.5, 0.9, 0.95});
       if (pooled.empty()) {
         pooled = rows;
         continue;
@@ -58,7 +68,7 @@ void termination_table() {
   for (double confidence : {0.5, 0.9}) {
     for (double target : confidence < 0.7 ? std::vector<double>{0.016, 0.008, 0.004}
                                           : std::vector<double>{0.04, 0.02, 0.01}) {
-      RenderOptions o = test::quick_options("plane_point.gltf", 32, 100000);
+      RenderOptions o = study_options("plane_point.gltf", 32, 100000);
       o.passes.reset();
       o.direct = DirectMode::Photons;
       o.confidence = confidence;
@@ -85,7 +95,7 @@ void stopping_table() {
     int above = 0;
     double ratio = 0.0, passes = 0.0;
     for (int seed = 1; seed <= kSeeds; ++seed) {
-      RenderOptions o = test::quick_options("plane_point.gltf", 32, 1);
+      RenderOptions o = study_options("plane_point.gltf", 32, 1);
       o.passes = 100000;
       o.direct = DirectMode::Photons;
       o.confidence = confidence;
@@ -107,6 +117,7 @@ void stopping_table() {
 
 int main(int argc, char** argv) {
   const std::string which = argc > 1 ? argv[1] : "all";
+  if (argc > 2 && std::string(argv[2]) == "sppm") g_method = Method::SPPM;
   if (which == "all" || which == "coverage") coverage_table();
   if (which == "all" || which == "termination") termination_table();
   if (which == "all" || which == "stopping") stopping_table();

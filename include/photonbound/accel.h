@@ -29,6 +29,17 @@ class Accel {
   // True when anything lies along the segment (tnear, tfar).
   bool occluded(const vec3& origin, const vec3& dir, float tnear, float tfar) const;
 
+  // Calls visit(mesh, prim) for every triangle whose bounding box meets the sphere (a superset
+  // of the triangles within `radius` of `center`; the caller tests the geometry itself).
+  using SphereVisit = void (*)(void* user, uint32_t mesh, uint32_t prim);
+  void query_sphere(const vec3& center, float radius, SphereVisit visit, void* user) const;
+  template <class F>
+  void query_sphere(const vec3& center, float radius, F&& f) const {
+    query_sphere(
+        center, radius,
+        [](void* u, uint32_t mesh, uint32_t prim) { (*static_cast<F*>(u))(mesh, prim); }, &f);
+  }
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;

@@ -3,6 +3,7 @@
 // ESTIMATOR.md sections 3 and 4 specify. Depends on math only: tested without a scene.
 #pragma once
 
+#include "photonbound/boundary.h"
 #include "photonbound/math.h"
 
 #include <cstdint>
@@ -15,6 +16,7 @@ struct PassGather {
   dvec3 phi_lap_r2{0.0};  // sum of w_lap(t) R_j^2 f Phi (divided by R_j^2 in the update)
   uint64_t count = 0;     // M_j: photons that landed within R_j on the point's side
   dvec3 direct{0.0};      // D_j: next-event estimate of direct light (0 with --direct photons)
+  DiscMoments disc;       // the kernel's moments over the reachable part of the disc (section 11)
 };
 
 // Everything the estimator keeps for one point, in double (ESTIMATOR.md section 8).
@@ -34,6 +36,10 @@ struct PointState {
   double c_rr = 0.0;
 };
 static_assert(sizeof(PointState) == 160, "the per-point memory budget counts on 160 bytes");
+
+// The smallest kernel mass a boundary correction divides by: a point whose disc is almost all
+// off its surface (the tip of a sliver) is not amplified beyond 1000x.
+inline constexpr double kMinKernelMass = 1e-3;
 
 struct EstimatorParams {
   double alpha = 0.7;             // PPM radius reduction, in (0, 1]
@@ -55,10 +61,17 @@ struct PointEstimate {
   dvec3 radiance{0.0};  // L_i = mean_j X_j (mean_x)
   dvec3 bias{0.0};      // B_i = 0.5 k2 Lap_i mean_j(R_j^2), signed
   dvec3 variance{0.0};  // S^2 / i: variance of the mean after the retroactive bias correction
-  bool known = false;   // false until kMinPhotonsForBound photons and passes >= 2
+  // Variance of the bias estimate B_i itself (section 6b): the Laplacian estimate is noisy.
+  dvec3 bias_variance{0.0};
+  bool known = false;  // false until kMinPhotonsForBound photons and passes >= 2
 };
 
 PointEstimate estimate(const PointState& state, uint64_t passes, double photons_per_pass);
+
+// Variance of the kernel estimate's bias estimate against that of the estimate itself, for
+// photons of a Poisson process: (0.5 k2)^2 integral (lap kappa)^2 / integral kappa^2 over the
+// unit disc (ESTIMATOR.md section 6b; the kernel test checks it by quadrature).
+inline constexpr double kBiasNoiseRatio = 0.36025628811821314;
 
 // Beyond ESTIMATOR.md section 7 (a point without photons is unknown): a t-interval over a
 // handful of Poisson arrivals is too short on the high side. Measured with a photon once per

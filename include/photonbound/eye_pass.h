@@ -22,8 +22,9 @@ struct MeasurementPoint {
   // S^2) already weighted, so a pixel is the plain sum of its points (ESTIMATOR.md section 5
   // with W_k moved inside), and the point needs one colour instead of two.
   vec3 f{0.0f};
+  uint32_t triangle = 0;  // World::triangle_index of the hit: the boundary index's key
 };
-static_assert(sizeof(MeasurementPoint) == 48, "the per-point memory budget counts on 48 bytes");
+static_assert(sizeof(MeasurementPoint) == 52, "the per-point memory budget counts on 52 bytes");
 
 struct EyePassResult {
   int width = 0, height = 0;

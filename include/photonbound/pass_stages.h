@@ -10,6 +10,7 @@
 // 5: a distributed render reduces exactly that array across machines before folding it.
 #pragma once
 
+#include "photonbound/boundary.h"
 #include "photonbound/estimator.h"
 #include "photonbound/eye_pass.h"
 #include "photonbound/hash_grid.h"
@@ -45,9 +46,11 @@ dvec3 direct_light(const World& world, const MeasurementPoint& point, Rng& rng);
 // Stage 3: adds the photons of the pass at points[k] into out[k] (phi, phi_lap_r2, count).
 // states[k].r2 is the radius of the pass. A point with f = 0 (SPPM: no visible point this
 // pass) gathers nothing and so does not shrink its radius.
+// With `boundary`, also the kernel's moments over the reachable part of each point's disc
+// (ESTIMATOR.md section 11); without, every disc counts as whole.
 void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
                  const HashGrid& grid, const std::vector<PhotonHit>& hits,
-                 std::span<PassGather> out);
+                 const BoundaryIndex* boundary, std::span<PassGather> out);
 
 // Stage 4: adds one next-event sample at points[k] to out[k].direct, drawn from
 // Rng(seed, pass, first + k, Stream::DirectLight): point (or pixel) first + k's own stream.
@@ -69,6 +72,7 @@ struct PassInputs {
   const HashGrid& grid;
   const std::vector<PhotonHit>& hits;
   const EstimatorParams& params;
+  const BoundaryIndex* boundary = nullptr;
   uint64_t seed = 0, pass = 0;
   bool next_event = true;
 };

@@ -5,6 +5,7 @@
 // stop, what to print and when to checkpoint belong to the driver (driver.h).
 #pragma once
 
+#include "photonbound/boundary.h"
 #include "photonbound/estimator.h"
 #include "photonbound/eye_pass.h"
 #include "photonbound/film.h"
@@ -96,7 +97,9 @@ class Renderer {
   FilmSettings film_settings() const;
   const PhaseTimings& timings() const { return timings_; }
   const World& world() const { return world_; }
+  const PinholeCamera& camera() const { return camera_; }
   double initial_radius() const { return initial_radius_; }
+  const BoundaryIndex& boundary() const { return boundary_; }
 
  private:
   ExrImage image(const RunInfo& run, const WorkCounters& work, double initial_radius,
@@ -110,6 +113,7 @@ class Renderer {
   EstimatorParams params_;
   PhotonTracer tracer_;
   HashGrid grid_;
+  BoundaryIndex boundary_;  // where surfaces end, for discs up to the initial radius
   std::vector<PhotonHit> hits_;
   std::vector<vec3> hit_positions_;
   std::vector<float> radii_;                      // search_radius(r2) per point, for the grid build

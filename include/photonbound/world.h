@@ -73,6 +73,19 @@ class World {
     return tfar > 0.0f && accel_.occluded(origin, dir, 0.0f, tfar);
   }
 
+  // Triangles by one global index (mesh after mesh, in Scene order), for the boundary index.
+  uint32_t triangle_count() const { return uint32_t(face_normals_.size()); }
+  uint32_t triangle_index(uint32_t mesh, uint32_t prim) const {
+    return first_triangle_[mesh] + prim;
+  }
+  uint32_t triangle_index(const Hit& hit) const { return triangle_index(hit.mesh, hit.prim); }
+  const vec3& face_normal(uint32_t triangle) const { return face_normals_[triangle]; }
+  // The three corners of a triangle, in winding order.
+  void triangle(uint32_t t, vec3& a, vec3& b, vec3& c) const;
+  // The mesh a triangle belongs to, and its material.
+  uint32_t mesh_of(uint32_t t) const;
+  const Material& material_of(uint32_t t) const { return *meshes_[mesh_of(t)].material; }
+
  private:
   // What surface() reads, without the indirection through Scene::meshes. The face normals
   // normalize(cross(p1 - p0, p2 - p0)) are precomputed (12 bytes per triangle): one load per
@@ -88,6 +101,7 @@ class World {
   const Scene scene_;
   std::vector<vec3> face_normals_;  // all meshes, concatenated
   std::vector<MeshView> meshes_;
+  std::vector<uint32_t> first_triangle_;  // per mesh, and the total last
   Accel accel_;
   Lights lights_;
   float scene_size_;

@@ -1,0 +1,69 @@
+// Where the surface under a kernel disc ends (ESTIMATOR.md section 11). At a point a distance d
+// from an edge of its surface, the disc of radius R reaches past the edge, where no photon can
+// land; the kernel estimate is then about c L, with c the share of the kernel's mass on the
+// surface, and the Laplacian kernel no longer integrates to zero. Only the geometry can give c
+// (photons cannot tell "no surface" from "no light"), so the index below finds, once per scene,
+// every segment where a surface ends as the gather sees it:
+//  - border edges of a triangle (no neighbour shares them) and creases whose neighbour faces
+//    away (normals at 90 degrees or more: the gather's same-side test rejects its photons);
+//  - blockers: other geometry rising from a surface (a block standing on a floor), cut with the
+//    surface's plane;
+// and lists, per triangle, the segments within the largest radius of it. moments() then
+// integrates the kernel over the part of the disc visible from the point within those
+// segments, in polar coordinates about the point (the star-shaped region of the disc the point
+// sees along its surface).
+#pragma once
+
+#include "photonbound/math.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace pb {
+
+class World;
+
+// Moments of the unit-mass kernel kappa and of its Laplacian over the part S of the unit disc
+// (u = (x - p) / R) that lies on reachable surface. The full disc has mass 1, second moment
+// 2 k2 = 5/24 (of |u|^2), Laplacian mass 0 and Laplacian second moment 4.
+struct DiscMoments {
+  double mass = 1.0;        // c = integral over S of kappa
+  double second = 5.0 / 24.0;  // integral over S of |u|^2 kappa
+  double lap_mass = 0.0;    // integral over S of lap kappa
+  double lap_second = 4.0;  // integral over S of |u|^2 lap kappa
+  bool full = true;         // S is the whole disc (the exact values above)
+};
+
+class BoundaryIndex {
+ public:
+  BoundaryIndex() = default;
+  // Segments of `world` and, per triangle, those within max_radius of it.
+  BoundaryIndex(const World& world, float max_radius);
+
+  // The disc of radius r about p, a point of triangle `triangle` whose normal on the side it is
+  // seen from is n. r must not exceed the index's max_radius.
+  DiscMoments moments(uint32_t triangle, const vec3& p, const vec3& n, float r) const;
+
+  size_t segment_count() const { return segments_.size(); }
+  size_t memory_bytes() const;
+
+  // Directions of the polar quadrature.
+  static constexpr int kDirections = 64;
+
+ private:
+  struct Segment {
+    vec3 a, b;
+  };
+  std::vector<Segment> segments_;
+  std::vector<uint32_t> start_;  // triangle t's segments: list_[start_[t], start_[t + 1])
+  std::vector<uint32_t> list_;
+};
+
+// The radial integrals of moments(), in closed form (kernel.h's quintic), for 0 <= a <= 1:
+// G(a) = integral from 0 to a of g(t) t dt for g = kappa, |u|^2 kappa, lap kappa, |u|^2 lap kappa.
+double kernel_mass_to(double a);
+double kernel_second_to(double a);
+double laplacian_mass_to(double a);
+double laplacian_second_to(double a);
+
+}  // namespace pb

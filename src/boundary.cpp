@@ -1,0 +1,352 @@
+#include "photonbound/boundary.h"
+
+#include "photonbound/counting_sort.h"
+#include "photonbound/parallel.h"
+#include "photonbound/world.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+
+namespace pb {
+
+// Closed forms of the radial integrals for the quintic kernel (kernel.h, ESTIMATOR.md section 2):
+// kappa(t) = 7/(2 pi) (1 - 10 t^3 + 15 t^4 - 6 t^5), lap kappa(t) = 105/pi (-3 t + 8 t^2 - 5 t^3).
+// Each G is integral_0^a g(t) t dt; over the whole disc 2 pi G(1) gives 1, 5/24, 0 and 4.
+double kernel_mass_to(double a) {
+  const double a2 = a * a, a5 = a2 * a2 * a;
+  return 7.0 / (2.0 * kPiD) * (a2 / 2.0 + a5 * (-2.0 + a * (2.5 - a * 6.0 / 7.0)));
+}
+double kernel_second_to(double a) {
+  const double a2 = a * a, a4 = a2 * a2, a7 = a4 * a2 * a;
+  return 7.0 / (2.0 * kPiD) * (a4 / 4.0 + a7 * (-10.0 / 7.0 + a * (15.0 / 8.0 - a * 2.0 / 3.0)));
+}
+double laplacian_mass_to(double a) {
+  const double a3 = a * a * a;
+  return 105.0 / kPiD * a3 * (-1.0 + a * (2.0 - a));
+}
+double laplacian_second_to(double a) {
+  const double a5 = a * a * a * a * a;
+  return 105.0 / kPiD * a5 * (-3.0 / 5.0 + a * (4.0 / 3.0 - a * 5.0 / 7.0));
+}
+
+namespace {
+
+constexpr int kK = BoundaryIndex::kDirections;
+
+struct Directions {
+  double c[kK], s[kK];
+  Directions() {
+    for (int k = 0; k < kK; ++k) {
+      const double th = (double(k) + 0.5) * 2.0 * kPiD / kK;
+      c[k] = std::cos(th);
+      s[k] = std::sin(th);
+    }
+  }
+};
+const Directions& directions() {
+  static const Directions d;
+  return d;
+}
+
+// Two triangles belong to one surface for the gather when its same-side test accepts photons
+// on both: normals less than 90 degrees apart (pass_stages.cpp, gather_photons).
+bool compatible(const vec3& n, const vec3& m) { return glm::dot(n, m) > 0.0f; }
+
+double segment_distance2(const vec3& p, const vec3& a, const vec3& b) {
+  const dvec3 ab = dvec3(b) - dvec3(a), ap = dvec3(p) - dvec3(a);
+  const double len2 = glm::dot(ab, ab);
+  const double s = len2 > 0.0 ? std::clamp(glm::dot(ap, ab) / len2, 0.0, 1.0) : 0.0;
+  const dvec3 d = ap - s * ab;
+  return glm::dot(d, d);
+}
+
+vec3 triangle_centre(const vec3 v[3]) { return (v[0] + v[1] + v[2]) / 3.0f; }
+
+float triangle_reach(const vec3 v[3]) {
+  const vec3 c = triangle_centre(v);
+  return std::sqrt(std::max({glm::dot(v[0] - c, v[0] - c), glm::dot(v[1] - c, v[1] - c),
+                             glm::dot(v[2] - c, v[2] - c)}));
+}
+
+// Clips segment [a, b] to the ball (c, r); false when they do not meet.
+bool clip_to_sphere(vec3& a, vec3& b, const vec3& c, float r) {
+  const dvec3 d = dvec3(b) - dvec3(a), f = dvec3(a) - dvec3(c);
+  const double qa = glm::dot(d, d), qb = 2.0 * glm::dot(f, d), qc = glm::dot(f, f) - double(r) * r;
+  if (!(qa > 0.0)) return qc <= 0.0;
+  const double disc = qb * qb - 4.0 * qa * qc;
+  if (disc < 0.0) return false;
+  const double sq = std::sqrt(disc);
+  const double s0 = std::max(0.0, (-qb - sq) / (2.0 * qa)), s1 = std::min(1.0, (-qb + sq) / (2.0 * qa));
+  if (s0 > s1) return false;
+  const dvec3 a0(a);
+  a = vec3(a0 + s0 * d);
+  b = vec3(a0 + s1 * d);
+  return true;
+}
+
+// An edge by its two corners, in a canonical order, as bit patterns (exact matching: shared
+// vertices of one mesh, and of meshes an exporter wrote from the same vertices).
+struct EdgeRecord {
+  uint32_t key[6];
+  uint32_t triangle;
+  uint8_t edge;
+};
+
+bool key_less(const EdgeRecord& x, const EdgeRecord& y) {
+  return std::memcmp(x.key, y.key, sizeof x.key) < 0;
+}
+
+void edge_key(const vec3& a, const vec3& b, uint32_t key[6]) {
+  uint32_t ka[3], kb[3];
+  std::memcpy(ka, &a, 12);
+  std::memcpy(kb, &b, 12);
+  const bool swap = std::memcmp(ka, kb, 12) > 0;
+  std::memcpy(key, swap ? kb : ka, 12);
+  std::memcpy(key + 3, swap ? ka : kb, 12);
+}
+
+// Whether point q lies on a triangle of `world` facing like n, within `tol` of its plane.
+bool covered(const World& world, const vec3& q, const vec3& n, float tol, uint32_t self) {
+  bool found = false;
+  world.accel().query_sphere(q, tol, [&](uint32_t mesh, uint32_t prim) {
+    const uint32_t t = world.triangle_index(mesh, prim);
+    if (found || t == self) return;
+    const vec3& m = world.face_normal(t);
+    if (glm::dot(m, n) < 0.99f) return;
+    vec3 a, b, c;
+    world.triangle(t, a, b, c);
+    if (std::fabs(glm::dot(q - a, m)) > tol) return;
+    // Barycentric inside test in the triangle's plane.
+    const vec3 e1 = b - a, e2 = c - a, w = q - a;
+    const float d11 = glm::dot(e1, e1), d12 = glm::dot(e1, e2), d22 = glm::dot(e2, e2);
+    const float w1 = glm::dot(w, e1), w2 = glm::dot(w, e2), den = d11 * d22 - d12 * d12;
+    if (!(den > 0.0f)) return;
+    const float u = (d22 * w1 - d12 * w2) / den, v = (d11 * w2 - d12 * w1) / den;
+    found = u >= -1e-4f && v >= -1e-4f && u + v <= 1.0f + 1e-4f;
+  });
+  return found;
+}
+
+}  // namespace
+
+BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
+  const uint32_t n = world.triangle_count();
+  // 1. Edges: sorted by their corners, so that the triangles sharing one are neighbours.
+  std::vector<EdgeRecord> edges(size_t(n) * 3);
+  parallel_for(n, 4096, [&](size_t b, size_t e) {
+    for (size_t t = b; t < e; ++t) {
+      vec3 v[3];
+      world.triangle(uint32_t(t), v[0], v[1], v[2]);
+      for (int k = 0; k < 3; ++k) {
+        EdgeRecord& r = edges[3 * t + size_t(k)];
+        edge_key(v[k], v[(k + 1) % 3], r.key);
+        r.triangle = uint32_t(t);
+        r.edge = uint8_t(k);
+      }
+    }
+  });
+  std::sort(edges.begin(), edges.end(), [](const EdgeRecord& x, const EdgeRecord& y) {
+    if (key_less(x, y)) return true;
+    if (key_less(y, x)) return false;
+    return x.triangle < y.triangle || (x.triangle == y.triangle && x.edge < y.edge);
+  });
+
+  // 2. Boundary edges: no neighbour on the edge whose photons the gather would accept. An edge
+  // nobody shares may still continue into a coplanar triangle that does not share its corners
+  // (a T-junction, or two meshes side by side): probed just outside the edge.
+  struct Pending {
+    uint32_t triangle;
+    Segment s;
+  };
+  std::vector<Pending> found;
+  // Points (and so discs) exist only on surfaces that are not mirrors or glass.
+  std::vector<uint8_t> host(n);
+  for (uint32_t t = 0; t < n; ++t) host[t] = world.material_of(t).model == Reflection::Lambertian;
+  for (size_t i = 0; i < edges.size();) {
+    size_t j = i + 1;
+    while (j < edges.size() && !key_less(edges[i], edges[j])) ++j;
+    for (size_t k = i; k < j; ++k) {
+      const uint32_t t = edges[k].triangle;
+      if (!host[t]) continue;
+      const vec3& nt = world.face_normal(t);
+      bool shared = false;
+      for (size_t q = i; q < j && !shared; ++q)
+        shared = edges[q].triangle != t && compatible(nt, world.face_normal(edges[q].triangle));
+      vec3 v[3];
+      world.triangle(t, v[0], v[1], v[2]);
+      const vec3 a = v[edges[k].edge], b = v[(edges[k].edge + 1) % 3];
+      if (!shared && j - i == 1) {
+        // Outward in the triangle's plane, a thousandth of the edge's length away.
+        const vec3 c = v[(edges[k].edge + 2) % 3];
+        const vec3 along = b - a;
+        vec3 out = glm::cross(along, nt);
+        if (glm::dot(out, c - a) > 0.0f) out = -out;
+        const float len = glm::length(along);
+        const float tol = 1e-3f * len + 1e-6f * max_component(glm::abs(a));
+        if (len > 0.0f) {
+          out *= tol / glm::length(out);
+          shared = covered(world, a + 0.25f * along + out, nt, 2.0f * tol, t) &&
+                   covered(world, a + 0.5f * along + out, nt, 2.0f * tol, t) &&
+                   covered(world, a + 0.75f * along + out, nt, 2.0f * tol, t);
+        }
+      }
+      if (!shared) found.push_back({t, {a, b}});
+    }
+    i = j;
+  }
+  std::vector<EdgeRecord>().swap(edges);
+  if (std::getenv("PB_BOUNDARY_DEBUG")) std::fprintf(stderr, "boundary: %zu edge segments\n", found.size());
+
+  // 3. Blockers: a triangle u rising through the plane of a triangle t it shares no corner
+  // with (a block standing on a floor) ends t's reachable surface where it crosses, just above
+  // the plane (at half the crossing tolerance: a face resting on the plane counts).
+  std::vector<std::vector<Pending>> blockers(n);
+  parallel_for(n, 256, [&](size_t b, size_t e) {
+    for (size_t uu = b; uu < e; ++uu) {
+      const uint32_t u = uint32_t(uu);
+      vec3 w[3];
+      world.triangle(u, w[0], w[1], w[2]);
+      const vec3 centre = triangle_centre(w);
+      const float reach = triangle_reach(w), size = reach;
+      const uint32_t mesh_of_u = world.mesh_of(u);
+      world.accel().query_sphere(centre, reach, [&](uint32_t mesh, uint32_t prim) {
+        const uint32_t t = world.triangle_index(mesh, prim);
+        if (t == u || !host[t]) return;
+        // Only other objects block: a surface folding through its own tangent planes (the
+        // bumps of one displaced mesh) is the surface the kernel integrates over, whatever its
+        // shape, and a surface bending up through the plane is one whose photons the gather
+        // accepts.
+        if (mesh_of_u == world.mesh_of(t) || compatible(world.face_normal(t), world.face_normal(u)))
+          return;
+        vec3 v[3];
+        world.triangle(t, v[0], v[1], v[2]);
+        for (const vec3& x : v)
+          for (const vec3& y : w)
+            if (x == y) return;  // neighbours: their shared edge or corner is a crease
+        const vec3& nt = world.face_normal(t);
+        const float level =
+            0.5f * (1e-3f * size + 1e-6f * max_component(glm::abs(centre)));  // half the tolerance
+        float d[3];
+        for (int k = 0; k < 3; ++k) d[k] = glm::dot(w[k] - v[0], nt) - level;
+        if (!(std::min({d[0], d[1], d[2]}) < 0.0f && std::max({d[0], d[1], d[2]}) > 0.0f)) return;
+        // The two points where u's edges cross the level.
+        vec3 cut[2];
+        int m = 0;
+        for (int k = 0; k < 3 && m < 2; ++k) {
+          const float d0 = d[k], d1 = d[(k + 1) % 3];
+          if ((d0 < 0.0f) == (d1 < 0.0f)) continue;
+          const float s = d0 / (d0 - d1);
+          cut[m++] = w[k] + s * (w[(k + 1) % 3] - w[k]);
+        }
+        // Only the part within reach of t's points matters (max_radius past t's bounding
+        // sphere): clipped there, so that a wall crossing a small triangle's plane far away
+        // adds nothing.
+        if (m == 2 && clip_to_sphere(cut[0], cut[1], triangle_centre(v), triangle_reach(v) + max_radius))
+          blockers[uu].push_back({t, {cut[0], cut[1]}});
+      });
+    }
+  });
+  for (std::vector<Pending>& list : blockers) {
+    found.insert(found.end(), list.begin(), list.end());
+    std::vector<Pending>().swap(list);
+  }
+
+  if (std::getenv("PB_BOUNDARY_DEBUG")) std::fprintf(stderr, "boundary: %zu segments with blockers\n", found.size());
+  // 4. Each segment is listed for every triangle of its host's surface within max_radius.
+  segments_.resize(found.size());
+  std::vector<std::vector<std::pair<uint32_t, uint32_t>>> near(found.size());
+  parallel_for(found.size(), 64, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i) {
+      const Pending& f = found[i];
+      segments_[i] = f.s;
+      const vec3& nh = world.face_normal(f.triangle);
+      const vec3 mid = 0.5f * (f.s.a + f.s.b);
+      const float radius = 0.5f * glm::length(f.s.b - f.s.a) + max_radius;
+      world.accel().query_sphere(mid, radius, [&](uint32_t mesh, uint32_t prim) {
+        const uint32_t t = world.triangle_index(mesh, prim);
+        if (!host[t] || !compatible(world.face_normal(t), nh)) return;
+        vec3 v[3];
+        world.triangle(t, v[0], v[1], v[2]);
+        const double reach = double(triangle_reach(v)) + max_radius;
+        if (segment_distance2(triangle_centre(v), f.s.a, f.s.b) < reach * reach)
+          near[i].emplace_back(t, uint32_t(i));
+      });
+    }
+  });
+  std::vector<std::pair<uint32_t, uint32_t>> pairs;
+  for (auto& v : near) {
+    pairs.insert(pairs.end(), v.begin(), v.end());
+    std::vector<std::pair<uint32_t, uint32_t>>().swap(v);
+  }
+  if (std::getenv("PB_BOUNDARY_DEBUG")) std::fprintf(stderr, "boundary: %zu pairs\n", pairs.size());
+  std::sort(pairs.begin(), pairs.end());
+  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
+  start_.assign(size_t(n) + 1, 0);
+  for (const auto& [t, s] : pairs) ++start_[t + 1];
+  for (uint32_t t = 0; t < n; ++t) start_[t + 1] += start_[t];
+  list_.resize(pairs.size());
+  for (size_t k = 0; k < pairs.size(); ++k) list_[k] = pairs[k].second;
+}
+
+size_t BoundaryIndex::memory_bytes() const {
+  return segments_.capacity() * sizeof(Segment) + start_.capacity() * sizeof(uint32_t) +
+         list_.capacity() * sizeof(uint32_t);
+}
+
+DiscMoments BoundaryIndex::moments(uint32_t triangle, const vec3& p, const vec3& n,
+                                   float r) const {
+  DiscMoments m;
+  if (start_.empty()) return m;
+  // The segments within r of p, projected into p's tangent plane.
+  constexpr int kMaxNear = 64;
+  double ax[kMaxNear], ay[kMaxNear], ex[kMaxNear], ey[kMaxNear];
+  int count = 0;
+  const double r2 = double(r) * double(r);
+  vec3 t1, t2;
+  orthonormal_basis(n, t1, t2);
+  for (uint32_t k = start_[triangle]; k < start_[triangle + 1] && count < kMaxNear; ++k) {
+    const Segment& s = segments_[list_[k]];
+    if (segment_distance2(p, s.a, s.b) >= r2) continue;
+    const dvec3 a = dvec3(s.a) - dvec3(p), b = dvec3(s.b) - dvec3(p);
+    ax[count] = glm::dot(a, dvec3(t1));
+    ay[count] = glm::dot(a, dvec3(t2));
+    ex[count] = glm::dot(b, dvec3(t1)) - ax[count];
+    ey[count] = glm::dot(b, dvec3(t2)) - ay[count];
+    ++count;
+  }
+  if (count == 0) return m;
+  // Polar quadrature about p: in each direction the visible extent rho (the first segment the
+  // ray meets, or r), and the radial integrals to rho / r (midpoint rule in the angle).
+  const Directions& dir = directions();
+  double mass = 0.0, second = 0.0, lap = 0.0, lap2 = 0.0;
+  for (int k = 0; k < kK; ++k) {
+    const double dx = dir.c[k], dy = dir.s[k];
+    double rho = double(r);
+    for (int i = 0; i < count; ++i) {
+      // p + t d = a + s e: t = cross(a, e) / cross(d, e), s = cross(a, d) / cross(d, e).
+      const double den = dx * ey[i] - dy * ex[i];
+      if (std::fabs(den) < 1e-300) continue;
+      const double t = (ax[i] * ey[i] - ay[i] * ex[i]) / den;
+      const double s = (ax[i] * dy - ay[i] * dx) / den;
+      if (t >= 0.0 && s >= 0.0 && s <= 1.0) rho = std::min(rho, t);
+    }
+    const double a = rho / double(r);
+    mass += kernel_mass_to(a);
+    second += kernel_second_to(a);
+    lap += laplacian_mass_to(a);
+    lap2 += laplacian_second_to(a);
+  }
+  const double w = 2.0 * kPiD / kK;
+  m.mass = mass * w;
+  m.second = second * w;
+  m.lap_mass = lap * w;
+  m.lap_second = lap2 * w;
+  m.full = false;
+  return m;
+}
+
+}  // namespace pb
