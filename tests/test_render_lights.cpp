@@ -150,7 +150,9 @@ TEST(DirectionalRender, PlaneMatchesTheAnalyticAnswer) {
         // The image mean's spread over seeds 1-6 at these settings: 0.47% (its pixels share
         // photons, so it is far above one pixel's noise / sqrt(1024)); 2% is 4 of them.
         EXPECT_NEAR(mean, exact, 0.02 * exact);
-        EXPECT_GE(double(within), 0.85 * double(known));
+        // Nominal 90%; neighbouring pixels share photons, so one image's fraction varies by a
+        // few percent (measured 86-87%).
+        EXPECT_GE(double(within), 0.8 * double(known));
         EXPECT_EQ(known, r.film.radiance.size());
       }
     }
