@@ -68,8 +68,8 @@ vec3 triangle_centre(const vec3 v[3]) { return (v[0] + v[1] + v[2]) / 3.0f; }
 
 float triangle_reach(const vec3 v[3]) {
   const vec3 c = triangle_centre(v);
-  return std::sqrt(std::max({glm::dot(v[0] - c, v[0] - c), glm::dot(v[1] - c, v[1] - c),
-                             glm::dot(v[2] - c, v[2] - c)}));
+  return std::sqrt(std::max(
+      {glm::dot(v[0] - c, v[0] - c), glm::dot(v[1] - c, v[1] - c), glm::dot(v[2] - c, v[2] - c)}));
 }
 
 // Clips segment [a, b] to the ball (c, r); false when they do not meet.
@@ -80,7 +80,8 @@ bool clip_to_sphere(vec3& a, vec3& b, const vec3& c, float r) {
   const double disc = qb * qb - 4.0 * qa * qc;
   if (disc < 0.0) return false;
   const double sq = std::sqrt(disc);
-  const double s0 = std::max(0.0, (-qb - sq) / (2.0 * qa)), s1 = std::min(1.0, (-qb + sq) / (2.0 * qa));
+  const double s0 = std::max(0.0, (-qb - sq) / (2.0 * qa)),
+               s1 = std::min(1.0, (-qb + sq) / (2.0 * qa));
   if (s0 > s1) return false;
   const dvec3 a0(a);
   a = vec3(a0 + s0 * d);
@@ -199,7 +200,8 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
     i = j;
   }
   std::vector<EdgeRecord>().swap(edges);
-  if (std::getenv("PB_BOUNDARY_DEBUG")) std::fprintf(stderr, "boundary: %zu edge segments\n", found.size());
+  if (std::getenv("PB_BOUNDARY_DEBUG"))
+    std::fprintf(stderr, "boundary: %zu edge segments\n", found.size());
 
   // 3. Blockers: a triangle u rising through the plane of a triangle t it shares no corner
   // with (a block standing on a floor) ends t's reachable surface where it crosses, just above
@@ -245,7 +247,8 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
         // Only the part within reach of t's points matters (max_radius past t's bounding
         // sphere): clipped there, so that a wall crossing a small triangle's plane far away
         // adds nothing.
-        if (m == 2 && clip_to_sphere(cut[0], cut[1], triangle_centre(v), triangle_reach(v) + max_radius))
+        if (m == 2 &&
+            clip_to_sphere(cut[0], cut[1], triangle_centre(v), triangle_reach(v) + max_radius))
           blockers[uu].push_back({t, {cut[0], cut[1]}});
       });
     }
@@ -255,7 +258,8 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
     std::vector<Pending>().swap(list);
   }
 
-  if (std::getenv("PB_BOUNDARY_DEBUG")) std::fprintf(stderr, "boundary: %zu segments with blockers\n", found.size());
+  if (std::getenv("PB_BOUNDARY_DEBUG"))
+    std::fprintf(stderr, "boundary: %zu segments with blockers\n", found.size());
   // 4. Each segment is listed for every triangle of its host's surface within max_radius.
   segments_.resize(found.size());
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> near(found.size());
@@ -297,8 +301,7 @@ size_t BoundaryIndex::memory_bytes() const {
          list_.capacity() * sizeof(uint32_t);
 }
 
-DiscMoments BoundaryIndex::moments(uint32_t triangle, const vec3& p, const vec3& n,
-                                   float r) const {
+DiscMoments BoundaryIndex::moments(uint32_t triangle, const vec3& p, const vec3& n, float r) const {
   DiscMoments m;
   if (start_.empty()) return m;
   // The segments within r of p, projected into p's tangent plane.

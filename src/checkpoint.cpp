@@ -167,6 +167,9 @@ void save_state(const std::string& path, const SavedRender& s) {
   w.f64(s.schedule.early_bound);
   w.u64(s.render.visible.size());
   w.raw(s.render.visible.data(), s.render.visible.size() * sizeof(uint32_t));
+  w.u64(s.render.min_mass.size());
+  w.raw(s.render.min_mass.data(), s.render.min_mass.size() * sizeof(float));
+  w.f64(s.render.max_photon_power);
   const std::vector<PointState>& states = s.render.states;
   w.u64(states.size());
   // The states go to the file straight from the snapshot, without a copy into the buffer.
@@ -223,6 +226,11 @@ SavedRender load_state(const std::string& path) {
     if (v > r.remaining() / sizeof(uint32_t)) throw StateError(path + ": truncated state file");
     s.render.visible.resize(v);
     r.raw(s.render.visible.data(), v * sizeof(uint32_t));
+    const uint64_t mm = r.u64();
+    if (mm > r.remaining() / sizeof(float)) throw StateError(path + ": truncated state file");
+    s.render.min_mass.resize(mm);
+    r.raw(s.render.min_mass.data(), mm * sizeof(float));
+    s.render.max_photon_power = r.f64();
     const uint64_t n = r.u64();
     if (n > r.remaining() / sizeof(PointState)) throw StateError(path + ": truncated state file");
     s.render.states.resize(n);

@@ -31,6 +31,18 @@ EnvironmentLight::EnvironmentLight(const Environment& env)
   for (double& v : row_cdf_) v = total > 0.0 ? v / total : 0.0;
   if (total > 0.0) row_cdf_[h] = 1.0;
   integral_ = vec3(integral);
+  // radiance / pdf in a pixel: L omega / P(pixel), with P from the same tables sample() uses.
+  for (size_t y = 0; y < h; ++y) {
+    const double omega =
+        2.0 * kPiD / double(w) * (double(cos_theta(int(y))) - cos_theta(int(y) + 1));
+    const float* c = column_cdf_.data() + y * (w + 1);
+    for (size_t x = 0; x < w; ++x) {
+      const double p = (row_cdf_[y + 1] - row_cdf_[y]) * double(c[x + 1] - c[x]);
+      if (p > 0.0)
+        max_over_pdf_ =
+            std::max(max_over_pdf_, float(double(max_component(pixels_[y * w + x])) * omega / p));
+    }
+  }
 }
 
 float EnvironmentLight::cos_theta(int row) const {

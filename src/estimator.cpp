@@ -2,6 +2,7 @@
 
 #include "photonbound/kernel.h"
 
+#include <boost/math/distributions/chi_squared.hpp>
 #include <boost/math/distributions/normal.hpp>
 #include <boost/math/distributions/students_t.hpp>
 
@@ -154,6 +155,17 @@ double BoundQuantile::operator()(double bias, double sd) const {
   const int k = std::min(int(pos), kTable - 1);
   const double f = pos - k;
   return b + sd * (table_[k] * (1.0 - f) + table_[k + 1] * f);
+}
+
+double sparse_photon_bound(uint64_t photons, uint64_t passes, double cap, double confidence) {
+  if (passes == 0 || !(cap > 0.0)) return 0.0;
+  const double total =
+      photons == 0
+          ? -std::log1p(-confidence)
+          : 0.5 * boost::math::quantile(
+                      boost::math::chi_squared_distribution<double>(2.0 * double(photons) + 2.0),
+                      confidence);
+  return total / double(passes) * cap;
 }
 
 double student_t_quantile(double nu, double p) {

@@ -12,6 +12,7 @@ namespace {
 struct PixelResult {
   dvec3 radiance{0.0}, bias{0.0}, variance{0.0};
   dvec3 bias_variance{0.0};  // of the bias estimate (ESTIMATOR.md section 6b)
+  dvec3 sparse{0.0};         // bound of the photon part of states with few photons (section 12)
   double photons = 0.0;
   float radius = 0.0f;
   bool exact = false;  // PPM: no point, so nothing random (background, exact emission)
@@ -21,8 +22,21 @@ struct PixelResult {
 // L_pix = Le_seen + sum_k W_k L_k; B_pix = sum_k W_k B_k; Var_pix = sum_k W_k^2 S_k^2 / i
 // (ESTIMATOR.md section 5). W_k is already inside each point's estimate (MeasurementPoint::f).
 // SPPM (section 10): one state per pixel, whose samples carry the emission seen along the path.
+// The bound of a state's photon part while it has fewer than kMinPhotonsForBound photons.
+dvec3 sparse_term(const PixelLayout& layout, const PointState& s, size_t k, const vec3& f,
+                  uint64_t passes_with_point, double confidence) {
+  if (s.photons >= kMinPhotonsForBound || !(layout.photon_cap > 0.0)) return dvec3(0.0);
+  const double c = layout.mass.empty() ? 1.0 : std::max(double(layout.mass[k]), kMinKernelMass);
+  const double area = c * kPiD * s.r2;
+  dvec3 out;
+  for (int ch = 0; ch < 3; ++ch)
+    out[ch] = sparse_photon_bound(s.photons, passes_with_point, layout.photon_cap * f[ch] / area,
+                                  confidence);
+  return out;
+}
+
 PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& states, size_t pixel,
-                    uint64_t passes, double photons_per_pass) {
+                    uint64_t passes, double photons_per_pass, double confidence) {
   PixelResult r;
   if (layout.pixel_begin.empty()) {
     const PointEstimate e = estimate(states[pixel], passes, photons_per_pass);
@@ -34,8 +48,12 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
     r.radius = float(std::sqrt(states[pixel].r2));
     // A pixel that never had a visible point has no photon part to wait for: its samples are
     // the emission along its paths, known from two passes on.
-    const bool no_photon_part = !layout.visible_passes.empty() && layout.visible_passes[pixel] == 0;
-    r.known = passes >= 2 && (e.known || no_photon_part);
+    const uint64_t visible = layout.visible_passes.empty() ? passes : layout.visible_passes[pixel];
+    r.sparse = sparse_term(layout, states[pixel], pixel, layout.max_f, visible, confidence);
+    // Without the photon cap a state with few photons has no bound (unknown); a pixel that never
+    // had a visible point has no photon part to wait for.
+    r.known = passes >= 2 && (e.known || layout.photon_cap > 0.0 || visible == 0) &&
+              (layout.mass.empty() || visible == 0 || layout.mass[pixel] >= kValidKernelMass);
     return r;
   }
   if (!layout.emission.empty()) r.radiance = layout.emission[pixel];
@@ -49,7 +67,10 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
     r.photons += double(states[k].photons);
     if (r.exact) r.radius = float(std::sqrt(states[k].r2));
     r.exact = false;
-    r.known = r.known && e.known;
+    if (!layout.points.empty())
+      r.sparse += sparse_term(layout, states[k], k, layout.points[k].f, passes, confidence);
+    r.known = r.known && passes >= 2 && (e.known || layout.photon_cap > 0.0) &&
+              (layout.mass.empty() || layout.mass[k] >= kValidKernelMass);
   }
   return r;
 }
@@ -115,7 +136,13 @@ const std::vector<float>& FilmImage::plane(Channel id) const {
 }
 
 PixelLayout layout_of(const EyePassResult& eye) {
-  return {eye.width, eye.height, eye.pixel_begin, eye.emission, {}};
+  PixelLayout l;
+  l.width = eye.width;
+  l.height = eye.height;
+  l.pixel_begin = eye.pixel_begin;
+  l.emission = eye.emission;
+  l.points = eye.points;
+  return l;
 }
 
 FilmSummary develop(const EyePassResult& eye, const std::vector<PointState>& states,
@@ -129,7 +156,7 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
   std::vector<PixelResult> results(pixels);
   parallel_for(pixels, 1024, [&](size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p)
-      results[p] = combine(eye, states, p, passes, s.photons_per_pass);
+      results[p] = combine(eye, states, p, passes, s.photons_per_pass, s.confidence);
   });
 
   // No bound exists before two passes (nu = i - 1 >= 1).
@@ -172,7 +199,7 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
         }
         const double vb = r.bias_variance[c], prior = tau2[p][c];
         const double w = vb > 0.0 ? prior / (prior + vb) : 1.0;
-        bound[c] = quantile(w * r.bias[c], std::sqrt(r.variance[c] + w * vb));
+        bound[c] = quantile(w * r.bias[c], std::sqrt(r.variance[c] + w * vb)) + r.sparse[c];
       }
       dvec3 metric = bound, bias_metric = glm::abs(r.bias);
       if (s.metric == ErrorMetric::Relative) {

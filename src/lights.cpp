@@ -138,6 +138,26 @@ Lights::Lights(const Scene& scene)
     probability_[k] = float(weights[k] / sum);
   }
   cdf_.back() = 1.0;
+  // Per emitter: flux per photon = power / probability (sample_photon); a spot's photons carry
+  // up to its intensity times the cone's solid angle, a directional light's pi r^2 E, an
+  // environment map's pi r^2 times its largest radiance over its sampling density.
+  for (size_t k = 0; k < weights.size(); ++k) {
+    if (!(probability_[k] > 0.0f)) continue;
+    vec3 peak(0.0f);
+    if (k == punctual_.size() + triangles_.size()) {
+      peak = vec3(kPi * radius_ * radius_ * environment_->max_radiance_over_pdf());
+    } else if (k < punctual_.size()) {
+      const PunctualLight& l = punctual_[k];
+      peak = l.kind == PunctualKind::Point ? 4.0f * kPi * l.intensity
+             : l.kind == PunctualKind::Directional
+                 ? punctual_power(l, radius_)
+                 : l.intensity * (2.0f * kPi * (1.0f - l.cos_outer));
+    } else {
+      const Triangle& t = triangles_[k - punctual_.size()];
+      peak = lambertian_emitter_power(t.area, t.radiance);
+    }
+    max_photon_flux_ = std::max(max_photon_flux_, max_component(peak) / probability_[k]);
+  }
 }
 
 size_t Lights::pick(float u) const {

@@ -152,8 +152,9 @@ void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> poi
 
 void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
                           std::span<PointState> states, std::span<float> radii,
-                          std::span<uint32_t> visible, std::span<MeasurementPoint> points,
-                          std::span<PassGather> sums, PointState* copy) {
+                          std::span<uint32_t> visible, std::span<float> min_mass,
+                          std::span<MeasurementPoint> points, std::span<PassGather> sums,
+                          PointState* copy) {
   constexpr size_t kGrain = 256;  // pixels per parallel task inside a block
   const size_t n = states.size(), block = sums.size();
   for (size_t first = 0; first < n; first += block) {
@@ -165,9 +166,12 @@ void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
       gather_pass(pts, std::span<const PointState>(states).subspan(first + b, e - b), in.grid,
                   in.hits, in.boundary, out);
       if (in.next_event) next_event_pass(in.world, pts, in.seed, in.pass, first + b, out);
-      for (size_t k = 0; k < pts.size(); ++k)  // saturating: 2^32 - 1 passes is far beyond use
-        if (max_component(pts[k].f) > 0.0f && visible[first + b + k] != UINT32_MAX)
-          ++visible[first + b + k];
+      for (size_t k = 0; k < pts.size(); ++k) {
+        if (!(max_component(pts[k].f) > 0.0f)) continue;
+        const size_t pixel = first + b + k;
+        if (visible[pixel] != UINT32_MAX) ++visible[pixel];  // saturating: far beyond use
+        min_mass[pixel] = std::min(min_mass[pixel], float(out[k].disc.mass));
+      }
     });
     // A distributed render reduces sums[0, count) across machines here.
     parallel_for(count, kGrain, [&](size_t b, size_t e) {

@@ -86,6 +86,7 @@ PhotonPassStats PhotonTracer::run(uint64_t seed, uint64_t pass, uint64_t count,
   const size_t chunks = size_t((count + kChunk - 1) / kChunk);
   if (chunk_hits_.size() < chunks) chunk_hits_.resize(chunks);
   chunk_bounds_.resize(chunks);
+  chunk_max_.resize(chunks);
   std::atomic<uint64_t> rays{0};
   parallel_chunks(size_t(count), kChunk, [&](size_t k, size_t begin, size_t end) {
     std::vector<PhotonHit>& out = chunk_hits_[k];
@@ -93,8 +94,13 @@ PhotonPassStats PhotonTracer::run(uint64_t seed, uint64_t pass, uint64_t count,
     uint64_t local_rays = 0;
     for (size_t i = begin; i < end; ++i) trace(seed, pass, i, out, local_rays);
     Bounds b;
-    for (const PhotonHit& h : out) b.extend(h.position);
+    float max_flux = 0.0f;
+    for (const PhotonHit& h : out) {
+      b.extend(h.position);
+      max_flux = std::max(max_flux, max_component(h.flux));
+    }
     chunk_bounds_[k] = b;
+    chunk_max_[k] = max_flux;
     rays += local_rays;
   });
   chunk_offset_.assign(chunks + 1, 0);
@@ -108,6 +114,7 @@ PhotonPassStats PhotonTracer::run(uint64_t seed, uint64_t pass, uint64_t count,
       std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   stats.rays = rays.load();
   stats.paths = count;
+  for (size_t k = 0; k < chunks; ++k) stats.max_flux = std::max(stats.max_flux, chunk_max_[k]);
   return stats;
 }
 

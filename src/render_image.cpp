@@ -24,35 +24,29 @@ ExrImage pack_channels(const FilmImage& film) {
   return out;
 }
 
-ExrImage Renderer::image(const RunInfo& run) const {
-  return image(run, work_, initial_radius_, states_, visible_);
-}
+ExrImage Renderer::image(const RunInfo& run) const { return image(run, view()); }
 
 ExrImage Renderer::image(const RunInfo& run, const RenderState& state) const {
-  return image(run, state.work, state.initial_radius, state.states, state.visible);
+  return image(run, view(state));
 }
 
-ExrImage Renderer::image(const RunInfo& run, const WorkCounters& work, double initial_radius,
-                         const std::vector<PointState>& states,
-                         const std::vector<uint32_t>& visible) const {
+ExrImage Renderer::image(const RunInfo& run, const View& v) const {
   FilmImage film;
-  PixelLayout l = layout();
-  if (!l.visible_passes.empty()) l.visible_passes = visible;
-  const FilmSummary summary = pb::develop(l, states, work.passes, film_settings(), &film);
+  const FilmSummary summary = develop(v, &film);
   ExrImage out = pack_channels(film);
   out.metadata = describe(options_);
   out.metadata.insert(out.metadata.end(),
                       {
                           {"version", PHOTONBOUND_VERSION},
                           {"command_line", options_.command_line},
-                          {"passes_done", std::to_string(work.passes)},
-                          {"photons_emitted", std::to_string(work.photons)},
+                          {"passes_done", std::to_string(v.work.passes)},
+                          {"photons_emitted", std::to_string(v.work.photons)},
                           {"seconds", number_text(run.seconds)},
                           {"stop_reason", run.stop_reason},
-                          {"initial_radius", number_text(initial_radius)},
+                          {"initial_radius", number_text(v.initial_radius)},
                           {"mean_error_bound", number_text(summary.mean_bound)},
                           {"unknown_pixels", std::to_string(summary.unknown_pixels)},
-                          {"estimator_states", std::to_string(states.size())},
+                          {"estimator_states", std::to_string(v.states.size())},
                       });
   return out;
 }

@@ -61,6 +61,7 @@ Renderer::Renderer(Scene scene, const RenderOptions& options)
     eye_.median_footprint = median_footprint(world_, camera_, options_.max_depth, 4);
     states = size_t(eye_.width) * size_t(eye_.height);
     visible_.assign(states, 0);
+    min_mass_.assign(states, 1.0f);
   }
   timings_.eye = seconds_since(t0);
   params_.alpha = options_.alpha;
@@ -72,6 +73,10 @@ Renderer::Renderer(Scene scene, const RenderOptions& options)
   // Radii only shrink: segments farther than the initial radius (as a float, what queries use)
   // from a triangle never matter to its points.
   boundary_ = BoundaryIndex(world_, std::nextafter(float(initial_radius_), INFINITY));
+  max_photon_power_ = world_.lights().max_photon_flux();
+  // The largest BRDF of any surface a visible point can lie on (the sparse-photon bound).
+  for (const Material& m : world_.scene().materials)
+    if (m.model == Reflection::Lambertian) max_f_ = glm::max(max_f_, lambertian(m.base_color));
   PointState initial;
   initial.r2 = initial_radius_ * initial_radius_;
   states_.assign(states, initial);
@@ -102,6 +107,7 @@ void Renderer::step(std::vector<PointState>* copy) {
   const PhotonPassStats stats = tracer_.run(options_.seed, pass, options_.photons_per_pass, hits_);
   work_.rays += stats.rays;
   work_.photons += stats.paths;
+  max_photon_power_ = std::max(max_photon_power_, double(stats.max_flux));
   timings_.trace += seconds_since(t);
 
   const size_t n = states_.size();
@@ -119,7 +125,8 @@ void Renderer::step(std::vector<PointState>* copy) {
     gather_and_fold(in, eye_.points, states_, radii_, sums_, out);
   } else {
     const CameraPathInputs cam{world_, camera_, options_.max_depth, options_.seed, pass};
-    sppm_gather_and_fold(in, cam, states_, radii_, visible_, visible_points_, sums_, out);
+    sppm_gather_and_fold(in, cam, states_, radii_, visible_, min_mass_, visible_points_, sums_,
+                         out);
   }
   timings_.gather += seconds_since(t);
 }
@@ -130,6 +137,8 @@ RenderState Renderer::snapshot(std::vector<PointState> states) const {
   s.initial_radius = initial_radius_;
   s.states = std::move(states);
   s.visible = visible_;
+  s.min_mass = min_mass_;
+  s.max_photon_power = max_photon_power_;
   return s;
 }
 
@@ -141,26 +150,53 @@ void Renderer::restore(const RenderState& saved) {
   if (saved.visible.size() != visible_.size())
     throw StateError("the state holds " + std::to_string(saved.visible.size()) +
                      " SPPM pixel counters but this render has " + std::to_string(visible_.size()));
+  if (saved.min_mass.size() != min_mass_.size())
+    throw StateError("the state holds " + std::to_string(saved.min_mass.size()) +
+                     " SPPM kernel masses but this render has " + std::to_string(min_mass_.size()));
   states_ = saved.states;
   visible_ = saved.visible;
+  min_mass_ = saved.min_mass;
+  max_photon_power_ = saved.max_photon_power;
   for (size_t k = 0; k < states_.size(); ++k) radii_[k] = search_radius(states_[k].r2);
   work_ = saved.work;
   initial_radius_ = saved.initial_radius;
 }
 
-PixelLayout Renderer::layout() const {
-  if (options_.method == Method::PPM) return layout_of(eye_);
-  return {eye_.width, eye_.height, {}, {}, visible_};
+PixelLayout Renderer::layout(const View& v) const {
+  PixelLayout l = options_.method == Method::PPM ? layout_of(eye_) : PixelLayout{};
+  if (options_.method == Method::SPPM) {
+    l.width = eye_.width;
+    l.height = eye_.height;
+    l.visible_passes = v.visible;
+    l.max_f = max_f_;
+    l.mass = v.min_mass;
+  } else {
+    // Each point's disc's kernel mass at the current radius (the sparse-photon bound and the
+    // validity of the bias model need it; interior points cost a list scan).
+    l.mass.assign(v.states.size(), 1.0f);
+    parallel_for(v.states.size(), 1024, [&](size_t b, size_t e) {
+      for (size_t k = b; k < e; ++k) {
+        const MeasurementPoint& p = eye_.points[k];
+        l.mass[k] =
+            float(boundary_.moments(p.triangle, p.position, p.normal, search_radius(v.states[k].r2))
+                      .mass);
+      }
+    });
+  }
+  l.photon_cap = kPeakWeight * v.max_photon_power / double(options_.photons_per_pass);
+  return l;
 }
 
-FilmSummary Renderer::develop(FilmImage* image) const {
-  return pb::develop(layout(), states_, work_.passes, film_settings(), image);
-}
+PixelLayout Renderer::layout() const { return layout(view()); }
+
+FilmSummary Renderer::develop(FilmImage* image) const { return develop(view(), image); }
 
 FilmSummary Renderer::develop(const RenderState& state, FilmImage* image) const {
-  PixelLayout l = layout();
-  if (!l.visible_passes.empty()) l.visible_passes = state.visible;
-  return pb::develop(l, state.states, state.work.passes, film_settings(), image);
+  return develop(view(state), image);
+}
+
+FilmSummary Renderer::develop(const View& v, FilmImage* image) const {
+  return pb::develop(layout(v), v.states, v.work.passes, film_settings(), image);
 }
 
 }  // namespace pb

@@ -198,23 +198,23 @@ struct FilmCounts {
 
 // Develops the render and asserts the channel contract of README "Output": radiance, bias,
 // photons and radius finite; bound and noise finite and >= 0 where known, +inf on all three
-// channels exactly where a point never received a photon (or fewer than 2 passes); radius > 0
+// channels exactly before the second pass (from then on a point with few or no photons has the
+// sparse-photon bound of ESTIMATOR.md section 12); radius > 0
 // where the pixel has points. The Variance channel is float32: with allow_variance_overflow a
 // channel may be +inf where the double variance exceeds FLT_MAX (the noise channel stays finite).
 inline FilmCounts check_film(const Renderer& r, const FilmSettings& s, FilmImage* out = nullptr,
                              FilmSummary* summary_out = nullptr,
                              bool allow_variance_overflow = false) {
   FilmImage img;
-  const FilmSummary summary = develop(r.eye(), r.states(), r.passes(), s, &img);
+  const PixelLayout layout = r.layout();
+  const FilmSummary summary = develop(layout, r.states(), r.passes(), s, &img);
   const EyePassResult& eye = r.eye();
   FilmCounts c;
   c.pixels = size_t(eye.width) * size_t(eye.height);
   for (size_t p = 0; p < c.pixels; ++p) {
     const uint32_t b = eye.pixel_begin[p], e = eye.pixel_begin[p + 1];
-    bool unknown = false;
-    for (uint32_t k = b; k < e; ++k)
-      unknown = unknown || r.states()[k].photons < kMinPhotonsForBound;
-    unknown = b != e && (unknown || r.passes() < 2);
+    bool unknown = b != e && r.passes() < 2;
+    for (uint32_t k = b; k < e; ++k) unknown = unknown || layout.mass[k] < kValidKernelMass;
     c.with_points += b != e;
     c.unknown += unknown;
     for (int ch = 0; ch < 3; ++ch) {

@@ -159,13 +159,16 @@ TEST(EnvironmentLights, UniformEnvironmentByTheCosineIsExact) {
 }
 
 // Photons of a light, traced to a horizontal disc of radius a at the scene's centre: the flux
-// crossing it downward estimates pi a^2 times the irradiance from above.
+// crossing it downward estimates pi a^2 times the irradiance from above. No photon carries more
+// than Lights::max_photon_flux().
 dvec3 flux_through_disc(const Lights& lights, double a, int n) {
   Rng rng(9, 0, 0, Stream::Test);
   dvec3 sum(0.0);
   for (int k = 0; k < n; ++k) {
     const EmittedPhoton ph = lights.sample_photon(rng);
     EXPECT_EQ(ph.normal, vec3(0.0f));
+    // The sparse-photon bound relies on max_photon_flux() bounding every photon.
+    EXPECT_LE(max_component(ph.flux), lights.max_photon_flux() * (1.0f + 1e-5f));
     EXPECT_GT(glm::length(ph.origin), std::sqrt(3.0f));  // starts outside the bounding sphere
     if (!(ph.dir.y < 0.0f)) continue;
     const float t = -ph.origin.y / ph.dir.y;

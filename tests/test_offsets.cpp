@@ -245,10 +245,11 @@ TEST(Offsets, SmallObjectOverHugeGroundKeepsItsRadiance) {
       // The radius floor at this ground (renderer.h min_radius): 1e-6 x the bounds' diagonal.
       const double radius = std::max(0.05, 1e-6 * std::sqrt(8.0 * double(g) * g + 1.0));
       const CubeMeans ref = cube_mean(10.0f, method, radius), m = cube_mean(g, method, radius);
-      std::printf("%s ground %g, radius %.3g: cube mean radiance %.5f, next-event part %.5f "
-                  "(ground 10: %.5f, %.5f)\n",
-                  method == Method::PPM ? "ppm" : "sppm", double(g), radius, m.total, m.direct,
-                  ref.total, ref.direct);
+      std::printf(
+          "%s ground %g, radius %.3g: cube mean radiance %.5f, next-event part %.5f "
+          "(ground 10: %.5f, %.5f)\n",
+          method == Method::PPM ? "ppm" : "sppm", double(g), radius, m.total, m.direct, ref.total,
+          ref.direct);
       // The next-event part is where self-shadowing shows first: to rounding.
       EXPECT_NEAR(m.direct, ref.direct, 1e-3 * ref.direct) << "ground " << g;
       // The whole radiance: the photon part's noise in these 8 passes is ~0.5% of the mean.

@@ -27,11 +27,11 @@ class World;
 // (u = (x - p) / R) that lies on reachable surface. The full disc has mass 1, second moment
 // 2 k2 = 5/24 (of |u|^2), Laplacian mass 0 and Laplacian second moment 4.
 struct DiscMoments {
-  double mass = 1.0;        // c = integral over S of kappa
+  double mass = 1.0;           // c = integral over S of kappa
   double second = 5.0 / 24.0;  // integral over S of |u|^2 kappa
-  double lap_mass = 0.0;    // integral over S of lap kappa
-  double lap_second = 4.0;  // integral over S of |u|^2 lap kappa
-  bool full = true;         // S is the whole disc (the exact values above)
+  double lap_mass = 0.0;       // integral over S of lap kappa
+  double lap_second = 4.0;     // integral over S of |u|^2 lap kappa
+  bool full = true;            // S is the whole disc (the exact values above)
 };
 
 class BoundaryIndex {

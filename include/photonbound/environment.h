@@ -27,6 +27,9 @@ class EnvironmentLight {
 
   // Integral of the radiance over the sphere, per channel (W/m^2 per unit of radiance x sr).
   vec3 integral() const { return integral_; }
+  // The largest channel of radiance / pdf over the directions sample() draws: what one photon
+  // of the environment carries at most, per unit of pi r^2 (Lights::max_photon_flux).
+  float max_radiance_over_pdf() const { return max_over_pdf_; }
   bool uniform() const { return width_ == 1 && height_ == 1; }
 
  private:
@@ -42,6 +45,7 @@ class EnvironmentLight {
   std::vector<double> row_cdf_;
   std::vector<float> column_cdf_;
   vec3 integral_{0.0f};
+  float max_over_pdf_ = 0.0f;
 };
 
 }  // namespace pb

@@ -41,6 +41,12 @@ static_assert(sizeof(PointState) == 160, "the per-point memory budget counts on 
 // off its surface (the tip of a sliver) is not amplified beyond 1000x.
 inline constexpr double kMinKernelMass = 1e-3;
 
+// Below this kernel mass on the surface the disc is mostly beyond it (a radius far above the
+// surface's size): the estimate is then an average over the whole surface, and no second-order
+// model of the bias holds. Such a state's bound is unknown until the radius shrinks
+// (ESTIMATOR.md section 11). A strip a hundredth of the radius wide still passes.
+inline constexpr double kValidKernelMass = 1e-2;
+
 struct EstimatorParams {
   double alpha = 0.7;             // PPM radius reduction, in (0, 1]
   double photons_per_pass = 1.0;  // M_e
@@ -82,6 +88,16 @@ inline constexpr uint64_t kMinPhotonsForBound = 5;
 // The photon part of L_i computed from the PPM accumulators, tau / (pi R^2 i M_e). Equal to the
 // mean of the photon parts of X_j (ESTIMATOR.md section 3, key identity).
 dvec3 photon_radiance(const PointState& state, uint64_t passes, double photons_per_pass);
+
+// Points with few photons (ESTIMATOR.md section 12): after n photons over k passes in which the
+// point could receive them, the expected photons per pass have the one-sided upper confidence
+// limit lambda_u = chi2_{conf}(2n + 2) / (2k) (Garwood 1936; for n = 0 it is -ln(1 - conf) / k),
+// and a photon adds at most `cap` to a pass sample, so the photon part's mean is at most
+// lambda_u cap. 0 when k = 0 (no photon part).
+double sparse_photon_bound(uint64_t photons, uint64_t passes, double cap, double confidence);
+
+// The kernel's peak weight w(0) = 3.5: no photon weighs more in phi (ESTIMATOR.md section 2).
+inline constexpr double kPeakWeight = 3.5;
 
 // Student-t quantile t_{nu, p} (Boost.Math), ESTIMATOR.md section 6. nu >= 1.
 double student_t_quantile(double nu, double p);

@@ -54,6 +54,13 @@ struct PixelLayout {
   std::span<const uint32_t> pixel_begin;     // empty: state p is pixel p
   std::span<const dvec3> emission;           // empty: no light outside the states
   std::span<const uint32_t> visible_passes;  // SPPM: per pixel
+  // For states with few photons (ESTIMATOR.md section 12): w(0) Phi_max / M_e, which with the
+  // state's f and 1 / (c pi R^2) is the most one photon adds to a pass sample; the states'
+  // BRDF (PPM: each point's f; SPPM: the largest a visible point can have) and kernel mass c.
+  double photon_cap = 0.0;
+  std::span<const MeasurementPoint> points;  // PPM
+  vec3 max_f{0.0f};                          // SPPM
+  std::vector<float> mass;                   // per state; empty: 1
 };
 PixelLayout layout_of(const EyePassResult& eye);
 

@@ -65,6 +65,10 @@ class Lights {
   size_t emitter_count() const { return probability_.size(); }
 
   EmittedPhoton sample_photon(Rng& rng) const;
+  // The largest channel of the power any emitted photon can carry (before the division by the
+  // photons per pass): emitter power over its choice probability; for a map, its largest
+  // radiance over its sampling density.
+  float max_photon_flux() const { return max_photon_flux_; }
   // One emitter and one direction toward it for a receiver with unit normal `normal` (the side
   // it is seen from; a uniform environment is sampled by the cosine about it). False when the
   // sample cannot contribute (back side of a one-sided emitter, outside a cone).
@@ -105,6 +109,7 @@ class Lights {
   std::vector<double> cdf_;
   std::vector<float> probability_;
   vec3 total_power_{0.0f};
+  float max_photon_flux_ = 0.0f;
 };
 
 }  // namespace pb

@@ -82,11 +82,13 @@ void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> poi
 
 // SPPM (ESTIMATOR.md section 10): the same with the camera stage first, per block of pixels:
 // trace_visible_points into `points` (block-sized scratch) and the sums' emission, gather,
-// next-event samples, count each pixel's passes with a visible point in `visible`, then fold.
+// next-event samples, count each pixel's passes with a visible point in `visible` and keep the
+// smallest kernel mass of its visible points in `min_mass` (section 12), then fold.
 struct CameraPathInputs;
 void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
                           std::span<PointState> states, std::span<float> radii,
-                          std::span<uint32_t> visible, std::span<MeasurementPoint> points,
-                          std::span<PassGather> sums, PointState* copy);
+                          std::span<uint32_t> visible, std::span<float> min_mass,
+                          std::span<MeasurementPoint> points, std::span<PassGather> sums,
+                          PointState* copy);
 
 }  // namespace pb

@@ -21,6 +21,7 @@ struct PhotonPassStats {
   uint64_t rays = 0;         // closest-hit rays traced
   uint64_t paths = 0;        // photons emitted
   double order_seconds = 0;  // wall clock spent ordering the hits (part of run())
+  float max_flux = 0.0f;     // largest channel of any stored hit's power (ESTIMATOR.md section 12)
 };
 
 class PhotonTracer {
@@ -52,6 +53,7 @@ class PhotonTracer {
   // Scratch reused across passes, so a warm pass does not allocate.
   std::vector<std::vector<PhotonHit>> chunk_hits_;
   std::vector<Bounds> chunk_bounds_;
+  std::vector<float> chunk_max_;
   std::vector<size_t> chunk_offset_;           // first global hit index of each chunk
   std::vector<uint32_t> chunk_of_;             // chunk of each global hit index
   std::vector<uint64_t> keys_, keys_scratch_;  // Morton code << 32 | global hit index

@@ -35,6 +35,8 @@ struct RenderState {
   double initial_radius = 0.0;
   std::vector<PointState> states;  // PPM: one per measurement point; SPPM: one per pixel
   std::vector<uint32_t> visible;   // SPPM: passes with a visible point, per pixel
+  std::vector<float> min_mass;     // SPPM: smallest kernel mass of a visible point, per pixel
+  double max_photon_power = 0.0;   // largest channel of a photon's power seen (section 12)
 };
 
 // Wall-clock seconds spent in each phase, accumulated over all passes (for the benchmark).
@@ -81,7 +83,7 @@ class Renderer {
   // True when no radius can shrink any more (alpha = 1, or every radius at its floor).
   bool radii_fixed() const;
 
-  // Which states make up each pixel.
+  // Which states make up each pixel (of the current states).
   PixelLayout layout() const;
   // Radiance and bounds of the current states, or of a snapshot's; the film when wanted.
   FilmSummary develop(FilmImage* image = nullptr) const;
@@ -102,8 +104,24 @@ class Renderer {
   const BoundaryIndex& boundary() const { return boundary_; }
 
  private:
-  ExrImage image(const RunInfo& run, const WorkCounters& work, double initial_radius,
-                 const std::vector<PointState>& states, const std::vector<uint32_t>& visible) const;
+  // The current state or a snapshot's, without copying either.
+  struct View {
+    const WorkCounters& work;
+    double initial_radius;
+    const std::vector<PointState>& states;
+    const std::vector<uint32_t>& visible;
+    const std::vector<float>& min_mass;
+    double max_photon_power;
+  };
+  View view() const {
+    return {work_, initial_radius_, states_, visible_, min_mass_, max_photon_power_};
+  }
+  static View view(const RenderState& s) {
+    return {s.work, s.initial_radius, s.states, s.visible, s.min_mass, s.max_photon_power};
+  }
+  PixelLayout layout(const View& v) const;
+  FilmSummary develop(const View& v, FilmImage* image) const;
+  ExrImage image(const RunInfo& run, const View& v) const;
 
   const RenderOptions options_;
   World world_;
@@ -119,6 +137,9 @@ class Renderer {
   std::vector<float> radii_;                      // search_radius(r2) per point, for the grid build
   std::vector<PassGather> sums_;                  // one fold block's pass sums (pass_stages.h)
   std::vector<uint32_t> visible_;                 // SPPM: passes with a visible point, per pixel
+  std::vector<float> min_mass_;                   // SPPM: smallest kernel mass seen, per pixel
+  double max_photon_power_ = 0.0;                 // emitted or stored, the largest channel
+  vec3 max_f_{0.0f};                              // largest BRDF a visible point can have
   std::vector<MeasurementPoint> visible_points_;  // SPPM: one fold block's, reused
   WorkCounters work_;
   double initial_radius_ = 0.0;
