@@ -7,6 +7,7 @@
 
 #include <charconv>
 #include <cmath>
+#include <filesystem>
 #include <functional>
 #include <limits>
 #include <string>
@@ -297,7 +298,10 @@ inline OptionSpec environment(OptionSpec s, std::string unset) {
   };
   s.parse = [=](RenderOptions& o, const std::string& t) {
     check(t);
-    o.environment = t;
+    // A map as an absolute path, like the scene in the state: `resume` may run elsewhere.
+    std::error_code ec;
+    const std::filesystem::path abs = std::filesystem::absolute(t, ec);
+    o.environment = is_map_file(t) && !ec ? abs.lexically_normal().string() : t;
   };
   s.check = [=](const RenderOptions& o) {
     if (!o.environment.empty()) check(o.environment);

@@ -145,12 +145,14 @@ TEST_F(CliDefaults, EnvironmentMapsFromExrAndHdr) {
   EXPECT_EQ(e.code, 0) << e.err;
 }
 
-// The map is part of the render's identity: an edited map is another render.
+// The map is part of the render's identity: an edited map is another render. A map given by a
+// relative path is kept as an absolute one, like the scene: resume works from anywhere.
 TEST_F(CliDefaults, ResumeRefusesAnEditedMap) {
   write_hdr(path("sky.hdr"), true);
   const std::string state = path("s.pbstate");
-  ASSERT_EQ(run("render " + quote(scene("unlit.gltf")) + quick() + " --quiet --environment " +
-                quote(path("sky.hdr")) + " --state " + quote(state))
+  ASSERT_EQ(pb::test::run_photonbound("render " + quote(scene("unlit.gltf")) + quick() +
+                                          " --quiet --environment sky.hdr --state " + quote(state),
+                                      dir_.string())
                 .code,
             0);
   EXPECT_EQ(
