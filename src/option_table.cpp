@@ -52,6 +52,54 @@ OptionSpec resolution() {
   return s;
 }
 
+OptionSpec stop_rule() {
+  OptionSpec s = base("--stop-rule", "stop_rule", "mean-error|mean-bound|pixels:Q", "error bounds",
+                      OptionKind::Adjust,
+                      "what --target-error tests: the image's mean error at the confidence, the "
+                      "mean of the per-pixel bounds (HJJ10), or the share Q of pixels whose bound "
+                      "meets the target");
+  const std::string bad = "is not one of mean-error, mean-bound, pixels:Q with Q in (0, 1]";
+  s.parse = [=](RenderOptions& o, const std::string& t) {
+    if (t == "mean-error") {
+      o.stop_rule = StopRule::MeanError;
+    } else if (t == "mean-bound") {
+      o.stop_rule = StopRule::MeanBound;
+    } else if (t.rfind("pixels:", 0) == 0) {
+      double q = 0.0;
+      const std::string v = t.substr(7);
+      const auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), q);
+      if (v.empty() || ec != std::errc() || ptr != v.data() + v.size() || !(q > 0.0 && q <= 1.0))
+        fail("--stop-rule", "'" + t + "' " + bad);
+      o.stop_rule = StopRule::Pixels;
+      o.stop_fraction = q;
+    } else {
+      fail("--stop-rule", "'" + t + "' " + bad);
+    }
+  };
+  s.check = [=](const RenderOptions& o) {
+    if (o.stop_rule == StopRule::Pixels && !(o.stop_fraction > 0.0 && o.stop_fraction <= 1.0))
+      fail("--stop-rule", "pixels:Q needs Q in (0, 1]");
+  };
+  s.format = [](const RenderOptions& o) -> std::string {
+    switch (o.stop_rule) {
+      case StopRule::MeanError:
+        return "mean-error";
+      case StopRule::MeanBound:
+        return "mean-bound";
+      case StopRule::Pixels:
+        return "pixels:" + number_text(o.stop_fraction);
+    }
+    return "mean-error";
+  };
+  s.reset = [](RenderOptions& o) {
+    o.stop_rule = RenderOptions{}.stop_rule;
+    o.stop_fraction = RenderOptions{}.stop_fraction;
+  };
+  s.accepted = {"mean-error", "mean-bound", "pixels:0.9", "pixels:1"};
+  s.rejected = {"", "mean", "pixels:0", "pixels:1.5", "pixels:", "pixels:x"};
+  return s;
+}
+
 std::vector<OptionSpec> make_table() {
   using K = OptionKind;
   const char* stop = "stop conditions (at least one; whichever is reached first)";
@@ -70,7 +118,7 @@ std::vector<OptionSpec> make_table() {
                         "wall-clock budget in seconds (steady clock), checked after each pass"),
                    &RenderOptions::time_seconds, {0, 1e9, true, false, " seconds", ""}, "none"));
   t.push_back(real(base("--target-error", "target_error", "E", stop, K::Stop,
-                        "stop when the image mean error bound is <= E"),
+                        "stop when the image is within E (see --stop-rule), at --confidence"),
                    &RenderOptions::target_error,
                    {0, kInf, true, true, "", "must be a finite number greater than 0"}, "none"));
   t.push_back(choice(base("--method", "method", "sppm|ppm", render, K::Image,
@@ -135,6 +183,7 @@ std::vector<OptionSpec> make_table() {
                           "image mean)"),
                      &RenderOptions::metric,
                      {{"absolute", ErrorMetric::Absolute}, {"relative", ErrorMetric::Relative}}));
+  t.push_back(stop_rule());
   OptionSpec progress = choice(base("--progress", "progress", "", run, K::Run,
                                     "progress lines on stderr (pass, photons, the tested quantity "
                                     "against the target, unknown "

@@ -98,6 +98,7 @@ FilmSettings Renderer::film_settings() const {
   s.confidence = options_.confidence;
   s.metric = options_.metric;
   s.target = options_.target_error.value_or(0.0);
+  s.stop_fraction = options_.stop_fraction;
   return s;
 }
 
@@ -184,6 +185,7 @@ PixelLayout Renderer::layout(const View& v) const {
     });
   }
   l.photon_cap = kPeakWeight * v.max_photon_power / double(options_.photons_per_pass);
+  l.footprint = eye_.median_footprint;
   return l;
 }
 

@@ -26,6 +26,8 @@ enum class Method { SPPM, PPM };
 enum class DirectMode { NextEvent, Photons };
 enum class ErrorMetric { Absolute, Relative };
 enum class ProgressMode { Auto, Always, Never };
+// What --target-error tests (README "Stopping", ESTIMATOR.md section 7).
+enum class StopRule { MeanError, MeanBound, Pixels };
 
 // Members only: ranges, defaults and help live in the option table.
 struct RenderOptions {
@@ -56,6 +58,8 @@ struct RenderOptions {
   double confidence = 0.9;  // 1 - beta
   uint64_t min_passes = 16;
   ErrorMetric metric = ErrorMetric::Absolute;
+  StopRule stop_rule = StopRule::MeanError;
+  double stop_fraction = 0.9;  // pixels:Q, the share of pixels whose bound must meet the target
   ProgressMode progress = ProgressMode::Auto;
   std::optional<double> checkpoint_every;
   std::string state_path;
