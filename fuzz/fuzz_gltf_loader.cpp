@@ -3,6 +3,8 @@
 // prepare or be refused with a SceneError. Anything else (a crash, a sanitizer report, another
 // exception type, a hang) is a finding. tools/fuzz.sh builds and runs it.
 #include "photonbound/gltf_loader.h"
+#include "photonbound/scene_setup.h"
+#include "photonbound/view.h"
 #include "photonbound/world.h"
 
 #include <cstdint>
@@ -18,10 +20,13 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const char* name = glb ? "fuzz-input/input.glb" : "fuzz-input/input.gltf";
   const std::vector<unsigned char> bytes(data, data + size);
   try {
-    const pb::Scene scene = pb::load_gltf_bytes(name, bytes);
-    // A scene the loader accepts must also be one the renderer can prepare: build the
-    // acceleration structure and the light distributions.
-    const pb::World world(scene);
+    pb::Scene scene = pb::load_gltf_bytes(name, bytes);
+    // A scene the loader accepts must also be one the renderer can prepare: add the default sky
+    // and view where it has none, build the acceleration structure and the light distributions.
+    const pb::RenderOptions options;
+    pb::complete_scene(scene, options);
+    const pb::World world(std::move(scene));
+    (void)pb::choose_camera(world.scene(), options);
   } catch (const pb::SceneError&) {
     // Refused with a message: the expected outcome for almost every mutated input.
   } catch (const std::exception& e) {

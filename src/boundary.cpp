@@ -294,11 +294,22 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
   for (uint32_t t = 0; t < n; ++t) start_[t + 1] += start_[t];
   list_.resize(pairs.size());
   for (size_t k = 0; k < pairs.size(); ++k) list_[k] = pairs[k].second;
+  // Centres of the triangles with segments, to tell which side of a segment through a point is
+  // its surface (moments()).
+  centre_.assign(n, vec3(0.0f));
+  parallel_for(n, 4096, [&](size_t b, size_t e) {
+    for (size_t t = b; t < e; ++t) {
+      if (start_[t + 1] == start_[t]) continue;
+      vec3 v[3];
+      world.triangle(uint32_t(t), v[0], v[1], v[2]);
+      centre_[t] = triangle_centre(v);
+    }
+  });
 }
 
 size_t BoundaryIndex::memory_bytes() const {
   return segments_.capacity() * sizeof(Segment) + start_.capacity() * sizeof(uint32_t) +
-         list_.capacity() * sizeof(uint32_t);
+         list_.capacity() * sizeof(uint32_t) + centre_.capacity() * sizeof(vec3);
 }
 
 DiscMoments BoundaryIndex::moments(uint32_t triangle, const vec3& p, const vec3& n, float r) const {
@@ -322,6 +333,30 @@ DiscMoments BoundaryIndex::moments(uint32_t triangle, const vec3& p, const vec3&
     ++count;
   }
   if (count == 0) return m;
+  // A point on a segment (a pixel centre that sees exactly the line where two walls meet) sees
+  // nothing along it: every ray meets the segment at t = 0. Such a point belongs to the side of
+  // its own triangle, so the quadrature's centre moves 1e-3 r towards that triangle's centre;
+  // the moments change by O(1e-3) (the disc's part beyond the segment is then about half).
+  double min_d2 = INFINITY;
+  for (int i = 0; i < count; ++i) {
+    const double len2 = ex[i] * ex[i] + ey[i] * ey[i];
+    const double s =
+        len2 > 0.0 ? std::clamp(-(ax[i] * ex[i] + ay[i] * ey[i]) / len2, 0.0, 1.0) : 0.0;
+    const double qx = ax[i] + s * ex[i], qy = ay[i] + s * ey[i];
+    min_d2 = std::min(min_d2, qx * qx + qy * qy);
+  }
+  if (min_d2 < 1e-8 * r2) {
+    const dvec3 toward = dvec3(centre_[triangle]) - dvec3(p);
+    const double cx = glm::dot(toward, dvec3(t1)), cy = glm::dot(toward, dvec3(t2));
+    const double len = std::sqrt(cx * cx + cy * cy);
+    if (len > 0.0) {
+      const double shift = std::min(1e-3 * double(r), len);
+      for (int i = 0; i < count; ++i) {
+        ax[i] -= shift * cx / len;
+        ay[i] -= shift * cy / len;
+      }
+    }
+  }
   // Polar quadrature about p: in each direction the visible extent rho (the first segment the
   // ray meets, or r), and the radial integrals to rho / r (midpoint rule in the angle).
   const Directions& dir = directions();

@@ -16,6 +16,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first,
     const float jx = rng.next_float(), jy = rng.next_float();
     const int x = int(pixel % size_t(width)), y = int(pixel / size_t(width));
     vec3 origin = in.camera.origin(), origin_normal(0.0f);
+    float origin_error = 0.0f;
     vec3 dir = in.camera.direction(float(x) + jx, float(y) + jy);
     vec3 weight(1.0f);
     dvec3 emission(0.0);
@@ -23,8 +24,11 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first,
     for (int depth = 0;; ++depth) {
       Hit hit;
       const bool found = depth == 0 ? in.world.accel().intersect(origin, dir, 0.0f, INFINITY, hit)
-                                    : in.world.trace(origin, origin_normal, dir, hit);
-      if (!found) break;  // background is black
+                                    : in.world.trace(origin, origin_normal, origin_error, dir, hit);
+      if (!found) {  // the environment (black without one), seen along the path
+        emission += dvec3(weight * in.world.lights().environment_radiance(dir));
+        break;
+      }
       const Surface s = in.world.surface(hit);
       const vec3 wo = -dir;
       const bool front = glm::dot(wo, s.ng) > 0.0f;
@@ -39,7 +43,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first,
       }
       if (stop) {
         const vec3 w = p_delta > 0.0f ? weight / (1.0f - p_delta) : weight;
-        point.position = s.position;
+        point.position = in.world.spawn(s, wo);  // lifted off the surface: shadow rays start here
         point.normal = front ? s.ng : -s.ng;
         point.shading = front ? s.ns : -s.ns;
         const bool lambertian = s.bsdf.is_lambertian();
@@ -59,6 +63,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first,
       if (!(max_component(weight) > 0.0f)) break;
       origin = s.position;
       origin_normal = s.ng;
+      origin_error = s.error;
       dir = b.wi;
     }
     points[k] = point;

@@ -165,7 +165,7 @@ void save_state(const std::string& path, const SavedRender& s) {
   w.f64(s.schedule.seconds);
   w.u64(s.schedule.next_check);
   w.u64(s.schedule.early_pass);
-  w.f64(s.schedule.early_bound);
+  w.f64(s.schedule.early_value);
   w.u64(s.render.visible.size());
   w.raw(s.render.visible.data(), s.render.visible.size() * sizeof(uint32_t));
   w.u64(s.render.min_mass.size());
@@ -224,7 +224,7 @@ SavedRender load_state(const std::string& path) {
     s.schedule.seconds = r.f64();
     s.schedule.next_check = r.u64();
     s.schedule.early_pass = r.u64();
-    s.schedule.early_bound = r.f64();
+    s.schedule.early_value = r.f64();
     const uint64_t v = r.u64();
     if (v > r.remaining() / sizeof(uint32_t)) throw StateError(path + ": truncated state file");
     s.render.visible.resize(v);

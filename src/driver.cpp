@@ -3,6 +3,7 @@
 #include "photonbound/timer.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace pb {
 
@@ -20,6 +21,30 @@ std::string stop_text(StopReason reason) {
       return "unreachable: the radius cannot shrink and the bias is above the target";
     case StopReason::Interrupted:
       return "interrupted";
+  }
+  return "";
+}
+
+double tested_quantity(const RenderOptions& o, const FilmSummary& s) {
+  switch (o.stop_rule) {
+    case StopRule::MeanError:
+      return s.predicted_error_upper;
+    case StopRule::MeanBound:
+      return s.unknown_pixels ? INFINITY : s.mean_bound;
+    case StopRule::Pixels:
+      return s.pixel_quantile_bound;
+  }
+  return INFINITY;
+}
+
+std::string tested_name(const RenderOptions& o) {
+  switch (o.stop_rule) {
+    case StopRule::MeanError:
+      return "mean error";
+    case StopRule::MeanBound:
+      return "mean bound";
+    case StopRule::Pixels:
+      return number_text(100.0 * o.stop_fraction) + "% of pixels";
   }
   return "";
 }
@@ -58,13 +83,15 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
       state_.next_check = pass + std::max<uint64_t>(1, pass / 10);
       if (state_.early_pass == 0 || pass >= 2 * state_.early_pass) {
         state_.early_pass = pass;
-        state_.early_bound = report.summary.mean_bound;
+        state_.early_value = tested_quantity(o, report.summary);
       }
     }
 
     if (o.passes && pass >= *o.passes) report.stop = StopReason::Passes;
     if (o.time_seconds && run_seconds >= *o.time_seconds) report.stop = StopReason::Time;
-    if (check && report.summary.mean_bound <= *o.target_error)
+    // Success needs every pixel's bound: pixels left out of a mean cannot be within a target
+    // (every tested quantity is +inf while a pixel is unknown).
+    if (check && tested_quantity(o, report.summary) <= *o.target_error)
       report.stop = StopReason::TargetError;
     // A target below the bias cannot be reached once the radii can no longer shrink (alpha = 1,
     // or every radius at its floor): more passes only shrink the noise.

@@ -12,6 +12,7 @@ namespace {
 struct PathVertex {
   vec3 origin, dir, weight;
   vec3 origin_normal;  // surface the ray leaves (0 for the camera)
+  float origin_error;  // its position error bound (Surface::error)
   float length;        // path length so far, for the footprint
   int depth;           // specular bounces so far
 };
@@ -29,13 +30,17 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
                  PixelOutput& out) {
   PathVertex stack[64];
   int top = 0;
-  stack[top++] = {camera.origin(), camera.direction(x, y), vec3(1.0f), vec3(0.0f), 0.0f, 0};
+  stack[top++] = {camera.origin(), camera.direction(x, y), vec3(1.0f), vec3(0.0f), 0.0f, 0.0f, 0};
   while (top > 0) {
     const PathVertex v = stack[--top];
     Hit hit;
-    const bool found = v.depth == 0 ? world.accel().intersect(v.origin, v.dir, 0.0f, INFINITY, hit)
-                                    : world.trace(v.origin, v.origin_normal, v.dir, hit);
-    if (!found) continue;  // background is black
+    const bool found = v.depth == 0
+                           ? world.accel().intersect(v.origin, v.dir, 0.0f, INFINITY, hit)
+                           : world.trace(v.origin, v.origin_normal, v.origin_error, v.dir, hit);
+    if (!found) {  // the environment (black without one): exact for this ray
+      out.emission += dvec3(v.weight * world.lights().environment_radiance(v.dir));
+      continue;
+    }
     const Surface s = world.surface(hit);
     const vec3 wo = -v.dir;
     // Inside an absorbing volume the segment's transmittance weighs what it reaches.
@@ -46,7 +51,7 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
     if (!s.bsdf.is_delta()) {
       const bool front = glm::dot(wo, s.ng) > 0.0f;
       MeasurementPoint p;
-      p.position = s.position;
+      p.position = world.spawn(s, wo);  // lifted off the surface: shadow rays start here
       p.normal = front ? s.ng : -s.ng;
       p.shading = front ? s.ns : -s.ns;
       const bool lambertian = s.bsdf.is_lambertian();
@@ -65,7 +70,7 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
     for (int k = 0; k < n; ++k) {
       const vec3 w = weight * branches[k].weight;
       if (max_component(w) <= 0.0f || top >= 64) continue;
-      stack[top++] = {s.position, branches[k].dir, w, s.ng, length, v.depth + 1};
+      stack[top++] = {s.position, branches[k].dir, w, s.ng, s.error, length, v.depth + 1};
     }
   }
 }

@@ -1,7 +1,9 @@
 #include "photonbound/film.h"
 
+#include "photonbound/error_model.h"
 #include "photonbound/parallel.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -133,6 +135,8 @@ const std::vector<float>& FilmImage::plane(Channel id) const {
       return photons;
     case Channel::Radius:
       return radius;
+    case Channel::TargetRatio:
+      return target_ratio;
   }
   return radiance;
 }
@@ -174,7 +178,8 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
   if (image) {
     image->width = eye.width;
     image->height = eye.height;
-    for (auto* v : {&image->radiance, &image->bound, &image->bias, &image->noise, &image->variance})
+    for (auto* v : {&image->radiance, &image->bound, &image->bias, &image->noise, &image->variance,
+                    &image->target_ratio})
       v->assign(3 * pixels, 0.0f);
     image->photons.assign(pixels, 0.0f);
     image->radius.assign(pixels, 0.0f);
@@ -182,7 +187,11 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
 
   const std::vector<dvec3> tau2 = bias_prior(results, eye.width, eye.height);
   double bound_sum = 0.0, noise_sum = 0.0, bias_sum = 0.0, bias_metric_sum = 0.0;
+  double error_sum = 0.0, error_var_sum = 0.0;  // of the error model (section 7)
+  const double nu = double(std::max<uint64_t>(passes, 2) - 1);
+  const double t_var = nu > 2.0 ? nu / (nu - 2.0) : 3.0;  // Var(T_nu); 3 stands in below nu = 3
   uint64_t known = 0, below = 0;
+  std::vector<float> pixel_bounds(pixels, 0.0f);  // largest channel, in the metric
   for (size_t p = 0; p < pixels; ++p) {
     const PixelResult& r = results[p];
     const bool known_pixel = r.exact || (passes >= 2 && r.known);
@@ -194,6 +203,11 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
       // The bias is known only through its noisy estimate B: given the prior of the
       // neighbourhood, the error's bias part is B shrunk by w = tau^2 / (tau^2 + Var B), with
       // the posterior's variance w Var B added to the noise (section 6b).
+      double pixel_error_sd = 0.0;
+      const dvec3 denominator =
+          s.metric == ErrorMetric::Relative
+              ? glm::max(r.radiance, dvec3(std::max(sum.relative_floor, 1e-300)))
+              : dvec3(1.0);
       for (int c = 0; c < 3; ++c) {
         if (r.exact) {
           bound[c] = 0.0;
@@ -202,21 +216,32 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
         const double vb = r.bias_variance[c], prior = tau2[p][c];
         const double w = vb > 0.0 ? prior / (prior + vb) : 1.0;
         bound[c] = quantile(w * r.bias[c], std::sqrt(r.variance[c] + w * vb)) + r.sparse[c];
+        // The same model, for the image's mean error: |w B + noise| with the noise's variance
+        // (the t's), plus the sparse-photon term as it stands (an upper limit).
+        const double mu = w * r.bias[c] / denominator[c];
+        const double sigma = std::sqrt(r.variance[c] * t_var + w * vb) / denominator[c];
+        error_sum += expected_abs_error(mu, sigma) + r.sparse[c] / denominator[c];
+        pixel_error_sd += std::sqrt(abs_error_variance(mu, sigma));
       }
-      dvec3 metric = bound, bias_metric = glm::abs(r.bias);
-      if (s.metric == ErrorMetric::Relative) {
-        const dvec3 denominator = glm::max(r.radiance, dvec3(std::max(sum.relative_floor, 1e-300)));
-        metric /= denominator;
-        bias_metric /= denominator;
-      }
+      // A pixel's three channels come from the same photons and paths: their errors are taken
+      // as fully correlated (exactly so in a grey scene), so their sd add.
+      error_var_sum += pixel_error_sd * pixel_error_sd;
+      const dvec3 metric = bound / denominator, bias_metric = glm::abs(r.bias) / denominator;
       bound_sum += metric.x + metric.y + metric.z;
       bias_metric_sum += bias_metric.x + bias_metric.y + bias_metric.z;
       noise_sum += noise.x + noise.y + noise.z;
       bias_sum += std::fabs(r.bias.x) + std::fabs(r.bias.y) + std::fabs(r.bias.z);
       ++known;
       if (s.target > 0.0 && max_component(metric) <= s.target) ++below;
+      pixel_bounds[p] = float(max_component(metric));
+      if (image)
+        for (int c = 0; c < 3; ++c)
+          image->target_ratio[3 * p + c] = float(s.target > 0.0 ? metric[c] / s.target : metric[c]);
     } else {
       ++sum.unknown_pixels;
+      pixel_bounds[p] = INFINITY;
+      if (image)
+        for (int c = 0; c < 3; ++c) image->target_ratio[3 * p + c] = INFINITY;
     }
     if (image) {
       for (int c = 0; c < 3; ++c) {
@@ -235,7 +260,29 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
     sum.mean_noise = noise_sum / (3.0 * double(known));
     sum.mean_abs_bias = bias_sum / (3.0 * double(known));
     sum.mean_bias_metric = bias_metric_sum / (3.0 * double(known));
-    sum.below_target = double(below) / double(known);
+  }
+  sum.below_target = double(below) / double(std::max<size_t>(pixels, 1));
+  if (pixels > 0) {
+    const size_t q = std::min(pixels - 1, size_t(std::ceil(s.stop_fraction * double(pixels))) - 1);
+    std::nth_element(pixel_bounds.begin(), pixel_bounds.begin() + q, pixel_bounds.end());
+    sum.pixel_quantile_bound = pixel_bounds[q];
+  }
+  if (sum.unknown_pixels == 0 && pixels > 0) {
+    // The mean over every pixel-channel, as `compare` takes it (exact pixels add no error).
+    // Its variance: the pixels' own, summed as if each were fully correlated with the K pixels
+    // its disc's photons also reach (section 7), plus the model's: each sigma^2 comes from
+    // i - 1 passes, and their mean over the n / K independent groups has relative error
+    // 1 / sqrt(2 (i - 1) n / K), which moves the predicted mean by half that.
+    const double n = 3.0 * double(pixels);
+    double mean_r2 = 0.0;
+    for (const PointState& st : states) mean_r2 += st.r2;
+    mean_r2 /= double(std::max<size_t>(states.size(), 1));
+    const double k = correlated_pixels(std::sqrt(mean_r2), eye.footprint);
+    const double m = error_sum / n;
+    const double model = 0.5 * m / std::sqrt(2.0 * nu * std::max(1.0, n / k));
+    const double var = k * error_var_sum / (n * n) + model * model;
+    sum.predicted_error = m;
+    sum.predicted_error_upper = m + normal_quantile(s.confidence) * std::sqrt(var);
   }
   return sum;
 }

@@ -163,7 +163,8 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
   const std::string where = ml + " primitive " + std::to_string(p);
   if (prim.mode != TINYGLTF_MODE_TRIANGLES)
     fail(where + " uses mode " + mode_name(prim.mode) + "; only TRIANGLES is supported");
-  if (!prim.targets.empty()) warn(ml + ": morph targets are ignored");
+  if (!prim.targets.empty())
+    warn(ml + ": morph targets are ignored; the mesh is drawn in its base shape");
   if (!prim.attributes.count("POSITION")) fail(where + " has no POSITION attribute");
   const DracoPrimitive* dp = draco(mesh_index, p, where);
   const View pos = *attribute(prim, dp, "POSITION", where);

@@ -132,10 +132,20 @@ void Loader::check_extensions() {
       "KHR_draco_mesh_compression", "EXT_meshopt_compression",
       "KHR_mesh_quantization",      "KHR_texture_transform",
       "KHR_texture_basisu",         "EXT_texture_webp"};  // basisu: the fallback image or a warning
+  // Unknown extensions, even required ones, are rendered without (README "Scenes"): a material
+  // extension then falls back to the core factors; data an unknown extension holds is missing,
+  // and the accessors that lack it are refused with their own message.
   for (const std::string& e : m_.extensionsRequired)
-    if (!known.count(e)) fail("requires extension '" + e + "', which is not supported");
+    if (!known.count(e))
+      warn("extension '" + e + "' is required but not implemented; rendered without it");
   for (const std::string& e : m_.extensionsUsed)
-    if (!known.count(e)) warn("extension '" + e + "' is ignored");
+    if (!known.count(e) &&
+        !std::count(m_.extensionsRequired.begin(), m_.extensionsRequired.end(), e))
+      warn("extension '" + e + "' is ignored");
+  if (!m_.animations.empty())
+    warn(std::to_string(m_.animations.size()) +
+         (m_.animations.size() == 1 ? " animation is" : " animations are") +
+         " ignored; the scene is drawn as the nodes place it");
 }
 
 dmat4 Loader::local_matrix(const tinygltf::Node& n, const std::string& nl) const {
@@ -213,19 +223,16 @@ void Loader::finish() {
   if (scene_.degenerate_triangles > 0)
     warn(std::to_string(scene_.degenerate_triangles) + " degenerate triangles skipped");
   if (scene_.meshes.empty()) fail("no triangles");
-  if (scene_.cameras.empty()) fail("no perspective camera");
-  bool lit = false;
-  for (const PunctualLight& l : scene_.lights) lit |= max_component(l.intensity) > 0.0f;
-  for (const Mesh& m : scene_.meshes) lit |= scene_.materials[m.material].emits();
-  if (!lit) fail("no light: the scene has no punctual light and no emissive triangles");
+  // No camera and no light are not errors: scene_setup.h frames the bounds and lights the scene
+  // with the default sky, as glTF viewers do.
+  for (const Mesh& m : scene_.meshes)
+    for (uint32_t i : m.indices) scene_.bounds.extend(m.positions[i]);
   // Photon flux is carried in float: the total emitted power must fit, or the light
   // distribution overflows later with no file to name.
   const double power = total_emitted_power(scene_);
   if (!(power <= double(std::numeric_limits<float>::max())))
     fail("the lights emit " + num(power) +
          " W in total, beyond the float range (3.4e+38) photon power is carried in");
-  for (const Mesh& m : scene_.meshes)
-    for (uint32_t i : m.indices) scene_.bounds.extend(m.positions[i]);
   scene_.source = file_;
 }
 

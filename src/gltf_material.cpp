@@ -165,18 +165,29 @@ void Loader::add_light(const tinygltf::Node& n, const std::string& nl, const Xfo
   const std::string ll = label("light", gl.name, size_t(li));
   PunctualLight out;
   out.name = gl.name.empty() ? "light " + num(li) : gl.name;
-  if (gl.type == "directional")
-    fail(ll + " is directional; only point and spot lights are supported");
-  if (gl.type != "point" && gl.type != "spot") fail(ll + " has unknown type '" + gl.type + "'");
+  if (gl.type != "point" && gl.type != "spot" && gl.type != "directional")
+    fail(ll + " has unknown type '" + gl.type + "'");
   const std::vector<double> color = gl.color.empty() ? std::vector<double>(3, 1.0) : gl.color;
   if (color.size() != 3) fail(ll + ": color must have 3 numbers");
-  for (int c = 0; c < 3; ++c) {  // radiant intensity per channel = color x intensity
+  // Radiant intensity per channel = color x intensity; for a directional light the irradiance on
+  // a surface facing it (glTF's lux), in the image's radiance units times sr.
+  for (int c = 0; c < 3; ++c) {
     const double v = color[size_t(c)] * gl.intensity;
     if (!(v >= 0.0 && gl.intensity >= 0.0 && color[size_t(c)] >= 0.0 && fits_float(v)))
       fail(ll + ": intensity and color must be finite and >= 0");
     out.intensity[c] = float(v);
   }
-  if (gl.range > 0.0) warn(ll + ": range is ignored (inverse-square falloff)");
+  if (gl.range > 0.0 && gl.type != "directional")
+    warn(ll + ": range is ignored (inverse-square falloff)");
+  if (gl.type == "directional") {  // light travels along the node's local -Z
+    out.kind = PunctualKind::Directional;
+    const dvec3 d = xf.direction(dvec3(0.0, 0.0, -1.0));
+    if (!(glm::length(d) > 0.0))
+      fail(ll + ": the light's direction is zero (" + nl + " is singular)");
+    out.direction = vec3(glm::normalize(d));
+    scene_.lights.push_back(std::move(out));
+    return;
+  }
   out.position = origin(xf, nl);
   if (gl.type == "spot") {
     out.kind = PunctualKind::Spot;

@@ -127,4 +127,34 @@ Image decode_image(const unsigned char* data, size_t size, const std::string& na
   return im;
 }
 
+RgbImage read_rgb_image(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw ImageError(path + ": cannot read image: " + one_line(OIIO::geterror()));
+  const OIIO::ImageSpec& spec = in->spec();
+  const size_t pixels = size_t(spec.width) * size_t(spec.height);
+  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 ||
+      pixels * size_t(std::max(spec.nchannels, 1)) > (size_t(1) << 29))
+    throw ImageError(path + ": " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                     " pixels of " + std::to_string(spec.nchannels) +
+                     " channels is not an environment map (at most 2^29 values)");
+  // R, G and B by name when the file has them (an EXR's channels need not come in that order),
+  // else the first three channels, or the one channel as grey.
+  int source[3] = {spec.channelindex("R"), spec.channelindex("G"), spec.channelindex("B")};
+  if (source[0] < 0 || source[1] < 0 || source[2] < 0)
+    for (int c = 0; c < 3; ++c) source[c] = std::min(c, spec.nchannels - 1);
+  const int channels = spec.nchannels;
+  std::vector<float> data(pixels * size_t(channels));
+  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, data.data()))
+    throw ImageError(path + ": cannot read pixels: " + one_line(in->geterror()));
+  in->close();
+  RgbImage out;
+  out.width = spec.width;
+  out.height = spec.height;
+  out.rgb.resize(3 * pixels);
+  for (size_t p = 0; p < pixels; ++p)
+    for (size_t c = 0; c < 3; ++c)
+      out.rgb[3 * p + c] = data[p * size_t(channels) + size_t(source[c])];
+  return out;
+}
+
 }  // namespace pb

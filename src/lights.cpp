@@ -1,6 +1,7 @@
 #include "photonbound/lights.h"
 
 #include "photonbound/bsdf.h"
+#include "photonbound/ray_offset.h"
 
 #include <algorithm>
 #include <stdexcept>
@@ -24,20 +25,36 @@ constexpr float kNearFactor2 = 4.0f * 4.0f;
 
 }  // namespace
 
+float emission_radius(const Bounds& b) {
+  // The bounding sphere of the box, 0.1% larger: the disc then lies outside every surface.
+  return std::max(0.5f * b.diagonal(), 1e-30f) * 1.001f;
+}
+
 // Power of a punctual light: integral of intensity times attenuation over the sphere.
 // Spot: 2 pi I (integral over cos from cos_outer to 1 of the attenuation)
 //     = 2 pi I ((cos_inner - cos_outer) / 3 + (1 - cos_inner)) for the squared linear ramp.
-vec3 punctual_power(const PunctualLight& l) {
+// Directional: irradiance E through the emission disc, pi r^2 E.
+vec3 punctual_power(const PunctualLight& l, float radius) {
   if (l.kind == PunctualKind::Point) return 4.0f * kPi * l.intensity;
+  if (l.kind == PunctualKind::Directional) return kPi * radius * radius * l.intensity;
   const float span = std::max(l.cos_inner - l.cos_outer, 0.0f);
   return 2.0f * kPi * l.intensity * (span / 3.0f + (1.0f - l.cos_inner));
 }
 
+vec3 environment_power(const EnvironmentLight& env, float radius) {
+  return kPi * radius * radius * env.integral();
+}
+
 double total_emitted_power(const Scene& scene) {
   double power = 0.0;
+  auto add = [&](const dvec3& p) { power += p.x + p.y + p.z; };
+  const double r = emission_radius(scene.bounds);
   for (const PunctualLight& l : scene.lights) {
-    const vec3 p = punctual_power(l);
-    power += double(p.x) + p.y + p.z;
+    // In double: r^2 E may overflow float, which is what the loader's range check looks for.
+    if (l.kind == PunctualKind::Directional)
+      add(kPiD * r * r * dvec3(l.intensity));
+    else
+      add(dvec3(punctual_power(l, 0.0f)));
   }
   for (const Mesh& m : scene.meshes) {
     const Material& mat = scene.materials[m.material];
@@ -48,61 +65,42 @@ double total_emitted_power(const Scene& scene) {
       const dvec3 p0(m.positions[m.indices[t]]);
       const double area = 0.5 * glm::length(glm::cross(dvec3(m.positions[m.indices[t + 1]]) - p0,
                                                        dvec3(m.positions[m.indices[t + 2]]) - p0));
-      const dvec3 p = lambertian_emitter_power(area, le);
-      power += p.x + p.y + p.z;
+      add(lambertian_emitter_power(area, le));
     }
   }
+  if (scene.environment) add(kPiD * r * r * dvec3(EnvironmentLight(*scene.environment).integral()));
   return power;
 }
 
-bool sample_spherical_triangle(const vec3& v0, const vec3& v1, const vec3& v2, const vec3& p,
-                               float u0, float u1, vec3& dir, float& solid_angle) {
-  // Arvo 1995, "Stratified sampling of spherical triangles", in the form of pbrt-v4's
-  // SampleSphericalTriangle, in double: the arcs and angles lose float precision quickly.
-  using glm::dvec3;
-  const dvec3 a = glm::normalize(dvec3(v0) - dvec3(p));
-  const dvec3 b = glm::normalize(dvec3(v1) - dvec3(p));
-  const dvec3 c = glm::normalize(dvec3(v2) - dvec3(p));
-  dvec3 n_ab = glm::cross(a, b), n_bc = glm::cross(b, c), n_ca = glm::cross(c, a);
-  const double l_ab = glm::length(n_ab), l_bc = glm::length(n_bc), l_ca = glm::length(n_ca);
-  if (!(l_ab > 1e-12 && l_bc > 1e-12 && l_ca > 1e-12)) return false;
-  n_ab /= l_ab;
-  n_bc /= l_bc;
-  n_ca /= l_ca;
-  auto angle = [](const dvec3& x, const dvec3& y) {
-    return std::acos(std::clamp(glm::dot(x, y), -1.0, 1.0));
-  };
-  const double alpha = angle(n_ab, -n_ca), beta = angle(n_bc, -n_ab), gamma = angle(n_ca, -n_bc);
-  const double area = alpha + beta + gamma - kPiD;  // spherical excess = solid angle
-  // Below this the excess is dominated by rounding; above 2 pi - eps the receiver is almost in
-  // the triangle's plane. Both fall back to area sampling.
-  if (!(area > 3e-4 && area < 6.22)) return false;
-
-  // Choose the sub-triangle area A' uniformly, then the point on arc b-c' for it.
-  const double ap_pi = kPiD + double(u0) * area;  // A' + pi
-  const double cos_alpha = std::cos(alpha), sin_alpha = std::sin(alpha);
-  const double sin_phi = std::sin(ap_pi) * cos_alpha - std::cos(ap_pi) * sin_alpha;
-  const double cos_phi = std::cos(ap_pi) * cos_alpha + std::sin(ap_pi) * sin_alpha;
-  const double k1 = cos_phi + cos_alpha;
-  const double k2 = sin_phi - sin_alpha * glm::dot(a, b);
-  double cos_bp = (k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha) /
-                  ((k2 * sin_phi + k1 * cos_phi) * sin_alpha);
-  cos_bp = std::clamp(cos_bp, -1.0, 1.0);
-  const double sin_bp = std::sqrt(std::max(0.0, 1.0 - cos_bp * cos_bp));
-  const dvec3 c_perp = c - glm::dot(c, a) * a;
-  if (!(glm::length(c_perp) > 0.0)) return false;
-  const dvec3 cp = cos_bp * a + sin_bp * glm::normalize(c_perp);
-  const double cos_theta = 1.0 - double(u1) * (1.0 - glm::dot(cp, b));
-  const double sin_theta = std::sqrt(std::max(0.0, 1.0 - cos_theta * cos_theta));
-  const dvec3 cp_perp = cp - glm::dot(cp, b) * b;
-  const double l = glm::length(cp_perp);
-  const dvec3 w = l > 0.0 ? cos_theta * b + sin_theta * (cp_perp / l) : b;
-  dir = vec3(glm::normalize(w));
-  solid_angle = float(area);
-  return std::isfinite(dir.x) && std::isfinite(dir.y) && std::isfinite(dir.z);
+bool has_light(const Scene& scene) {
+  for (const PunctualLight& l : scene.lights)
+    if (max_component(l.intensity) > 0.0f) return true;
+  for (const Mesh& m : scene.meshes)
+    if (scene.materials[m.material].emits()) return true;
+  return scene.environment && max_component(EnvironmentLight(*scene.environment).integral()) > 0.0f;
 }
 
-Lights::Lights(const Scene& scene) : punctual_(scene.lights), images_(scene.images) {
+// How far from the emitter triangle t's plane, along its normal, rounding may put a point that
+// is on it, seen from `receiver`: the sample's own error (t.error) plus Embree's, whose distance
+// to the plane is computed from v0 - origin and so grows with the receiver's coordinates too
+// (ray_offset.h). A receiver closer than this lies in the plane (a point beside the emitter on
+// the same wall, lifted off it by World::spawn): it sees none of it, not a hemisphere.
+float Lights::plane_tolerance(const Triangle& t, const vec3& receiver) {
+  return t.error + gamma_bound(7) * glm::dot(glm::abs(t.normal), glm::abs(receiver));
+}
+
+// That distance along a shadow ray at cosine cos_light to t's normal: where the ray must stop.
+float Lights::shadow_margin(const Triangle& t, const vec3& receiver, float cos_light) {
+  return cos_light > 0.0f ? plane_tolerance(t, receiver) / cos_light : INFINITY;
+}
+
+Lights::Lights(const Scene& scene)
+    : punctual_(scene.lights),
+      images_(scene.images),
+      centre_(0.5f * (scene.bounds.lo + scene.bounds.hi)),
+      radius_(emission_radius(scene.bounds)) {
+  if (scene.bounds.empty()) centre_ = vec3(0.0f);
+  if (scene.environment) environment_.emplace(*scene.environment);
   for (const Mesh& mesh : scene.meshes) {
     const Material& mat = scene.materials[mesh.material];
     if (!mat.emits()) continue;
@@ -115,6 +113,7 @@ Lights::Lights(const Scene& scene) : punctual_(scene.lights), images_(scene.imag
       tri.area = 0.5f * glm::length(c);
       if (!(tri.area > 0.0f)) continue;
       tri.normal = c / (2.0f * tri.area);
+      tri.error = surface_error(tri.p0, tri.p0 + tri.e1, tri.p0 + tri.e2, tri.normal);
       tri.radiance = mat.emission;
       tri.select = average(tri.radiance);
       tri.two_sided = mat.double_sided;
@@ -130,7 +129,7 @@ Lights::Lights(const Scene& scene) : punctual_(scene.lights), images_(scene.imag
     weights.push_back(weight);
   };
   for (const PunctualLight& l : punctual_) {
-    const vec3 p = punctual_power(l);
+    const vec3 p = punctual_power(l, radius_);
     add(p, double(p.x) + p.y + p.z);
   }
   for (const Triangle& t : triangles_) {
@@ -139,6 +138,10 @@ Lights::Lights(const Scene& scene) : punctual_(scene.lights), images_(scene.imag
     // Chosen by power; a textured piece by its select radiance, which is never 0 where it emits.
     add(p, t.source < 0 ? double(p.x) + p.y + p.z
                         : 3.0 * double(lambertian_emitter_power(t.area * sides, t.select)));
+  }
+  if (environment_) {
+    const vec3 p = environment_power(*environment_, radius_);
+    add(p, double(p.x) + p.y + p.z);
   }
 
   double sum = 0.0;
@@ -155,14 +158,19 @@ Lights::Lights(const Scene& scene) : punctual_(scene.lights), images_(scene.imag
   }
   cdf_.back() = 1.0;
   // Per emitter: flux per photon = power / probability (sample_photon); a spot's photons carry
-  // up to its intensity times the cone's solid angle.
+  // up to its intensity times the cone's solid angle, a directional light's pi r^2 E, an
+  // environment map's pi r^2 times its largest radiance over its sampling density.
   for (size_t k = 0; k < weights.size(); ++k) {
     if (!(probability_[k] > 0.0f)) continue;
     vec3 peak(0.0f);
-    if (k < punctual_.size()) {
+    if (k == punctual_.size() + triangles_.size()) {
+      peak = vec3(kPi * radius_ * radius_ * environment_->max_radiance_over_pdf());
+    } else if (k < punctual_.size()) {
       const PunctualLight& l = punctual_[k];
       peak = l.kind == PunctualKind::Point ? 4.0f * kPi * l.intensity
-                                           : l.intensity * (2.0f * kPi * (1.0f - l.cos_outer));
+             : l.kind == PunctualKind::Directional
+                 ? punctual_power(l, radius_)
+                 : l.intensity * (2.0f * kPi * (1.0f - l.cos_outer));
     } else {
       const Triangle& t = triangles_[k - punctual_.size()];
       // A textured piece's photons carry the radiance where they start: at most its peak.
@@ -193,6 +201,11 @@ EmittedPhoton Lights::sample_photon(Rng& rng) const {
   const float u1 = rng.next_float(), u2 = rng.next_float();
   if (k < punctual_.size()) {
     const PunctualLight& l = punctual_[k];
+    if (l.kind == PunctualKind::Directional) {
+      ph = from_disc(l.direction, u1, u2);
+      ph.flux = l.intensity * (kPi * radius_ * radius_) / p_pick;
+      return ph;
+    }
     ph.origin = l.position;
     if (l.kind == PunctualKind::Point) {
       ph.dir = sample_uniform_sphere(u1, u2);
@@ -204,12 +217,25 @@ EmittedPhoton Lights::sample_photon(Rng& rng) const {
     }
     return ph;
   }
+  if (k == punctual_.size() + triangles_.size()) {
+    // The environment: a direction toward it by the map, entering through the disc facing it
+    // (pbrt-v4 ImageInfiniteLight::SampleLe): flux = Le pi r^2 / pdf.
+    float pdf = 0.0f;
+    const float v0 = rng.next_float(), v1 = rng.next_float();
+    const vec3 w = environment_->sample(u1, u2, v0, v1, pdf);
+    const float d0 = rng.next_float(), d1 = rng.next_float();
+    ph = from_disc(-w, d0, d1);
+    ph.flux = pdf > 0.0f ? environment_->radiance(w) * (kPi * radius_ * radius_) / (pdf * p_pick)
+                         : vec3(0.0f);
+    return ph;
+  }
   const Triangle& t = triangles_[k - punctual_.size()];
   // Uniform point on the triangle (pbrt-v4 SampleUniformTriangle, square-root mapping).
   const float s = std::sqrt(u1);
   const float b1 = 1.0f - s, b2 = u2 * s;
   ph.origin = t.p0 + b1 * t.e1 + b2 * t.e2;
   ph.normal = t.normal;
+  ph.error = t.error;
   // Drawn in this order: the arguments of an earlier call, which GCC evaluated right to left
   // (images stay bit-identical; the order is now explicit for every compiler).
   const float v2 = rng.next_float(), v1 = rng.next_float();
@@ -225,9 +251,24 @@ EmittedPhoton Lights::sample_photon(Rng& rng) const {
   return ph;
 }
 
+EmittedPhoton Lights::from_disc(const vec3& travel, float u0, float u1) const {
+  // Uniform by area (radius r sqrt(u0), angle 2 pi u1) on the disc of radius r facing the light,
+  // r before the scene's centre: outside the bounding sphere, covering all of it.
+  vec3 t, b;
+  orthonormal_basis(travel, t, b);
+  const float rho = radius_ * std::sqrt(u0), phi = 2.0f * kPi * u1;
+  EmittedPhoton ph;
+  ph.origin = centre_ - radius_ * travel + rho * (std::cos(phi) * t + std::sin(phi) * b);
+  ph.dir = travel;
+  return ph;
+}
+
 float Lights::local_weight(size_t k, const vec3& receiver) const {
+  if (k == punctual_.size() + triangles_.size())       // the environment: pi x its mean radiance,
+    return average(environment_->integral()) * 0.25f;  // the irradiance it gives a free surface
   if (k < punctual_.size()) {
     const PunctualLight& l = punctual_[k];
+    if (l.kind == PunctualKind::Directional) return average(l.intensity);  // irradiance
     const vec3 d = l.position - receiver;
     const float dist2 = glm::dot(d, d);
     if (!(dist2 > 0.0f)) return 0.0f;
@@ -235,7 +276,9 @@ float Lights::local_weight(size_t k, const vec3& receiver) const {
   }
   const Triangle& t = triangles_[k - punctual_.size()];
   const vec3 a = t.p0 - receiver, b = a + t.e1, c = a + t.e2;
-  if (!t.two_sided && glm::dot(a, t.normal) >= 0.0f) return 0.0f;  // behind a one-sided emitter
+  // Receiver behind a one-sided emitter, or in its plane.
+  const float side = -glm::dot(a, t.normal);
+  if ((t.two_sided ? std::fabs(side) : side) <= plane_tolerance(t, receiver)) return 0.0f;
   // Solid angle (Van Oosterom & Strackee 1983): tan(omega / 2) = |a.(b x c)| / denominator.
   const float la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
   const float num = std::fabs(glm::dot(a, glm::cross(b, c)));
@@ -244,7 +287,30 @@ float Lights::local_weight(size_t k, const vec3& receiver) const {
   return t.select * std::max(omega, 0.0f);
 }
 
-bool Lights::sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) const {
+bool Lights::sample_environment(const vec3& normal, float p_pick, Rng& rng,
+                                DirectSample& out) const {
+  const float u1 = rng.next_float(), u2 = rng.next_float();
+  out.distance = INFINITY;
+  out.margin = 0.0f;
+  if (environment_->uniform()) {
+    // A uniform environment by the cosine about the receiver's normal: Li cos / pdf = pi Le for
+    // every sample the receiver's side sees (exact on a convex object).
+    out.wi = sample_cosine_hemisphere(normal, u1, u2);
+    const float cos = glm::dot(out.wi, normal);
+    if (!(cos > 0.0f)) return false;
+    out.li = environment_->radiance(out.wi) * (kPi / (cos * p_pick));
+  } else {
+    float pdf = 0.0f;
+    const float u3 = rng.next_float(), u4 = rng.next_float();
+    out.wi = environment_->sample(u1, u2, u3, u4, pdf);
+    if (!(pdf > 0.0f)) return false;
+    out.li = environment_->radiance(out.wi) / (pdf * p_pick);
+  }
+  return max_component(out.li) > 0.0f && is_finite(out.li);
+}
+
+bool Lights::sample_direct(const vec3& receiver, const vec3& normal, Rng& rng,
+                           DirectSample& out) const {
   size_t k = 0;
   float p_pick = 0.0f;
   const float u0 = rng.next_float();
@@ -273,22 +339,32 @@ bool Lights::sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) co
     k = pick(u0);
     p_pick = probability_[k];
   }
+  if (k == punctual_.size() + triangles_.size())
+    return sample_environment(normal, p_pick, rng, out);
   const float u1 = rng.next_float(), u2 = rng.next_float();
   if (k < punctual_.size()) {
     const PunctualLight& l = punctual_[k];
+    if (l.kind == PunctualKind::Directional) {  // a delta direction, unoccluded to infinity
+      out.wi = -l.direction;
+      out.distance = INFINITY;
+      out.margin = 0.0f;
+      out.li = l.intensity / p_pick;
+      return max_component(out.li) > 0.0f;
+    }
     const vec3 d = l.position - receiver;
     const float dist2 = glm::dot(d, d);
     if (!(dist2 > 0.0f)) return false;
     out.distance = std::sqrt(dist2);
     out.wi = d / out.distance;
     out.li = spot_falloff(l, -out.wi) / (dist2 * p_pick);
+    out.margin = 0.0f;
     return max_component(out.li) > 0.0f;
   }
   const Triangle& t = triangles_[k - punctual_.size()];
   const vec3 p1 = t.p0 + t.e1, p2 = t.p0 + t.e2;
   // A receiver on a one-sided emitter's back side, or in its plane, sees no light from it.
   const float side = glm::dot(receiver - t.p0, t.normal);
-  if (t.two_sided ? side == 0.0f : side <= 0.0f) return false;
+  if ((t.two_sided ? std::fabs(side) : side) <= plane_tolerance(t, receiver)) return false;
   vec3 dir;
   float solid_angle = 0.0f;
   // Solid-angle sampling only pays near the emitter: from farther than a few times its size,
@@ -314,6 +390,7 @@ bool Lights::sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) co
       le = radiance_at(t, c1, c2);
     }
     out.li = le * (solid_angle / p_pick);
+    out.margin = shadow_margin(t, receiver, std::fabs(glm::dot(dir, t.normal)));
     return max_component(out.li) > 0.0f;
   }
   // Tiny or degenerate solid angle: uniform area sampling (pbrt-v4 does the same).
@@ -330,6 +407,7 @@ bool Lights::sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) co
   // Area sampling converted to solid angle: Le cos_l A / (d^2 p_pick).
   const vec3 le = t.source < 0 ? t.radiance : radiance_at(t, 1.0f - s, u2 * s);
   out.li = le * (cos_light * t.area / (dist2 * p_pick));
+  out.margin = shadow_margin(t, receiver, cos_light);
   return t.source < 0 || max_component(out.li) > 0.0f;
 }
 

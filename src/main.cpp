@@ -12,6 +12,7 @@
 #include "photonbound/parallel.h"
 #include "photonbound/progress.h"
 #include "photonbound/renderer.h"
+#include "photonbound/scene_setup.h"
 
 #include <unistd.h>
 #include <algorithm>
@@ -46,6 +47,8 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   pb::Scene scene = pb::load_gltf(options.scene);
   for (const std::string& w : scene.warnings)
     std::cerr << "photonbound: warning: " << options.scene << ": " << w << "\n";
+  for (const std::string& n : pb::complete_scene(scene, options))
+    std::cerr << "photonbound: note: " << n << "\n";
   const uint64_t scene_hash = scene.content_hash;
   if (saved) {
     const std::vector<std::string> diff = pb::differences(*saved, options, scene_hash);
@@ -117,7 +120,10 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   pb::Driver driver(renderer, saved ? saved->schedule : pb::DriverState{});
   const pb::RenderReport report = driver.run(&g_stop, observers);
   // Ctrl-C keeps the work: the state is written then too.
-  pb::write_exr(options.output, renderer.image(report.run()));
+  const pb::ExrImage image = renderer.image(report.run());
+  pb::write_exr(options.output, image);
+  if (const auto dark = pb::dark_image_warning(image, renderer.world().scene()))
+    std::cerr << "photonbound: warning: " << options.scene << ": " << *dark << "\n";
   if (keep_state || report.stop == pb::StopReason::Interrupted)
     pb::save_state(state_path, {options, scene_hash, renderer.snapshot(), driver.state()});
   if (options.progress != pb::ProgressMode::Never)

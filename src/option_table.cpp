@@ -3,6 +3,8 @@
 // that uses it; parsing, validation, --help, metadata, the state file and resume follow.
 #include "photonbound/options.h"
 
+#include "option_builders.h"
+
 #include <charconv>
 #include <cmath>
 #include <limits>
@@ -11,207 +13,7 @@ namespace pb {
 
 namespace {
 
-[[noreturn]] void fail(std::string_view flag, const std::string& what) {
-  throw UsageError(std::string(flag) + ": " + what);
-}
-
-// A closed or open interval of doubles, with the text README and --help show.
-struct RealRange {
-  double lo, hi;
-  bool lo_open, hi_open;
-  std::string unit;     // " seconds" appended to the message
-  std::string message;  // replaces "must be in <range><unit>" when set
-  std::string text() const {
-    auto n = [](double v) {
-      if (std::isinf(v)) return std::string("inf");
-      const double e = std::log10(v);
-      if (v >= 1e6 && e == std::floor(e)) return "1e" + std::to_string(int(e));  // "1e9"
-      return number_text(v);
-    };
-    return std::string(lo_open ? "(" : "[") + n(lo) + ", " + n(hi) + (hi_open ? ")" : "]");
-  }
-  bool contains(double v) const {
-    return (lo_open ? v > lo : v >= lo) && (hi_open ? v < hi : v <= hi) && std::isfinite(v);
-  }
-  void check(std::string_view flag, double v) const {
-    if (!contains(v)) fail(flag, message.empty() ? "must be in " + text() + unit : message);
-  }
-};
-
-// Integers: [lo, hi]; text with powers of ten where they read better ("1e12").
-struct IntRange {
-  uint64_t lo, hi;
-  std::string text() const {
-    auto n = [](uint64_t v) {
-      if (v == UINT64_MAX) return std::string("2^64-1");
-      int e = 0;
-      uint64_t m = v;
-      while (m >= 10 && m % 10 == 0) m /= 10, ++e;
-      return e >= 6 && m == 1 ? "1e" + std::to_string(e) : std::to_string(v);
-    };
-    return "[" + n(lo) + ", " + n(hi) + "]";
-  }
-  void check(std::string_view flag, long double v) const {
-    if (!(v >= (long double)lo && v <= (long double)hi)) fail(flag, "must be in " + text());
-  }
-};
-
-double parse_real(std::string_view flag, const std::string& text) {
-  double v = 0.0;
-  const char* end = text.data() + text.size();
-  const auto [ptr, ec] = std::from_chars(text.data(), end, v);
-  if (text.empty() || ec != std::errc() || ptr != end) fail(flag, "'" + text + "' is not a number");
-  if (!std::isfinite(v)) fail(flag, "'" + text + "' is not a finite number");
-  return v;
-}
-
-// A whole number, possibly negative or beyond 64 bits (then out of range, not malformed).
-long double parse_integer(std::string_view flag, const std::string& text) {
-  const bool negative = !text.empty() && text[0] == '-';
-  const std::string digits = negative ? text.substr(1) : text;
-  if (digits.empty() || digits.find_first_not_of("0123456789") != std::string::npos)
-    fail(flag, "'" + text + "' is not a whole number");
-  uint64_t v = 0;
-  const auto [ptr, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), v);
-  (void)ptr;
-  const long double x = ec == std::errc::result_out_of_range ? 1e30L : (long double)v;
-  return negative ? -x : x;
-}
-
-// The value type of a plain or optional member.
-template <class M>
-struct ValueType {
-  using type = M;
-};
-template <class M>
-struct ValueType<std::optional<M>> {
-  using type = M;
-};
-
-using Parse = std::function<void(RenderOptions&, const std::string&)>;
-using Format = std::function<std::string(const RenderOptions&)>;
-using Check = std::function<void(const RenderOptions&)>;
-
-OptionSpec base(std::string_view flag, std::string_view key, std::string_view metavar,
-                std::string_view group, OptionKind kind, std::string_view help) {
-  OptionSpec s;
-  s.flag = flag;
-  s.key = key;
-  s.metavar = metavar;
-  s.group = group;
-  s.kind = kind;
-  s.help = help;
-  return s;
-}
-
-// A real member (plain or optional).
-template <class Member>
-OptionSpec real(OptionSpec s, Member RenderOptions::*m, RealRange r, std::string unset = "") {
-  s.reset = [=](RenderOptions& o) { o.*m = RenderOptions{}.*m; };
-  s.range = r.text();
-  s.unset = std::move(unset);
-  const std::string_view flag = s.flag;
-  s.parse = [=](RenderOptions& o, const std::string& t) {
-    const double v = parse_real(flag, t);
-    r.check(flag, v);
-    o.*m = v;
-  };
-  s.check = [=](const RenderOptions& o) {
-    if constexpr (std::is_same_v<Member, double>)
-      r.check(flag, o.*m);
-    else if ((o.*m).has_value())
-      r.check(flag, *(o.*m));
-  };
-  s.format = [=](const RenderOptions& o) -> std::string {
-    if constexpr (std::is_same_v<Member, double>)
-      return number_text(o.*m);
-    else
-      return (o.*m) ? number_text(*(o.*m)) : "";
-  };
-  const double lo_in = r.lo_open ? std::nextafter(r.lo, INFINITY) : r.lo;
-  s.accepted = {number_text(lo_in)};
-  s.rejected = {number_text(r.lo_open ? r.lo : std::nextafter(r.lo, -INFINITY))};
-  if (std::isfinite(r.hi)) {
-    s.accepted.push_back(number_text(r.hi_open ? std::nextafter(r.hi, -INFINITY) : r.hi));
-    s.rejected.push_back(number_text(r.hi_open ? r.hi : std::nextafter(r.hi, INFINITY)));
-  }
-  return s;
-}
-
-// An integer member (plain or optional) of type T.
-template <class Member>
-OptionSpec integer(OptionSpec s, Member RenderOptions::*m, IntRange r, std::string unset = "") {
-  s.reset = [=](RenderOptions& o) { o.*m = RenderOptions{}.*m; };
-  s.range = r.text();
-  s.unset = std::move(unset);
-  const std::string_view flag = s.flag;
-  using T = typename ValueType<Member>::type;
-  s.parse = [=](RenderOptions& o, const std::string& t) {
-    const long double v = parse_integer(flag, t);
-    r.check(flag, v);
-    o.*m = T(v);
-  };
-  s.check = [=](const RenderOptions& o) {
-    if constexpr (std::is_integral_v<Member>)
-      r.check(flag, (long double)(o.*m));
-    else if ((o.*m).has_value())
-      r.check(flag, (long double)(*(o.*m)));
-  };
-  s.format = [=](const RenderOptions& o) -> std::string {
-    if constexpr (std::is_integral_v<Member>)
-      return std::to_string(o.*m);
-    else
-      return (o.*m) ? std::to_string(*(o.*m)) : "";
-  };
-  auto text = [](long double v) { return std::to_string((long long)v); };
-  s.accepted = {std::to_string(r.lo), std::to_string(r.hi)};
-  s.rejected.push_back(text((long double)r.lo - 1));
-  s.rejected.push_back(r.hi < UINT64_MAX ? std::to_string(r.hi + 1) : "18446744073709551616");
-  return s;
-}
-
-// An enumeration member: the texts in order.
-template <class E>
-OptionSpec choice(OptionSpec s, E RenderOptions::*m, std::vector<std::pair<std::string, E>> names) {
-  s.reset = [=](RenderOptions& o) { o.*m = RenderOptions{}.*m; };
-  std::string list;
-  for (const auto& [n, v] : names) list += (list.empty() ? "" : ", ") + n;
-  const std::string_view flag = s.flag;
-  s.parse = [=](RenderOptions& o, const std::string& t) {
-    for (const auto& [n, v] : names)
-      if (n == t) {
-        o.*m = v;
-        return;
-      }
-    fail(flag, "'" + t + "' is not one of " + list);
-  };
-  s.check = [](const RenderOptions&) {};
-  s.format = [=](const RenderOptions& o) {
-    for (const auto& [n, v] : names)
-      if (o.*m == v) return n;
-    return names.front().first;
-  };
-  for (const auto& [n, v] : names) s.accepted.push_back(n);
-  s.rejected = {"", names.front().first + "x"};
-  return s;
-}
-
-// A path or name; empty means unset.
-OptionSpec text(OptionSpec s, std::string RenderOptions::*m, std::string unset = "") {
-  s.reset = [=](RenderOptions& o) { o.*m = RenderOptions{}.*m; };
-  s.unset = std::move(unset);
-  const std::string_view flag = s.flag;
-  const std::string what = s.metavar == "NAME" ? "the name is empty" : "the path is empty";
-  s.parse = [=](RenderOptions& o, const std::string& t) {
-    if (t.empty()) fail(flag, what);
-    o.*m = t;
-  };
-  s.check = [](const RenderOptions&) {};
-  s.format = [=](const RenderOptions& o) { return o.*m; };
-  s.accepted = {"x"};
-  s.rejected = {""};
-  return s;
-}
+using namespace option_builders;
 
 OptionSpec resolution() {
   OptionSpec s =
@@ -250,6 +52,54 @@ OptionSpec resolution() {
   return s;
 }
 
+OptionSpec stop_rule() {
+  OptionSpec s = base("--stop-rule", "stop_rule", "mean-error|mean-bound|pixels:Q", "error bounds",
+                      OptionKind::Adjust,
+                      "what --target-error tests: the image's mean error at the confidence, the "
+                      "mean of the per-pixel bounds (HJJ10), or the share Q of pixels whose bound "
+                      "meets the target");
+  const std::string bad = "is not one of mean-error, mean-bound, pixels:Q with Q in (0, 1]";
+  s.parse = [=](RenderOptions& o, const std::string& t) {
+    if (t == "mean-error") {
+      o.stop_rule = StopRule::MeanError;
+    } else if (t == "mean-bound") {
+      o.stop_rule = StopRule::MeanBound;
+    } else if (t.rfind("pixels:", 0) == 0) {
+      double q = 0.0;
+      const std::string v = t.substr(7);
+      const auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), q);
+      if (v.empty() || ec != std::errc() || ptr != v.data() + v.size() || !(q > 0.0 && q <= 1.0))
+        fail("--stop-rule", "'" + t + "' " + bad);
+      o.stop_rule = StopRule::Pixels;
+      o.stop_fraction = q;
+    } else {
+      fail("--stop-rule", "'" + t + "' " + bad);
+    }
+  };
+  s.check = [=](const RenderOptions& o) {
+    if (o.stop_rule == StopRule::Pixels && !(o.stop_fraction > 0.0 && o.stop_fraction <= 1.0))
+      fail("--stop-rule", "pixels:Q needs Q in (0, 1]");
+  };
+  s.format = [](const RenderOptions& o) -> std::string {
+    switch (o.stop_rule) {
+      case StopRule::MeanError:
+        return "mean-error";
+      case StopRule::MeanBound:
+        return "mean-bound";
+      case StopRule::Pixels:
+        return "pixels:" + number_text(o.stop_fraction);
+    }
+    return "mean-error";
+  };
+  s.reset = [](RenderOptions& o) {
+    o.stop_rule = RenderOptions{}.stop_rule;
+    o.stop_fraction = RenderOptions{}.stop_fraction;
+  };
+  s.accepted = {"mean-error", "mean-bound", "pixels:0.9", "pixels:1"};
+  s.rejected = {"", "mean", "pixels:0", "pixels:1.5", "pixels:", "pixels:x"};
+  return s;
+}
+
 std::vector<OptionSpec> make_table() {
   using K = OptionKind;
   const char* stop = "stop conditions (at least one; whichever is reached first)";
@@ -268,7 +118,7 @@ std::vector<OptionSpec> make_table() {
                         "wall-clock budget in seconds (steady clock), checked after each pass"),
                    &RenderOptions::time_seconds, {0, 1e9, true, false, " seconds", ""}, "none"));
   t.push_back(real(base("--target-error", "target_error", "E", stop, K::Stop,
-                        "stop when the image mean error bound is <= E"),
+                        "stop when the image is within E (see --stop-rule), at --confidence"),
                    &RenderOptions::target_error,
                    {0, kInf, true, true, "", "must be a finite number greater than 0"}, "none"));
   t.push_back(choice(base("--method", "method", "sppm|ppm", render, K::Image,
@@ -295,6 +145,27 @@ std::vector<OptionSpec> make_table() {
   t.push_back(text(base("--camera", "camera", "NAME", render, K::Image,
                         "glTF camera name, \"camera N\" when unnamed"),
                    &RenderOptions::camera, "first"));
+  constexpr double kWorld = 1e10;  // the loader's limit on world coordinates
+  t.push_back(triple(base("--look-from", "look_from", "X,Y,Z", render, K::Image,
+                          "camera position, replacing the camera's (or the default view's)"),
+                     &RenderOptions::look_from, kWorld, false, "the camera's"));
+  t.push_back(triple(base("--look-at", "look_at", "X,Y,Z", render, K::Image,
+                          "point the camera looks at (with --look-from alone: the bounds' centre)"),
+                     &RenderOptions::look_at, kWorld, false, "the camera's"));
+  t.push_back(
+      triple(base("--up", "up", "X,Y,Z", render, K::Image, "direction that is up in the image"),
+             &RenderOptions::up, kWorld, true, "the camera's, or +Y"));
+  t.push_back(real(base("--fov", "fov", "DEGREES", render, K::Image,
+                        "vertical field of view, replacing the camera's"),
+                   &RenderOptions::fov, {0, 180, true, true, "", ""}, "the camera's, or 45"));
+  t.push_back(
+      environment(base("--environment", "environment", "COLOR|FILE.exr|FILE.hdr", render, K::Image,
+                       "environment light: radiance V or R,G,B, or an equirectangular map "
+                       "(centre column -Z, top row +Y)"),
+                  "none; 1 without lights"));
+  t.push_back(real(base("--environment-scale", "environment_scale", "S", render, K::Image,
+                        "factor on the environment's radiance"),
+                   &RenderOptions::environment_scale, {0, 1e30, true, false, "", ""}));
   t.push_back(integer(base("--threads", "threads", "T", run, K::Run,
                            "worker threads, 0 = all; the image does not depend on it"),
                       &RenderOptions::threads, {0, 1024}));
@@ -316,6 +187,7 @@ std::vector<OptionSpec> make_table() {
                           "image mean)"),
                      &RenderOptions::metric,
                      {{"absolute", ErrorMetric::Absolute}, {"relative", ErrorMetric::Relative}}));
+  t.push_back(stop_rule());
   OptionSpec progress = choice(base("--progress", "progress", "", run, K::Run,
                                     "progress lines on stderr (pass, photons, the tested quantity "
                                     "against the target, unknown "
@@ -370,6 +242,16 @@ const OptionSpec& option(std::string_view key) {
   for (const OptionSpec& s : option_table())
     if (s.key == key) return s;
   throw std::logic_error("no option with key " + std::string(key));
+}
+
+bool environment_is_map(const std::string& text) { return is_map_file(text); }
+
+std::array<double, 3> environment_colour(const std::string& text) {
+  std::vector<double> v;
+  if (!parse_numbers(text, v) || (v.size() != 1 && v.size() != 3))
+    throw UsageError("--environment: '" + text + "' is not a colour");
+  return v.size() == 3 ? std::array<double, 3>{v[0], v[1], v[2]}
+                       : std::array<double, 3>{v[0], v[0], v[0]};
 }
 
 std::string number_text(double v) {

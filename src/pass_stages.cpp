@@ -131,12 +131,12 @@ template void gather_photons<false>(const MeasurementPoint&, const GlossyPoint&,
 dvec3 direct_light(const World& world, const MeasurementPoint& point, const GlossyPoint* glossy,
                    Rng& rng) {
   DirectSample s;
-  if (!world.lights().sample_direct(point.position, rng, s)) return dvec3(0.0);
+  if (!world.lights().sample_direct(point.position, point.shading, rng, s)) return dvec3(0.0);
   const float cos_s = glm::dot(s.wi, point.shading);
   if (cos_s <= 0.0f || glm::dot(s.wi, point.normal) <= 0.0f) return dvec3(0.0);
   const vec3 f = glossy ? point.f * glossy->bsdf.eval(glossy->wo, s.wi) : point.f;
   if (glossy && !(max_component(f) > 0.0f)) return dvec3(0.0);  // no shadow ray for nothing
-  if (world.occluded(point.position, point.normal, s.wi, s.distance)) return dvec3(0.0);
+  if (world.occluded(point.position, s.wi, s.distance, s.margin)) return dvec3(0.0);
   return dvec3(f * s.li * cos_s);
 }
 

@@ -50,11 +50,12 @@ void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, std::vect
   Rng rng(seed, pass, index, Stream::Photon);
   const EmittedPhoton e = world_.lights().sample_photon(rng);
   vec3 origin = e.origin, dir = e.dir, flux = e.flux, origin_normal = e.normal;
+  float origin_error = e.error;
   for (int bounce = 0; bounce < kMaxBounces; ++bounce) {
     Hit hit;
     ++rays;
     const bool found = glm::dot(origin_normal, origin_normal) > 0.0f
-                           ? world_.trace(origin, origin_normal, dir, hit)
+                           ? world_.trace(origin, origin_normal, origin_error, dir, hit)
                            : world_.accel().intersect(origin, dir, 0.0f, INFINITY, hit);
     if (!found) return;
     const Surface s = world_.surface(hit);
@@ -77,6 +78,7 @@ void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, std::vect
     flux *= factor / q;
     origin = s.position;
     origin_normal = s.ng;
+    origin_error = s.error;
     dir = next;
   }
 }

@@ -47,25 +47,37 @@ std::string ProgressPrinter::line(const PassInfo& info) {
   line.precision(4);
   line << "pass " << pass << " | " << format_count(double(info.renderer.work().photons))
        << " photons";
+  const double tested = tested_quantity(o, s);
   if (pass >= 2) {
-    line << " | bound " << s.mean_bound;
-    if (o.target_error) line << " | " << int(100.0 * s.below_target) << "% below target";
+    if (o.target_error) {
+      // The quantity the stop rule tests, next to the target (README "Stopping").
+      line << " | " << tested_name(o) << " " << (o.stop_rule == StopRule::MeanError ? "<= " : "")
+           << tested << " (target " << *o.target_error << ")";
+    } else {
+      line << " | bound " << s.mean_bound;
+    }
     line << " | " << s.unknown_pixels << " unknown";
   }
   line << " | " << seconds << " s";
-  // Time left: the smallest of what the stop conditions imply; the target's from the observed
-  // power-law decay of the mean bound since an earlier check.
+  // Time left: the smallest of what the stop conditions imply. The target's comes from the
+  // power-law decay of the tested quantity since an earlier test; once the quantity is at the
+  // target it is the time to the next scheduled test, never the rest of the budget.
   const double per_pass = seconds / double(pass);
   double left = INFINITY;
   if (o.passes) left = std::min(left, double(*o.passes - pass) * per_pass);
   if (o.time_seconds) left = std::min(left, *o.time_seconds - info.run_seconds);
-  const uint64_t early = info.schedule.early_pass;
-  const double early_bound = info.schedule.early_bound;
-  if (o.target_error && early > 0 && pass > early && s.mean_bound < early_bound &&
-      s.mean_bound > *o.target_error) {
-    const double k = std::log(early_bound / s.mean_bound) / std::log(double(pass) / early);
-    const double needed = double(pass) * std::pow(s.mean_bound / *o.target_error, 1.0 / k);
-    left = std::min(left, (needed - double(pass)) * per_pass);
+  if (o.target_error && std::isfinite(tested)) {
+    const uint64_t next = std::max(info.schedule.next_check, pass);
+    const double to_check = double(next - pass) * per_pass;
+    const uint64_t early = info.schedule.early_pass;
+    const double early_value = info.schedule.early_value;
+    if (tested <= *o.target_error) {
+      left = std::min(left, to_check);
+    } else if (early > 0 && pass > early && tested < early_value) {
+      const double k = std::log(early_value / tested) / std::log(double(pass) / double(early));
+      const double needed = double(pass) * std::pow(tested / *o.target_error, 1.0 / k);
+      left = std::min(left, std::max((needed - double(pass)) * per_pass, to_check));
+    }
   }
   if (std::isfinite(left)) line << " | ~" << std::max(0.0, left) << " s left";
   return line.str();
@@ -89,6 +101,9 @@ void PassLogger::after_pass(const PassInfo& info) {
       .add("mean_noise", s.mean_noise)
       .add("mean_abs_bias", s.mean_abs_bias)
       .add("below_target", s.below_target)
+      .add("predicted_error", std::isfinite(s.predicted_error) ? s.predicted_error : -1.0)
+      .add("predicted_error_upper",
+           std::isfinite(s.predicted_error_upper) ? s.predicted_error_upper : -1.0)
       .add("unknown_pixels", s.unknown_pixels);
   if (reference_) {
     FilmImage film;

@@ -4,6 +4,7 @@
 #include "photonbound/checkpoint.h"
 #include "photonbound/parallel.h"
 #include "photonbound/pass_stages.h"
+#include "photonbound/scene_setup.h"
 #include "photonbound/timer.h"
 
 #include <algorithm>
@@ -22,29 +23,14 @@ constexpr double kMinRadiusFraction = 1e-6;
 // last-level cache between the two, and the array exists whole for a distributed reduction.
 constexpr size_t kFoldBlock = 16384;
 
-}  // namespace
-
-PinholeCamera choose_camera(const Scene& scene, const RenderOptions& o) {
-  const Camera* cam = nullptr;
-  for (const Camera& c : scene.cameras) {
-    if (o.camera.empty() || c.name == o.camera) {
-      cam = &c;
-      break;
-    }
-  }
-  if (!cam)
-    throw UsageError("--camera: " + scene.source + " has no perspective camera named '" + o.camera +
-                     "'");
-  int w = 512, h = 512;
-  if (o.width && o.height) {
-    w = *o.width;
-    h = *o.height;
-  } else {
-    const float aspect = cam->aspect.value_or(1.0f);
-    h = std::clamp(int(std::lround(512.0f / aspect)), 1, 16384);
-  }
-  return PinholeCamera(*cam, w, h);
+// The scene with what the options and the defaults add (scene_setup.h); main has done it already
+// and printed its notes, and doing it again changes nothing.
+Scene completed(Scene scene, const RenderOptions& options) {
+  complete_scene(scene, options);
+  return scene;
 }
+
+}  // namespace
 
 double min_radius(const World& world) { return kMinRadiusFraction * world.scene_size(); }
 
@@ -59,7 +45,7 @@ double default_initial_radius(const EyePassResult& eye, const World& world) {
 
 Renderer::Renderer(Scene scene, const RenderOptions& options)
     : options_(options),
-      world_(std::move(scene), float(options.mirror_roughness)),
+      world_(completed(std::move(scene), options), float(options.mirror_roughness)),
       camera_(choose_camera(world_.scene(), options)),
       tracer_(world_, options.direct == DirectMode::Photons) {
   const auto t0 = Clock::now();
@@ -123,6 +109,7 @@ FilmSettings Renderer::film_settings() const {
   s.confidence = options_.confidence;
   s.metric = options_.metric;
   s.target = options_.target_error.value_or(0.0);
+  s.stop_fraction = options_.stop_fraction;
   return s;
 }
 
@@ -217,6 +204,7 @@ PixelLayout Renderer::layout(const View& v) const {
     });
   }
   l.photon_cap = kPeakWeight * v.max_photon_power / double(options_.photons_per_pass);
+  l.footprint = eye_.median_footprint;
   return l;
 }
 

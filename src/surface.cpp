@@ -38,6 +38,7 @@ Surface World::surface(const Hit& hit) const {
   // Barycentric interpolation is more accurate than origin + t dir far from the origin.
   s.position = w * mesh.positions[i0] + hit.u * mesh.positions[i1] + hit.v * mesh.positions[i2];
   s.ng = mesh.face_normals[hit.prim];
+  s.error = surface_error(mesh.positions[i0], mesh.positions[i1], mesh.positions[i2], s.ng);
   s.ns = s.ng;
   if (mesh.normals) {
     const vec3 n = w * mesh.normals[i0] + hit.u * mesh.normals[i1] + hit.v * mesh.normals[i2];

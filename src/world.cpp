@@ -9,9 +9,6 @@ World::World(Scene scene, float mirror_roughness)
       accel_(scene_),
       lights_(scene_),
       scene_size_(std::max(scene_.bounds.diagonal(), 1e-30f)),
-      // Offsets of 1e-5 of the scene keep rays off their own surface without skipping
-      // neighbouring geometry; the |p| term in offset() covers float spacing far from 0.
-      epsilon_(1e-5f * scene_size_),
       mirror_roughness_(mirror_roughness) {
   size_t triangles = 0;
   for (const Mesh& m : scene_.meshes) triangles += m.indices.size() / 3;

@@ -5,13 +5,19 @@
 #include "analytic.h"
 #include "render_fixture.h"
 
+#include "photonbound/error_model.h"
+
 #include <cstdio>
+#include <cstdlib>
 
 namespace {
 
 using namespace pb;
 
-Method g_method = Method::PPM;  // `bounds_study TABLE sppm` studies SPPM
+Method g_method = Method::PPM;
+
+// The confidence whose one-sided normal quantile is 1.
+double normal_cdf_one() { return 0.8413447460685429; }  // `bounds_study TABLE sppm` studies SPPM
 
 RenderOptions study_options(const std::string& scene, int size, uint64_t passes) {
   RenderOptions o = test::quick_options(scene, size, passes);
@@ -115,6 +121,162 @@ void stopping_table() {
   std::printf("\n");
 }
 
+// The stop rules side by side (issue "Stop on the error the user asked for"): for each scene,
+// confidence and target, 20 seeds rendered to the target with each rule; how often the actual
+// mean error ended within the target, the mean specified / actual, passes and seconds.
+void rules_table(int seeds) {
+  std::printf("### Stop rules: %d seeds per row (%s, 32x32)\n\n", seeds,
+              g_method == Method::PPM ? "PPM" : "SPPM");
+  std::printf(
+      "| scene | rule | confidence | target | runs within target | mean specified / actual | "
+      "mean passes | mean seconds |\n|---|---|---|---|---|---|---|---|\n");
+  struct SceneCase {
+    const char* name;
+    DirectMode direct;
+    uint64_t photons;
+    double targets[3];
+  };
+  const SceneCase scenes[] = {{"plane", DirectMode::Photons, 10000, {0.02, 0.01, 0.005}},
+                              {"box", DirectMode::NextEvent, 10000, {0.06, 0.03, 0.015}}};
+  const std::pair<StopRule, const char*> rules[] = {{StopRule::MeanError, "mean-error"},
+                                                    {StopRule::MeanBound, "mean-bound"},
+                                                    {StopRule::Pixels, "pixels:0.9"}};
+  const char* only = std::getenv("PB_STUDY_RULE");
+  for (const SceneCase& sc : scenes)
+    for (const auto& [rule, rule_name] : rules) {
+      if (only && std::string(only) != rule_name) continue;
+      for (double confidence : {0.5, 0.9, 0.95})
+        for (double target : sc.targets) {
+          int within = 0;
+          double ratio = 0.0, passes = 0.0, seconds = 0.0;
+          for (int seed = 1; seed <= seeds; ++seed) {
+            RenderOptions o = study_options(analytic::by_name(sc.name).file, 32, 1);
+            o.passes = 1000000;
+            o.direct = sc.direct;
+            o.photons_per_pass = sc.photons;
+            o.confidence = confidence;
+            o.target_error = target;
+            o.stop_rule = rule;
+            o.seed = uint64_t(seed) * 7919u;
+            const analytic::TerminationRow r = analytic::termination_run(sc.name, o);
+            within += r.actual <= target;
+            ratio += target / r.actual / seeds;
+            passes += double(r.passes) / seeds;
+            seconds += r.seconds / seeds;
+          }
+          std::printf("| %s | %s | %.0f%% | %.4g | %d / %d | %.2f | %.0f | %.2f |\n", sc.name,
+                      rule_name, 100.0 * confidence, target, within, seeds, ratio, passes, seconds);
+          std::fflush(stdout);
+        }
+    }
+  std::printf("\n");
+}
+
+// The error model's prediction against the actual mean error at fixed pass counts, over seeds:
+// mean actual, mean predicted, the actual's spread across seeds and the predicted spread.
+void calibration_table(int seeds) {
+  std::printf("### Mean-error prediction (%s, 32x32)\n\n",
+              g_method == Method::PPM ? "PPM" : "SPPM");
+  std::printf(
+      "| scene | passes | actual | predicted | actual sd | predicted sd "
+      "|\n|---|---|---|---|---|---|\n");
+  const std::pair<const char*, DirectMode> scenes[] = {{"plane", DirectMode::Photons},
+                                                       {"box", DirectMode::NextEvent}};
+  for (const auto& [name, direct] : scenes)
+    for (uint64_t passes : {16, 64, 256, 1024}) {
+      std::vector<double> actual, predicted, sd;
+      for (int seed = 1; seed <= seeds; ++seed) {
+        RenderOptions o = study_options(analytic::by_name(name).file, 32, passes);
+        o.direct = direct;
+        o.photons_per_pass = 10000;
+        o.seed = uint64_t(seed) * 7919u;
+        o.confidence = normal_cdf_one();  // z = 1: upper - predicted = one sd
+        Renderer r(load_gltf(o.scene), o);
+        while (r.passes() < passes) r.step();
+        const std::vector<double> truth = analytic::pixel_truth(r, analytic::by_name(name).exact);
+        FilmImage img;
+        const FilmSummary sum = r.develop(&img);
+        double e = 0.0;
+        size_t n = 0;
+        for (size_t p = 0; p < truth.size(); ++p)
+          for (int c = 0; c < 3; ++c, ++n)
+            e += std::isnan(truth[p]) ? 0.0 : std::fabs(img.radiance[3 * p + c] - truth[p]);
+        actual.push_back(e / double(n));
+        predicted.push_back(sum.predicted_error);
+        sd.push_back(sum.predicted_error_upper - sum.predicted_error);
+      }
+      auto mean = [](const std::vector<double>& v) {
+        double m = 0.0;
+        for (double x : v) m += x;
+        return m / double(v.size());
+      };
+      const double ma = mean(actual);
+      double var = 0.0, dvar = 0.0, dm = 0.0;
+      for (size_t k = 0; k < actual.size(); ++k)
+        dm += (actual[k] - predicted[k]) / double(actual.size());
+      for (size_t k = 0; k < actual.size(); ++k) {
+        var += (actual[k] - ma) * (actual[k] - ma);
+        const double d = actual[k] - predicted[k] - dm;
+        dvar += d * d;
+      }
+      std::printf("| %s | %llu | %.5f | %.5f | %.5f | %.5f | diff sd %.5f |\n", name,
+                  (unsigned long long)passes, ma, mean(predicted),
+                  std::sqrt(var / double(actual.size() - 1)), mean(sd),
+                  std::sqrt(dvar / double(actual.size() - 1)));
+      std::fflush(stdout);
+    }
+  std::printf("\n");
+}
+
+// The errors' correlation between pixels, measured: sum over offsets up to 8 pixels of the
+// correlation of e / sigma (and of |e|), against correlated_pixels().
+void correlation_table() {
+  const std::pair<const char*, DirectMode> scenes[] = {{"plane", DirectMode::Photons},
+                                                       {"box", DirectMode::NextEvent}};
+  for (const auto& [name, direct] : scenes)
+    for (uint64_t passes : {16, 256}) {
+      RenderOptions o = study_options(analytic::by_name(name).file, 64, passes);
+      o.direct = direct;
+      o.photons_per_pass = 10000;
+      Renderer r(load_gltf(o.scene), o);
+      while (r.passes() < passes) r.step();
+      const std::vector<double> truth = analytic::pixel_truth(r, analytic::by_name(name).exact);
+      FilmImage img;
+      r.develop(&img);
+      const int w = r.eye().width, h = r.eye().height;
+      std::vector<double> z(size_t(w * h)), a(size_t(w * h));
+      double ma = 0.0;
+      for (int p = 0; p < w * h; ++p) {
+        const double sd = std::sqrt(std::max(1e-30, double(img.variance[3 * p])));
+        z[p] = (img.radiance[3 * p] - truth[p]) / sd;
+        a[p] = std::fabs(z[p]);
+        ma += a[p] / (w * h);
+      }
+      double sz = 0.0, sa = 0.0, z0 = 0.0, a0 = 0.0;
+      for (int dy = -8; dy <= 8; ++dy)
+        for (int dx = -8; dx <= 8; ++dx) {
+          double cz = 0.0, ca = 0.0;
+          int n = 0;
+          for (int y = 8; y < h - 8; ++y)
+            for (int x = 8; x < w - 8; ++x) {
+              const int p = y * w + x, q = (y + dy) * w + (x + dx);
+              cz += z[p] * z[q];
+              ca += (a[p] - ma) * (a[q] - ma);
+              ++n;
+            }
+          sz += cz / n;
+          sa += ca / n;
+          if (dx == 0 && dy == 0) z0 = cz / n, a0 = ca / n;
+        }
+      double mr2 = 0.0;
+      for (const PointState& st : r.states()) mr2 += st.r2 / double(r.states().size());
+      std::printf("%s %llu passes: sum corr(e) %.1f, sum corr(|e|) %.1f, model K %.1f (R/f %.2f)\n",
+                  name, (unsigned long long)passes, sz / z0, sa / a0,
+                  correlated_pixels(std::sqrt(mr2), r.eye().median_footprint),
+                  std::sqrt(mr2) / r.eye().median_footprint);
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -123,5 +285,8 @@ int main(int argc, char** argv) {
   if (which == "all" || which == "coverage") coverage_table();
   if (which == "all" || which == "termination") termination_table();
   if (which == "all" || which == "stopping") stopping_table();
+  if (which == "correlation") correlation_table();
+  if (which == "calibration") calibration_table(argc > 3 ? std::atoi(argv[3]) : 20);
+  if (which == "all" || which == "rules") rules_table(argc > 3 ? std::atoi(argv[3]) : 20);
   return 0;
 }

@@ -1,7 +1,10 @@
 // Writes a small corpus of glTF files that use the features the loader decodes, built by
 // gltf_fixture.h: Draco (.glb, .gltf), meshoptimizer with a fallback buffer (.glb, .gltf),
 // KHR_mesh_quantization, sparse accessors (also an indices accessor without bufferView) and a
-// skin without inverseBindMatrices. Every file loads. tools/fuzz.sh seeds the fuzzer with them.
+// skin without inverseBindMatrices. Every file loads. The .glb files have neither camera nor light,
+// as Blender and gltfpack often write them (the render adds the default view and sky); the
+// .gltf files keep gltf_fixture.h's camera and point light. tools/fuzz.sh seeds the fuzzer with
+// them; tests/test_corpus.cpp renders them with tools/make_scenes.py --corpus's files.
 //   make_gltf_corpus OUTPUT_FOLDER
 #include "gltf_fixture.h"
 
@@ -11,6 +14,15 @@
 namespace {
 
 using namespace pb::test;
+
+// The scene lists only the mesh nodes: the fixture's camera (node 0) and light (node 1) stay in
+// the file, unreferenced, as an exporter leaves unused objects out of the scene.
+void without_camera_and_light(Doc& d) {
+  json& roots = d.j["scenes"][0]["nodes"];
+  roots.erase(roots.begin(), roots.begin() + 2);
+}
+
+bool is_glb(const char* name) { return std::string(name).find(".glb") != std::string::npos; }
 
 void quantised(const std::string& file) {
   Doc d;
@@ -71,11 +83,13 @@ int main(int argc, char** argv) {
     Doc d;
     d.require({"KHR_draco_mesh_compression"});
     d.mesh_node(draco_primitive(d, g, d.view(enc), DracoIds{}, g.vertices()));
+    if (is_glb(name)) without_camera_and_light(d);
     d.write((out / name).string());
   }
   for (const char* name : {"meshopt.glb", "meshopt.gltf"}) {
     MeshoptGrid mg(g, true);
     mg.d.mesh_node(mg.prim);
+    if (is_glb(name)) without_camera_and_light(mg.d);
     mg.d.write((out / name).string());
   }
   quantised((out / "quantised.gltf").string());

@@ -176,8 +176,8 @@ TEST(GltfBsdf, MaxFBoundsEveryValue) {
             }
         }
         const float cap = max_component(bsdf.max_f(wo));
-        std::printf("max_f: roughness %.1f metallic %.0f theta %.2f: cap / largest %.3f\n",
-                    rough, metallic, theta, cap / seen);
+        std::printf("max_f: roughness %.1f metallic %.0f theta %.2f: cap / largest %.3f\n", rough,
+                    metallic, theta, cap / seen);
         EXPECT_GE(cap, seen);
         EXPECT_LE(cap, 1.3f * seen);
       }

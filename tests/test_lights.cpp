@@ -209,7 +209,8 @@ TEST(TexturedEmitter, NextEventEstimateMatchesTheIrradianceIntegral) {
   for (int i = 0; i < 400000; ++i) {
     Rng rng(13, 0, uint64_t(i), Stream::Test);
     DirectSample s;
-    e.add(lights.sample_direct(receiver, rng, s) ? double(s.li.x) * glm::dot(s.wi, normal) : 0.0);
+    e.add(lights.sample_direct(receiver, normal, rng, s) ? double(s.li.x) * glm::dot(s.wi, normal)
+                                                         : 0.0);
   }
   EXPECT_NEAR(e.mean(), want, 4.0 * e.se() + 1e-3 * want);
 }
@@ -238,8 +239,10 @@ TEST(DoubleSidedEmitter, EmitsTwiceThePowerFromBothSides) {
   for (int i = 0; i < 200000; ++i) {
     Rng a(15, 0, uint64_t(i), Stream::Test), b(16, 0, uint64_t(i), Stream::Test);
     DirectSample s;
-    front.add(lights.sample_direct(vec3(0.7f, 0.4f, 0.5f), a, s) ? double(s.li.x) : 0.0);
-    behind.add(lights.sample_direct(vec3(0.7f, 0.4f, -0.5f), b, s) ? double(s.li.x) : 0.0);
+    front.add(lights.sample_direct(vec3(0.7f, 0.4f, 0.5f), vec3(0, 0, -1), a, s) ? double(s.li.x)
+                                                                                 : 0.0);
+    behind.add(lights.sample_direct(vec3(0.7f, 0.4f, -0.5f), vec3(0, 0, 1), b, s) ? double(s.li.x)
+                                                                                  : 0.0);
   }
   EXPECT_GT(behind.mean(), 0.0);
   // Near the quad both are sampled in solid angle: each sample is Le x the solid angle.
@@ -250,7 +253,7 @@ TEST(DoubleSidedEmitter, EmitsTwiceThePowerFromBothSides) {
   const Lights single(one);
   Rng rng(17, 0, 0, Stream::Test);
   DirectSample s;
-  EXPECT_FALSE(single.sample_direct(vec3(0.7f, 0.4f, -0.5f), rng, s));
+  EXPECT_FALSE(single.sample_direct(vec3(0.7f, 0.4f, -0.5f), vec3(0, 0, 1), rng, s));
 }
 
 }  // namespace

@@ -38,6 +38,21 @@ TEST(Render, BitIdenticalAcrossThreadCounts) {
   EXPECT_FALSE(same_pixels(one, render_image(o, 2)));
 }
 
+// SPPM too: camera paths are keyed by (seed, pass, pixel), the glass sphere's branch choice
+// included; and with the default sky of a scene without light (unlit.gltf: environment misses
+// in every background pixel, the default view).
+TEST(Render, BitIdenticalAcrossThreadCountsWithSppm) {
+  for (const char* scene : {"cornell.gltf", "unlit.gltf"})
+    for (DirectMode d : {DirectMode::NextEvent, DirectMode::Photons}) {
+      SCOPED_TRACE(scene);
+      RenderOptions o = test::quick_options(scene, 40, 3);
+      o.method = Method::SPPM;
+      o.direct = d;
+      o.photons_per_pass = 20000;
+      EXPECT_TRUE(same_pixels(render_image(o, 1), render_image(o, 2)));
+    }
+}
+
 TEST(Render, BitIdenticalAcrossThreadCountsWithPhotonsOnly) {
   RenderOptions o = test::quick_options("glass_slab.gltf", 40, 3);
   o.photons_per_pass = 20000;

@@ -46,32 +46,75 @@ TEST(SlowBounds, CoverageOnClosedEmittingBoxWithNextEvent) {
   expect_coverage("box", o);
 }
 
-// Three targets halving in turn: the actual mean error at the stop is below the target in every
-// run, and at 50% confidence the target is at most 1.5x the actual error (HJJ10 report 1.3-1.4).
-void expect_termination(double confidence, std::initializer_list<double> targets,
-                        double max_ratio) {
+// Three targets halving in turn, three seeds each, with the default rule (mean-error: the
+// predicted mean |error| at the confidence is at most the target, ESTIMATOR.md section 7).
+// Issue 15's figures: the actual mean error is within the target in at least a fraction C of
+// the runs, and the mean specified / actual is at most 1.2. Nine runs cannot resolve a
+// fraction, so at 50% no run may end more than 25% above its target and at 90% at most one of
+// the nine above it (0.9^9 = 0.39 of a calibrated rule's sets have none, 0.39 + 0.39 one: a
+// second would be a 22% event for a rule that was right, and a sign of an optimistic one).
+// The mean ratio is held to 1.2 at both (the issue's figure) and to at least 0.8 at 50%.
+void expect_termination(Method method, double confidence, std::initializer_list<double> targets) {
+  double ratio_sum = 0.0;
+  int runs = 0, above = 0;
   for (double target : targets) {
-    RenderOptions o = test::quick_options("plane_point.gltf", 32, 1);
-    o.passes = 20000;  // a safety net only: the target must stop it first
-    o.direct = DirectMode::Photons;
-    o.confidence = confidence;
-    o.target_error = target;
-    const analytic::TerminationRow r = analytic::termination_run("plane", o);
-    std::printf("target %.4f at %.0f%%: actual %.5f, specified/actual %.2f, %llu passes\n", target,
-                100.0 * confidence, r.actual, target / r.actual, (unsigned long long)r.passes);
-    EXPECT_EQ(r.stop_reason, "target-error");
-    EXPECT_LE(r.mean_bound, target);
-    EXPECT_LT(r.actual, target);
-    if (max_ratio > 0.0) EXPECT_LE(target / r.actual, max_ratio);
+    for (uint64_t seed : {1, 2, 3}) {
+      RenderOptions o = test::quick_options("plane_point.gltf", 32, 1);
+      o.method = method;
+      o.seed = seed;
+      o.passes = 20000;  // a safety net only: the target must stop it first
+      o.direct = DirectMode::Photons;
+      o.confidence = confidence;
+      o.target_error = target;
+      const analytic::TerminationRow r = analytic::termination_run("plane", o);
+      std::printf(
+          "%s target %.4f at %.0f%% seed %llu: actual %.5f, specified/actual %.2f, %llu passes\n",
+          method == Method::SPPM ? "sppm" : "ppm", target, 100.0 * confidence,
+          (unsigned long long)seed, r.actual, target / r.actual, (unsigned long long)r.passes);
+      EXPECT_EQ(r.stop_reason, "target-error");
+      ratio_sum += target / r.actual;
+      ++runs;
+      if (r.actual > target) ++above;
+      if (confidence <= 0.5) EXPECT_GE(target / r.actual, 0.8);
+    }
   }
+  const double mean_ratio = ratio_sum / runs;
+  std::printf("mean specified/actual %.3f, %d of %d runs above the target\n", mean_ratio, above,
+              runs);
+  EXPECT_LE(mean_ratio, 1.2);
+  if (confidence <= 0.5) EXPECT_GE(mean_ratio, 0.8);
+  if (confidence >= 0.9) EXPECT_LE(above, 1);
 }
 
 TEST(SlowBounds, TerminationAtHalvingTargetsFiftyPercent) {
-  expect_termination(0.5, {0.016, 0.008, 0.004}, 1.5);
+  expect_termination(Method::SPPM, 0.5, {0.016, 0.008, 0.004});
 }
 
 TEST(SlowBounds, TerminationAtHalvingTargetsNinetyPercent) {
-  expect_termination(0.9, {0.04, 0.02, 0.01}, 0.0);
+  expect_termination(Method::SPPM, 0.9, {0.016, 0.008, 0.004});
+}
+
+TEST(SlowBounds, TerminationAtHalvingTargetsNinetyPercentPpm) {
+  expect_termination(Method::PPM, 0.9, {0.016, 0.008, 0.004});
+}
+
+// HJJ10's rule (mean-bound): the mean of the per-pixel 90% bounds at the target. It is
+// conservative at 90% (README: 2.45-2.85x below the target), so every run ends below it.
+TEST(SlowBounds, MeanBoundRuleAtNinetyPercentEndsBelowTheTarget) {
+  for (double target : {0.02, 0.01}) {
+    RenderOptions o = test::quick_options("plane_point.gltf", 32, 1);
+    o.passes = 20000;
+    o.direct = DirectMode::Photons;
+    o.confidence = 0.9;
+    o.target_error = target;
+    o.stop_rule = StopRule::MeanBound;
+    const analytic::TerminationRow r = analytic::termination_run("plane", o);
+    std::printf("mean-bound target %.4f at 90%%: actual %.5f, specified/actual %.2f, %llu passes\n",
+                target, r.actual, target / r.actual, (unsigned long long)r.passes);
+    EXPECT_EQ(r.stop_reason, "target-error");
+    EXPECT_LE(r.mean_bound, target);
+    EXPECT_LT(r.actual, target);
+  }
 }
 
 }  // namespace

@@ -83,7 +83,13 @@ TEST(SlowExtremes, RareArrivalsRendered) {
           (unsigned long long)kmax, coverage, known,
           double(few_covered) / double(std::max(few, 1L)), few,
           double(streak_covered) / double(std::max(streak, 1L)), streak);
-      if (known >= 50) EXPECT_GE(coverage, conf > 0.7 ? 0.7 : 0.45);
+      // Few points are known (54 to 167 here), so the 50% threshold is two binomial standard
+      // errors below nominal (0.077 at 167 points; they share photons, so that is if anything
+      // generous to the bound) and at least the 5 points of the other coverage tests; at 90% a
+      // fixed 0.7: with about 5 photons a point's estimate is far from normal, and the
+      // Poisson-limit bound only has to be of the right size, not calibrated.
+      const double slack = std::max(0.05, 2.0 * std::sqrt(conf * (1.0 - conf) / double(known)));
+      if (known >= 50) EXPECT_GE(coverage, conf > 0.7 ? 0.7 : conf - slack);
     }
   }
 }

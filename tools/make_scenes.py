@@ -50,6 +50,25 @@ Scenes (analytic answers are radiances in the renderer's units):
                      0.067 m closer); floor radiance there ~ 0.8/pi * 0.547 = 0.139, plus
                      ~2% from floor <-> slab-underside interreflection.
 
+  unlit.gltf         A model as exporters write one with neither camera nor light: a 4 x 4
+                     grey ground (rho 0.8), a red box, a blue sphere and a mirror sphere.
+                     Rendered as shipped it gets the default view (framing the bounds) and the
+                     default sky (uniform radiance 1): the README's example.
+  furnace.gltf       Flat-shaded unit sphere (a convex polyhedron, rho 0.5), camera at
+                     (0, 0, 4), no light: under the default sky (Le = 1) exactly L = rho Le =
+                     0.5 wherever the sphere is seen, 1 elsewhere.
+  sun.gltf           10 x 10 plane (rho 0.5) under a directional light of irradiance 2
+                     travelling 30 degrees from straight down, camera 3 above looking down:
+                     exactly L = (0.5/pi) * 2 * cos(30 deg) = 0.275664.
+
+--corpus DIR writes files the way exporters do (tests/test_corpus.cpp renders them, with
+tests/make_gltf_corpus's Draco, meshopt, quantised and sparse files):
+
+  exported.glb       no camera, no light; an animation, a morph target and an extension
+                     photonbound does not implement (KHR_materials_specular).
+  sun_spot.gltf      a camera, a directional light and a spot light with a range.
+  huge_ground.gltf   a 1-unit box and sphere on a 2e5 x 2e5 ground under a sun, a close camera.
+
 Not in scenes/ (25 MB; generated on demand, by the benchmark on first use, or with
 python3 tools/make_scenes.py --heavy DIR):
 
@@ -291,6 +310,7 @@ class GltfBuilder:
         self.materials, self.meshes, self.nodes = [], [], []
         self.cameras, self.lights, self.roots = [], [], []
         self.extensions = set()
+        self.animations = []
 
     # -- buffers
     def _accessor(self, fmt, values, count, component, kind, target, bounds=False):
@@ -356,18 +376,37 @@ class GltfBuilder:
                              thickness=thickness)
 
     # -- meshes, cameras, lights, nodes
-    def mesh(self, name, parts):
-        """parts: [(Geometry, material index)], one primitive each."""
+    def mesh(self, name, parts, flat=False, targets=None):
+        """parts: [(Geometry, material index)], one primitive each; flat: no NORMAL (faceted);
+        targets: per-vertex POSITION offsets of one morph target for every primitive."""
         prims = []
         for geo, mat in parts:
-            attrs = {"POSITION": self._vec3(geo.positions, bounds=True),
-                     "NORMAL": self._vec3(geo.normals)}
+            attrs = {"POSITION": self._vec3(geo.positions, bounds=True)}
+            if not flat:
+                attrs["NORMAL"] = self._vec3(geo.normals)
             ind = self._accessor("I", geo.indices, len(geo.indices), UINT, "SCALAR",
                                  ELEMENT_ARRAY_BUFFER)
             prims.append({"attributes": attrs, "indices": ind, "material": mat,
                           "mode": TRIANGLES})
+            if targets is not None:
+                prims[-1]["targets"] = [{"POSITION": self._vec3(targets(geo), bounds=True)}]
         self.meshes.append({"name": name, "primitives": prims})
+        if targets is not None:
+            self.meshes[-1]["weights"] = [0.5]
         return len(self.meshes) - 1
+
+    def scalars(self, values):
+        """A FLOAT SCALAR accessor with min/max (animation times)."""
+        acc = self._accessor("f", values, len(values), FLOAT, "SCALAR", ARRAY_BUFFER)
+        self.accessors[acc]["min"], self.accessors[acc]["max"] = [min(values)], [max(values)]
+        return acc
+
+    def animate_translation(self, node, times, translations):
+        """One LINEAR translation channel on a node (as exporters write object motion)."""
+        inp, out = self.scalars(times), self._vec3(translations)
+        self.animations.append({"name": "motion", "samplers": [{"input": inp, "output": out}],
+                                "channels": [{"sampler": 0,
+                                              "target": {"node": node, "path": "translation"}}]})
 
     def camera(self, name, yfov, aspect=1.0):
         self.cameras.append({"name": name, "type": "perspective", "perspective": {
@@ -382,6 +421,17 @@ class GltfBuilder:
         return self._light({"name": name, "type": "spot", "color": list(color),
                             "intensity": intensity,
                             "spot": {"innerConeAngle": inner, "outerConeAngle": outer}})
+
+    def directional_light(self, name, intensity, color=(1.0, 1.0, 1.0)):
+        """Irradiance color x intensity on a surface facing it; travels along the node's -Z."""
+        return self._light({"name": name, "type": "directional", "color": list(color),
+                            "intensity": intensity})
+
+    def light_node(self, name, light, travel, position=(0.0, 0.0, 0.0)):
+        """A node whose -Z points along `travel` (directional and spot lights)."""
+        up = (0.0, 0.0, -1.0) if abs(normalize(travel)[1]) > 0.99 else (0.0, 1.0, 0.0)
+        rot = look_rotation((0.0, 0.0, 0.0), travel, up)
+        return self.node(name, light=light, translation=position, rotation=quaternion(rot))
 
     def _light(self, light):
         self.extensions.add(EXT_LIGHTS)
@@ -405,8 +455,8 @@ class GltfBuilder:
             self.roots.append(len(self.nodes) - 1)
         return len(self.nodes) - 1
 
-    def mesh_node(self, name, parts, **xform):
-        return self.node(name, mesh=self.mesh(name, parts), **xform)
+    def mesh_node(self, name, parts, flat=False, targets=None, **xform):
+        return self.node(name, mesh=self.mesh(name, parts, flat, targets), **xform)
 
     def camera_node(self, name, eye, target, yfov, aspect=1.0, up=(0.0, 1.0, 0.0),
                     use_matrix=False):
@@ -429,6 +479,8 @@ class GltfBuilder:
             doc["cameras"] = self.cameras
         if self.lights:
             doc["extensions"] = {EXT_LIGHTS: {"lights": self.lights}}
+        if self.animations:
+            doc["animations"] = self.animations
         doc.update({"buffers": [buf], "bufferViews": self.buffer_views,
                     "accessors": self.accessors})
         return doc
@@ -573,6 +625,85 @@ def build_glass_slab():
     return b
 
 
+def unlit_parts(b):
+    """The unlit model: ground, box, sphere, mirror sphere (the README's example)."""
+    ground = b.lambertian("ground", (0.8, 0.8, 0.8))
+    red = b.lambertian("red", (0.75, 0.2, 0.12))
+    blue = b.lambertian("blue", (0.15, 0.3, 0.7))
+    chrome = b.mirror("chrome", (0.9, 0.9, 0.9))
+    b.mesh_node("ground", [(horizontal_quad((0.0, 0.0, 0.0), 2.0, 2.0), ground)])
+    b.mesh_node("box", [(box((-1.2, 0.0, -0.7), (-0.3, 0.9, 0.2)), red)])
+    b.mesh_node("sphere", [(uv_sphere((0.0, 0.0, 0.0), 0.45), blue)],
+                translation=(0.5, 0.45, -0.3))
+    b.mesh_node("mirror_ball", [(uv_sphere((0.0, 0.0, 0.0), 0.3, 48, 24), chrome)],
+                translation=(-0.1, 0.3, 0.75))
+
+
+def build_unlit():
+    b = GltfBuilder()
+    unlit_parts(b)
+    return b
+
+
+def build_furnace():
+    b = GltfBuilder()
+    grey = b.lambertian("grey", (0.5, 0.5, 0.5))
+    b.mesh_node("sphere", [(uv_sphere((0.0, 0.0, 0.0), 1.0, 48, 24), grey)], flat=True)
+    b.camera_node("camera", eye=(0.0, 0.0, 4.0), target=(0.0, 0.0, 0.0), yfov=0.7)
+    return b
+
+
+SUN_TRAVEL = (math.sin(math.pi / 6), -math.cos(math.pi / 6), 0.0)  # 30 degrees from straight down
+
+
+def build_sun():
+    b = GltfBuilder()
+    grey = b.lambertian("grey", (0.5, 0.5, 0.5))
+    b.mesh_node("plane", [(horizontal_quad((0.0, 0.0, 0.0), 5.0, 5.0), grey)])
+    b.light_node("sun", b.directional_light("sun", 2.0), SUN_TRAVEL)
+    b.camera_node("camera", **PLANE_CAMERA)
+    return b
+
+
+# --corpus: files as exporters write them.
+
+def build_exported():
+    """No camera, no light, an animation, a morph target, an unimplemented extension."""
+    b = GltfBuilder()
+    unlit_parts(b)
+    b.materials[1]["extensions"] = {"KHR_materials_specular": {"specularFactor": 0.5}}
+    b.extensions.add("KHR_materials_specular")
+    bump = lambda geo: [scale(n, 0.05) for n in geo.normals]
+    b.mesh_node("blob", [(uv_sphere((0.0, 0.0, 0.0), 0.2, 24, 12), 2)], targets=bump,
+                translation=(1.2, 0.2, 0.9))
+    b.animate_translation(1, [0.0, 1.0], [(0.0, 0.0, 0.0), (0.0, 0.5, 0.0)])
+    return b
+
+
+def build_sun_spot():
+    b = GltfBuilder()
+    unlit_parts(b)
+    b.light_node("sun", b.directional_light("sun", 3.0, (1.0, 0.95, 0.85)),
+                 (-0.3, -1.0, -0.4))
+    spot = b.spot_light("spot", 30.0, inner=0.2, outer=0.5)
+    b.lights[spot]["range"] = 20.0
+    b.light_node("spot", spot, (0.0, -1.0, 0.0), position=(0.5, 2.5, -0.3))
+    b.camera_node("camera", eye=(1.5, 2.5, 4.5), target=(0.0, 0.4, 0.0), yfov=0.6)
+    return b
+
+
+def build_huge_ground():
+    b = GltfBuilder()
+    ground = b.lambertian("ground", (0.5, 0.5, 0.5))
+    clay = b.lambertian("clay", (0.8, 0.6, 0.4))
+    b.mesh_node("ground", [(horizontal_quad((0.0, 0.0, 0.0), 1e5, 1e5), ground)])
+    b.mesh_node("box", [(box((-0.5, 0.0, -0.5), (0.5, 1.0, 0.5)), clay)])
+    b.mesh_node("sphere", [(uv_sphere((0.0, 0.0, 0.0), 0.4), clay)], translation=(1.1, 0.4, 0.2))
+    b.light_node("sun", b.directional_light("sun", 3.0), (-0.4, -1.0, -0.6))
+    b.camera_node("camera", eye=(2.5, 1.8, 3.5), target=(0.3, 0.4, 0.0), yfov=0.7)
+    return b
+
+
 # ----------------------------------------------------------------------------- validation
 
 
@@ -712,10 +843,22 @@ def check_spot(s):
     check(near(s["lights"][0].direction, (0, -1, 0)), "spot must point down")
 
 
-SCENE_CHECKS = {"cornell.gltf": check_cornell, "cornell_heavy.glb": check_cornell,
+def check_sun(s):
+    check_faces_up(s)
+    check(near(s["lights"][0].direction, normalize(SUN_TRAVEL)), "sun direction")
+
+
+def check_furnace(s):
+    check(closed_volume(s["prims"][0][1]) > 0, "furnace sphere must be closed, outward")
+
+
+SCENE_CHECKS = {"cornell.gltf": check_cornell, "sun.gltf": check_sun,
+                "furnace.gltf": check_furnace, "cornell_heavy.glb": check_cornell,
                 "closed_box.gltf": check_closed_box,
                 "spot.gltf": check_spot, "glass_slab.gltf": check_faces_up,
                 "plane_point.gltf": check_faces_up}
+# No camera; no light but for furnace.gltf, which has a camera and no light.
+WITHOUT_CAMERA_OR_LIGHT = ("unlit.gltf", "exported.glb")
 SAME_AS_PLANE_POINT = ("plane_point.glb", "plane_point_external.gltf", "nested.gltf")
 
 
@@ -736,9 +879,12 @@ def validate(path):
         check("metallicFactor" in pbr, f"material {mat.name}: metallicFactor must be explicit")
         if mat.model == "dielectric":
             check(closed_volume(tris) > 0, f"glass {mat.name}: must be closed, outward")
-    check(len(s["cameras"]) == 1, "exactly one camera expected")
+    bare = path.name in WITHOUT_CAMERA_OR_LIGHT
+    check(len(s["cameras"]) == (0 if bare else 1), "exactly one camera expected" if not bare
+          else "no camera expected")
     emitters = [(mat, tris) for mat, tris in s["prims"] if any(mat.emission)]
-    check(s["lights"] or emitters, "no light")
+    check(bool(s["lights"] or emitters) != bare or path.name == "furnace.gltf",
+          "no light expected" if bare else "no light")
     SCENE_CHECKS.get(path.name, lambda _: None)(s)
 
     tris = sum(len(t) for _, t in s["prims"])
@@ -746,10 +892,16 @@ def validate(path):
     lights += [f"emitter '{m.name}' Le={max(m.emission):g} "
                f"area={sum(length(cross(sub(t[1], t[0]), sub(t[2], t[0]))) / 2 for t in ts):.3g}"
                for m, ts in emitters]
-    cam = s["cameras"][0]
+    lights += [f"{l.type} E={l.json['intensity']:g} along {fmt_vec(l.direction)}"
+               for l in s["lights"] if l.type == "directional"]
+    lights = [x for x in lights if not x.startswith("directional I=")] or ["no light"]
+    view = "no camera"
+    if s["cameras"]:
+        cam = s["cameras"][0]
+        view = (f"camera {fmt_vec(cam.position)} -> {fmt_vec(cam.forward)} yfov {cam.yfov:g}")
     summary = (f"{path.name:27s} {tris:5d} tris, {len(s['prims'])} prims, "
-               f"{len(doc['materials'])} mats, {'; '.join(lights)}; camera {fmt_vec(cam.position)} "
-               f"-> {fmt_vec(cam.forward)} yfov {cam.yfov:g}, {path.stat().st_size} bytes")
+               f"{len(doc['materials'])} mats, {'; '.join(lights)}; {view}, "
+               f"{path.stat().st_size} bytes")
     return s, summary
 
 
@@ -765,32 +917,41 @@ OUTPUTS = [  # (file name, builder, writer)
     ("glass_slab.gltf", build_glass_slab, GltfBuilder.write_gltf),
     ("nested.gltf", build_nested, GltfBuilder.write_gltf),
     ("glossy_plane.gltf", build_glossy_plane, GltfBuilder.write_gltf),
+    ("unlit.gltf", build_unlit, GltfBuilder.write_gltf),
+    ("furnace.gltf", build_furnace, GltfBuilder.write_gltf),
+    ("sun.gltf", build_sun, GltfBuilder.write_gltf),
+]
+
+CORPUS = [
+    ("exported.glb", build_exported, GltfBuilder.write_glb),
+    ("sun_spot.gltf", build_sun_spot, GltfBuilder.write_gltf),
+    ("huge_ground.gltf", build_huge_ground, GltfBuilder.write_gltf),
 ]
 
 
 HEAVY = ("cornell_heavy.glb", build_cornell_heavy, GltfBuilder.write_glb)
 
 
-def write_heavy(out_dir):
-    """--heavy DIR: writes and validates only the benchmark's heavy scene, into DIR."""
+def write_into(out_dir, outputs):
+    """--heavy DIR, --corpus DIR: writes and validates only those files, into DIR."""
     out_dir.mkdir(parents=True, exist_ok=True)
-    name, build, write = HEAVY
-    write(build(), out_dir / name)
-    try:
-        _, summary = validate(out_dir / name)
-    except gltf_scene.GltfError as e:
-        raise SystemExit(f"make_scenes: {name}: INVALID: {e.detail}")
-    except (Invalid, KeyError, ValueError, struct.error) as e:
-        raise SystemExit(f"make_scenes: {name}: INVALID: {e}")
-    print(summary)
+    for name, build, write in outputs:
+        write(build(), out_dir / name)
+        try:
+            _, summary = validate(out_dir / name)
+        except gltf_scene.GltfError as e:
+            raise SystemExit(f"make_scenes: {name}: INVALID: {e.detail}")
+        except (Invalid, KeyError, ValueError, struct.error) as e:
+            raise SystemExit(f"make_scenes: {name}: INVALID: {e}")
+        print(summary)
 
 
 def main():
-    if len(sys.argv) == 3 and sys.argv[1] == "--heavy":
-        write_heavy(Path(sys.argv[2]))
+    if len(sys.argv) == 3 and sys.argv[1] in ("--heavy", "--corpus"):
+        write_into(Path(sys.argv[2]), [HEAVY] if sys.argv[1] == "--heavy" else CORPUS)
         return
     if len(sys.argv) != 1:
-        raise SystemExit("usage: make_scenes.py [--heavy DIR]")
+        raise SystemExit("usage: make_scenes.py [--heavy DIR | --corpus DIR]")
     out_dir = Path(__file__).resolve().parent.parent / "scenes"
     out_dir.mkdir(exist_ok=True)
     for name, build, write in OUTPUTS:

@@ -121,7 +121,10 @@ def run_one(exe, name, cfg, resolution, confidence, target, ref, runs, limit):
            "--resolution", resolution, "--direct", cfg["direct"], "--photons-per-pass",
            str(cfg["photons"]), "--confidence",
            f"{confidence:g}", "--target-error", f"{target:g}", "--time", f"{limit:g}", "--seed",
-           str(SEED), "--log", log, "--reference", ref, "--quiet"]
+           str(SEED), "--log", log, "--reference", ref, "--quiet",
+           # The study of issue 4 (HJJ10's setting: fixed points, the mean-bound rule); its
+           # references are pixel-centre answers.
+           "--method", "ppm", "--stop-rule", "mean-bound"]
     start = time.monotonic()
     p = subprocess.run(cmd, capture_output=True, text=True)
     wall = time.monotonic() - start

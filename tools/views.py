@@ -13,6 +13,8 @@ writes into OUTDIR (PREFIX defaults to IN's file name without .exr):
   PREFIX_noise_bias.png |Bias| / noise half-width per pixel (sums over R, G, B, as
                         `photonbound compare` counts bias-dominated pixels): blue pixels are
                         noise-dominated, red ones bias-dominated
+  PREFIX_target_ratio.png  TargetRatio (bound over the target, 1 = at the target) on a
+                        diverging scale: blue within the target, red beyond
   PREFIX_bounded.png    with --reference: whether |L - L_ref| <= ErrorBound, per pixel
                         (HJJ10 figure 1): how many of its bounded channels are covered
 
@@ -121,6 +123,30 @@ def bound_view(plt, exr, path, label):
     pbtools.save_figure(fig, path)
 
 
+def target_ratio_view(plt, exr, path, label):
+    """The TargetRatio channel (bound over --target-error in the render's metric, max over R, G,
+    B) on a diverging log scale centred at 1: blue within the target, red beyond it."""
+    import matplotlib.colors as mcolors
+    ratio = np.max(exr.rgb("TargetRatio"), axis=-1)
+    bound = exr.rgb("ErrorBound")
+    exact, unknown = pixel_classes(bound)
+    known = ~exact & ~unknown & np.isfinite(ratio) & (ratio > 0)
+    cmap = plt.get_cmap("coolwarm")
+    norm = mcolors.LogNorm(vmin=0.1, vmax=10.0)
+    colours = cmap(norm(np.clip(np.where(known, ratio, 1.0), 0.1, 10.0)))
+    colours[~known & ~exact & ~unknown] = EXACT_COLOUR
+    within = float(np.mean(ratio[known] <= 1.0)) if known.any() else float("nan")
+    target = exr.meta("photonbound:target_error", "none")
+    fig, ax = map_figure(plt, ratio.shape, f"{label}\nbound / target ({target}) at "
+                         f"{confidence_text(exr)} confidence ({100 * within:.1f}% within)")
+    ax.imshow(paint(colours, exact, unknown), interpolation="nearest")
+    bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, extend="both",
+                       shrink=0.9)
+    bar.set_label("TargetRatio, max over R, G, B (1 = at the target)")
+    add_class_legend(ax, exact, unknown)
+    pbtools.save_figure(fig, path)
+
+
 def noise_bias_view(plt, exr, path, label):
     import matplotlib.colors as mcolors
     bound = exr.rgb("ErrorBound")
@@ -209,6 +235,8 @@ def main():
     radiance_view(plt, exr, out("radiance"), args.exposure)
     bound_view(plt, exr, out("bound"), label)
     noise_bias_view(plt, exr, out("noise_bias"), label)
+    if "TargetRatio.R" in exr.planes:  # images before the channel existed lack it
+        target_ratio_view(plt, exr, out("target_ratio"), label)
     if ref is not None:
         bounded_view(plt, exr, ref, out("bounded"), label)
     print(f"views: wrote {name}_*.png in {args.output}")

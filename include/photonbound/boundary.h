@@ -57,6 +57,7 @@ class BoundaryIndex {
   std::vector<Segment> segments_;
   std::vector<uint32_t> start_;  // triangle t's segments: list_[start_[t], start_[t + 1])
   std::vector<uint32_t> list_;
+  std::vector<vec3> centre_;  // of triangles with segments (zero elsewhere)
 };
 
 // The radial integrals of moments(), in closed form (kernel.h's quintic), for 0 <= a <= 1:

@@ -13,6 +13,7 @@ class PinholeCamera {
   int width() const { return width_; }
   int height() const { return height_; }
   const vec3& origin() const { return camera_.position; }
+  const Camera& camera() const { return camera_; }
   // Unit direction through the centre of pixel (x, y).
   vec3 direction(int x, int y) const { return direction(float(x) + 0.5f, float(y) + 0.5f); }
   // Unit direction through the image point (px, py) in pixel units: pixel (x, y) covers

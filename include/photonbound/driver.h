@@ -25,8 +25,8 @@ std::string stop_text(StopReason reason);
 struct DriverState {
   double seconds = 0.0;     // wall clock of all runs so far
   uint64_t next_check = 0;  // pass of the next stop test; 0 = not scheduled yet
-  uint64_t early_pass = 0;  // an earlier test and its mean bound, for the time-left estimate
-  double early_bound = 0.0;
+  uint64_t early_pass = 0;  // an earlier test and its tested quantity, for the time left
+  double early_value = 0.0;
 };
 
 // What observers are told after each pass.
@@ -61,6 +61,13 @@ struct RenderReport {
   FilmSummary summary;
   RunInfo run() const { return {seconds, stop_text(stop)}; }
 };
+
+// What the stop rule of `options` compares with --target-error (README "Stopping"): the upper
+// confidence limit of the image's mean error (mean-error), the mean of the pixels' bounds
+// (mean-bound), or the bound that the share Q of the pixels is within (pixels:Q).
+double tested_quantity(const RenderOptions& options, const FilmSummary& summary);
+// A short name of it for the progress line ("mean error", "mean bound", "90% of pixels").
+std::string tested_name(const RenderOptions& options);
 
 class Driver {
  public:

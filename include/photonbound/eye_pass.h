@@ -12,6 +12,9 @@
 namespace pb {
 
 struct MeasurementPoint {
+  // On the surface, lifted off it by its rounding error bound to the side the camera path
+  // arrived from (World::spawn): next-event shadow rays start here, and the lift (~1e-7 of the
+  // coordinates) is far below any gather radius.
   vec3 position{0.0f};
   vec3 normal{0.0f};   // geometric normal, on the side the camera path arrived from
   vec3 shading{0.0f};  // shading normal, same side

@@ -16,13 +16,14 @@ namespace pb {
 // Planar float images, RGB channels interleaved per pixel (3 floats), scalars one per pixel.
 struct FilmImage {
   int width = 0, height = 0;
-  std::vector<float> radiance;  // L_pix
-  std::vector<float> bound;     // Eb_pix at the chosen confidence; +inf where unknown
-  std::vector<float> bias;      // B_pix, signed
-  std::vector<float> noise;     // noise half-width t sqrt(Var_pix)
-  std::vector<float> variance;  // Var_pix: variance of the mean
-  std::vector<float> photons;   // photons gathered by the pixel's points
-  std::vector<float> radius;    // current radius of the pixel's first point (0 if none)
+  std::vector<float> radiance;      // L_pix
+  std::vector<float> bound;         // Eb_pix at the chosen confidence; +inf where unknown
+  std::vector<float> bias;          // B_pix, signed
+  std::vector<float> noise;         // noise half-width t sqrt(Var_pix)
+  std::vector<float> variance;      // Var_pix: variance of the mean
+  std::vector<float> photons;       // photons gathered by the pixel's points
+  std::vector<float> radius;        // current radius of the pixel's first point (0 if none)
+  std::vector<float> target_ratio;  // bound over the target in the metric (over 1 without one)
 
   // The plane of an EXR channel group (channels.def): 3 floats per pixel for RGB groups.
   const std::vector<float>& plane(Channel id) const;
@@ -34,16 +35,25 @@ struct FilmSummary {
   double mean_abs_bias = 0.0;    // mean |B| (absolute)
   double mean_bias_metric =
       0.0;  // mean |B| in the chosen metric: the part of the bound the noise cannot shrink
-  double below_target = 0.0;    // fraction of known pixels whose every channel meets the target
-  uint64_t unknown_pixels = 0;  // pixels with a point that never received a photon
+  double below_target = 0.0;    // fraction of pixels whose every channel's bound meets the target
+  uint64_t unknown_pixels = 0;  // pixels with a state whose bound is unknown (section 7)
   double relative_floor = 0.0;  // denominator floor of the relative metric
+  // The image's mean absolute error over pixels and channels (what `compare` reports), in the
+  // chosen metric, as the error model predicts it, and its upper confidence limit at the
+  // settings' confidence (ESTIMATOR.md section 7); +inf while a pixel is unknown.
+  double predicted_error = INFINITY;
+  double predicted_error_upper = INFINITY;
+  // The settings' quantile (stop_fraction) of the pixels' bounds (largest channel, in the
+  // metric): at most the target exactly when that share of the pixels is within it.
+  double pixel_quantile_bound = INFINITY;
 };
 
 struct FilmSettings {
   double photons_per_pass = 1.0;
   double confidence = 0.9;
   ErrorMetric metric = ErrorMetric::Absolute;
-  double target = 0.0;  // 0 = no target
+  double target = 0.0;         // 0 = no target
+  double stop_fraction = 0.9;  // the share of pixels pixel_quantile_bound is taken at
 };
 
 // Which states make up each pixel (ESTIMATOR.md sections 5 and 10): PPM's measurement points,
@@ -62,6 +72,7 @@ struct PixelLayout {
   vec3 max_f{0.0f};                          // SPPM
   std::span<const float> glossy_f;           // SPPM: per pixel, glossy points' (empty: none)
   std::vector<float> mass;                   // per state; empty: 1
+  double footprint = 0.0;  // median pixel footprint at the points (the errors' correlation)
 };
 PixelLayout layout_of(const EyePassResult& eye);
 

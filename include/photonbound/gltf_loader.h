@@ -18,8 +18,10 @@ class SceneError : public std::runtime_error {
 
 // Reads a .gltf (embedded or external buffers) or .glb file. Throws SceneError for anything
 // the renderer cannot use: missing or malformed file, out-of-range accessors or indices,
-// non-finite or absurd coordinates, unsupported primitive modes or light types, no camera,
-// no light with positive power. Degenerate triangles are skipped and counted.
+// non-finite or absurd coordinates, unsupported primitive modes or light types, lights whose
+// power overflows float. No camera and no light are allowed (scene_setup.h and view.h add the
+// default view and sky); what is ignored (skins, morph targets, animations, unknown extensions)
+// is in Scene::warnings. Degenerate triangles are skipped and counted.
 Scene load_gltf(const std::string& path);
 
 // The same for a file already in memory (the fuzz target's entry point). `path` names the input

@@ -37,6 +37,14 @@ void write_exr(const std::string& path, const ExrImage& image,
 
 ExrImage read_exr(const std::string& path);
 
+// An image's colour as linear RGB floats, for environment maps: any format OpenImageIO reads
+// (.exr, .hdr), its first three channels (one channel: grey). Throws ImageError naming the file.
+struct RgbImage {
+  int width = 0, height = 0;
+  std::vector<float> rgb;  // 3 floats per pixel, row-major, row 0 at the top
+};
+RgbImage read_rgb_image(const std::string& path);
+
 // Writes an 8-bit RGB PNG (rgb: 3 bytes per pixel, row-major), atomically like write_exr.
 void write_png(const std::string& path, int width, int height,
                const std::vector<unsigned char>& rgb);

@@ -1,10 +1,13 @@
-// All emitters of a scene (punctual lights and emissive triangles) behind one sampler that
-// chooses an emitter in proportion to its power, for photon emission and next-event estimation.
+// All emitters of a scene (punctual and directional lights, emissive triangles and the
+// environment) behind one sampler that chooses an emitter in proportion to its power, for photon
+// emission and next-event estimation.
 #pragma once
 
+#include "photonbound/environment.h"
 #include "photonbound/rng.h"
 #include "photonbound/scene.h"
 
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -13,14 +16,19 @@ namespace pb {
 struct EmittedPhoton {
   vec3 origin{0.0f};
   vec3 dir{0.0f};
-  vec3 flux{0.0f};    // power carried, already divided by every sampling probability
-  vec3 normal{0.0f};  // surface normal at the origin (area lights), 0 for punctual lights
+  vec3 flux{0.0f};     // power carried, already divided by every sampling probability
+  vec3 normal{0.0f};   // surface normal at the origin (area lights), 0 off any surface
+  float error = 0.0f;  // the origin's position error bound along normal (ray_offset.h)
 };
 
 struct DirectSample {
   vec3 wi{0.0f};       // unit direction from the receiver toward the light
-  float distance = 0;  // to the sampled light point
+  float distance = 0;  // to the sampled light point; infinite for directional and environment
   vec3 li{0.0f};       // incident radiance times geometry over pdf, without the receiver's cosine
+  // How far before `distance` a shadow ray must stop so as not to find the light's own surface
+  // by rounding (World::occluded): the sample's error bound on an emissive triangle, 0 for
+  // punctual lights.
+  float margin = 0.0f;
 };
 
 // Direction from p uniform in the solid angle the triangle (v0, v1, v2) subtends, from two
@@ -36,9 +44,19 @@ template <class S, class V>
 V lambertian_emitter_power(S area, const V& radiance) {
   return S(kPiD) * area * radiance;
 }
-vec3 punctual_power(const PunctualLight& light);
+//
+// Directional and environment light enter the scene through a disc of radius
+// emission_radius(bounds) perpendicular to their direction, just outside the bounding sphere
+// (pbrt-v4's DistantLight and infinite lights do the same): a directional light of irradiance E
+// delivers pi r^2 E, an environment pi r^2 times its radiance integrated over the sphere.
+float emission_radius(const Bounds& bounds);
+vec3 punctual_power(const PunctualLight& light, float radius);
+vec3 environment_power(const EnvironmentLight& env, float radius);
 // Every emitter of the scene, summed over channels, in double (so that a float overflow shows).
 double total_emitted_power(const Scene& scene);
+// True when the scene has an emitter of positive power (a light, an emissive triangle or the
+// environment).
+bool has_light(const Scene& scene);
 
 class Lights {
  public:
@@ -51,10 +69,19 @@ class Lights {
 
   EmittedPhoton sample_photon(Rng& rng) const;
   // The largest channel of the power any emitted photon can carry (before the division by the
-  // photons per pass): emitter power over its choice probability.
+  // photons per pass): emitter power over its choice probability; for a map, its largest
+  // radiance over its sampling density.
   float max_photon_flux() const { return max_photon_flux_; }
-  // False when the sample cannot contribute (back side of a one-sided emitter, outside a cone).
-  bool sample_direct(const vec3& receiver, Rng& rng, DirectSample& out) const;
+  // One emitter and one direction toward it for a receiver with unit normal `normal` (the side
+  // it is seen from; a uniform environment is sampled by the cosine about it). False when the
+  // sample cannot contribute (back side of a one-sided emitter, outside a cone).
+  bool sample_direct(const vec3& receiver, const vec3& normal, Rng& rng, DirectSample& out) const;
+
+  // Radiance of the environment seen along dir (camera rays that leave the scene); 0 without one.
+  vec3 environment_radiance(const vec3& dir) const {
+    return environment_ ? environment_->radiance(dir) : vec3(0.0f);
+  }
+  const std::optional<EnvironmentLight>& environment() const { return environment_; }
 
  private:
   // An emissive triangle, or a piece of a textured one: a textured emitter is cut into n^2
@@ -64,6 +91,7 @@ class Lights {
     vec3 p0, e1, e2;
     vec3 normal;  // front side, from the winding
     float area;
+    float error;             // position error bound along normal of points on it (ray_offset.h)
     vec3 radiance;           // emitted radiance; textured: its mean over the piece
     float select = 0.0f;     // radiance the choice weights use: average(radiance), or for a
                              // textured piece at least a tenth of its brightest texel
@@ -82,17 +110,26 @@ class Lights {
   void add_textured(const Mesh& mesh, const Material& mat, uint32_t tri, const Triangle& whole);
   // The radiance at barycentrics (c1, c2) of piece t (of its vertices 1 and 2).
   vec3 radiance_at(const Triangle& t, float c1, float c2) const;
-  // Emitter k < punctual_.size() is a punctual light, the rest are triangles.
+  // Emitter k < punctual_.size() is a punctual or directional light, then come the triangles,
+  // then the environment (when there is one).
   size_t pick(float u) const;
   // Next-event choice weight of emitter k at a receiver (used for small emitter sets).
   float local_weight(size_t k, const vec3& receiver) const;
   static constexpr size_t kLocalSelectionMax = 16;
+  static float plane_tolerance(const Triangle& t, const vec3& receiver);
+  static float shadow_margin(const Triangle& t, const vec3& receiver, float cos_light);
   vec3 spot_falloff(const PunctualLight& light, const vec3& dir) const;
+  // A photon entering through the disc (emission_radius) perpendicular to `travel`.
+  EmittedPhoton from_disc(const vec3& travel, float u0, float u1) const;
+  bool sample_environment(const vec3& normal, float p_pick, Rng& rng, DirectSample& out) const;
 
   std::vector<PunctualLight> punctual_;
   std::vector<Triangle> triangles_;
   std::vector<Source> sources_;
   std::span<const Image> images_;
+  std::optional<EnvironmentLight> environment_;
+  vec3 centre_{0.0f};    // of the scene's bounds
+  float radius_ = 0.0f;  // emission_radius of the bounds
   std::vector<double> cdf_;
   std::vector<float> probability_;
   vec3 total_power_{0.0f};

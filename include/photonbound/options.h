@@ -6,6 +6,7 @@
 
 #include "photonbound/microfacet.h"  // kDefaultMirrorRoughness
 
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <optional>
@@ -27,6 +28,8 @@ enum class Method { SPPM, PPM };
 enum class DirectMode { NextEvent, Photons };
 enum class ErrorMetric { Absolute, Relative };
 enum class ProgressMode { Auto, Always, Never };
+// What --target-error tests (README "Stopping", ESTIMATOR.md section 7).
+enum class StopRule { MeanError, MeanBound, Pixels };
 
 // Members only: ranges, defaults and help live in the option table.
 struct RenderOptions {
@@ -44,12 +47,22 @@ struct RenderOptions {
   double mirror_roughness = kDefaultMirrorRoughness;
   std::optional<int> width, height;
   std::string camera;  // empty = first perspective camera
+  // The view (view.h): each replaces the camera's own, or the default view's when the file has
+  // no camera.
+  std::optional<std::array<double, 3>> look_from, look_at, up;
+  std::optional<double> fov;  // vertical field of view, degrees
+  // The environment light (scene_setup.h): "" for none, or the default sky when the scene has
+  // no light; a colour "V" or "R,G,B"; or an .exr / .hdr equirectangular map.
+  std::string environment;
+  double environment_scale = 1.0;
   int threads = 0;
   uint64_t seed = 1;
   DirectMode direct = DirectMode::NextEvent;
   double confidence = 0.9;  // 1 - beta
   uint64_t min_passes = 16;
   ErrorMetric metric = ErrorMetric::Absolute;
+  StopRule stop_rule = StopRule::MeanError;
+  double stop_fraction = 0.9;  // pixels:Q, the share of pixels whose bound must meet the target
   ProgressMode progress = ProgressMode::Auto;
   std::optional<double> checkpoint_every;
   std::string state_path;
@@ -96,6 +109,11 @@ struct OptionSpec {
 const std::vector<OptionSpec>& option_table();
 const OptionSpec* find_option(std::string_view flag_or_switch);  // null when unknown
 const OptionSpec& option(std::string_view key);                  // by key; throws when unknown
+
+// --environment's text (accepted by the option table): true when it names a map file (.exr or
+// .hdr, any case); otherwise its colour, grey "V" repeated.
+bool environment_is_map(const std::string& text);
+std::array<double, 3> environment_colour(const std::string& text);
 
 // The state file a render writes: --state, or the output path with its extension replaced by
 // ".pbstate".

@@ -13,6 +13,7 @@
 #include "photonbound/image_io.h"
 #include "photonbound/options.h"
 #include "photonbound/photon_pass.h"
+#include "photonbound/view.h"
 #include "photonbound/world.h"
 
 #include <cstdint>
@@ -55,9 +56,6 @@ struct RunInfo {
 
 // The EXR layout of channels.def (no metadata).
 ExrImage pack_channels(const FilmImage& film);
-
-// Picks the camera (by node or camera name when given) and the image size.
-PinholeCamera choose_camera(const Scene& scene, const RenderOptions& options);
 
 // The default initial radius: kFootprintsPerRadius pixel footprints (median over the points),
 // or 1% of the scene without points; never below the radius floor.

@@ -4,6 +4,7 @@
 
 #include "photonbound/accel.h"
 #include "photonbound/lights.h"
+#include "photonbound/ray_offset.h"
 #include "photonbound/scene.h"
 #include "photonbound/surface.h"
 #include "photonbound/texture.h"
@@ -59,22 +60,27 @@ class World {
   // material has a lobe that smooth (the note the command line prints).
   std::string mirror_note() const;
 
-  // Start point for a ray leaving p in direction dir: moved off the surface along ng, to dir's
-  // side, by an amount that scales with the scene and with |p| (float spacing).
-  vec3 offset(const vec3& p, const vec3& ng, const vec3& dir) const {
-    const float mag = max_component(glm::abs(p));
-    const float eps = epsilon_ + mag * 4e-7f;
-    return p + (glm::dot(dir, ng) >= 0.0f ? eps : -eps) * ng;
+  // Start point for a ray leaving surface point p (geometric normal ng, position error bound
+  // `error` along it, Surface::error) toward dir's side (ray_offset.h). Nothing here depends on
+  // the scene's size: a small object beside a huge one keeps offsets of its own scale.
+  static vec3 spawn(const vec3& p, const vec3& ng, float error, const vec3& dir) {
+    return offset_ray_origin(p, ng, error, dir);
+  }
+  static vec3 spawn(const Surface& s, const vec3& dir) {
+    return offset_ray_origin(s.position, s.ng, s.error, dir);
   }
 
-  // Closest hit from p (on a surface with normal ng) in direction dir.
-  bool trace(const vec3& p, const vec3& ng, const vec3& dir, Hit& hit) const {
-    return accel_.intersect(offset(p, ng, dir), dir, 0.0f, INFINITY, hit);
+  // Closest hit from surface point p (normal ng, error bound `error`) in direction dir.
+  bool trace(const vec3& p, const vec3& ng, float error, const vec3& dir, Hit& hit) const {
+    return accel_.intersect(spawn(p, ng, error, dir), dir, 0.0f, INFINITY, hit);
   }
-  // True when the segment from p toward dir of length dist is blocked.
-  bool occluded(const vec3& p, const vec3& ng, const vec3& dir, float dist) const {
-    const vec3 o = offset(p, ng, dir);
-    return accel_.occluded(o, dir, 0.0f, dist * (1.0f - 1e-4f) - 2.0f * epsilon_);
+  // True when the segment from `origin` (already spawned off its surface) toward dir is blocked
+  // before the point at `dist`, less `margin`: the distance within which that point's own
+  // surface may be found by rounding (DirectSample::margin; 0 for a point light, and dist is
+  // infinite for directional and environment light).
+  bool occluded(const vec3& origin, const vec3& dir, float dist, float margin) const {
+    const float tfar = (dist - margin) * kShadowLengthFactor;
+    return tfar > 0.0f && accel_.occluded(origin, dir, 0.0f, tfar);
   }
 
   // Triangles by one global index (mesh after mesh, in Scene order), for the boundary index.
@@ -112,7 +118,6 @@ class World {
   Accel accel_;
   Lights lights_;
   float scene_size_;
-  float epsilon_;
   float mirror_roughness_;
 };
 
