@@ -23,6 +23,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 
 namespace {
 
@@ -37,6 +38,18 @@ extern "C" void on_signal(int sig) {
 }
 
 // Renders `options`; with `saved`, continues that render (already checked to match).
+// What the stop line reports: the quantity the stop rule tests, then the mean bound.
+std::string stop_figures(const pb::RenderOptions& o, const pb::FilmSummary& s) {
+  std::ostringstream out;
+  const std::string conf = pb::number_text(100.0 * o.confidence) + "%";
+  if (o.stop_rule == pb::StopRule::MeanError && std::isfinite(s.predicted_error_upper))
+    out << "mean error at most " << s.predicted_error_upper << " (predicted, " << conf << "), ";
+  if (o.stop_rule == pb::StopRule::Pixels && std::isfinite(s.pixel_quantile_bound))
+    out << pb::tested_name(o) << " within " << s.pixel_quantile_bound << " (" << conf << "), ";
+  out << "mean bound " << s.mean_bound;
+  return out.str();
+}
+
 int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   // Installed first: a Ctrl-C while the scene loads still ends with an image and a state.
   std::signal(SIGINT, on_signal);
@@ -128,8 +141,8 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
     pb::save_state(state_path, {options, scene_hash, renderer.snapshot(), driver.state()});
   if (options.progress != pb::ProgressMode::Never)
     std::cerr << "photonbound: stopped (" << pb::stop_text(report.stop) << ") after "
-              << report.work.passes << " passes, " << report.seconds << " s; mean bound "
-              << report.summary.mean_bound << "; wrote " << options.output << "\n";
+              << report.work.passes << " passes, " << report.seconds << " s; "
+              << stop_figures(options, report.summary) << "; wrote " << options.output << "\n";
   return 0;
 }
 
