@@ -85,6 +85,7 @@ void big_render(const std::string& path, const Config& c) {
   reset_peak_rss();
   const double rss0 = peak_rss_bytes();
   const pb::Scene scene = pb::load_gltf(path);
+  const double rss_loaded = peak_rss_bytes();
   pb::RenderOptions o;
   o.scene = path;
   o.output = "unused.exr";
@@ -129,11 +130,53 @@ void big_render(const std::string& path, const Config& c) {
       grid.level_count());
   std::printf("  peak RSS                 %.0f MiB (%.3f of the 2 GiB limit; %.0f MiB at start)\n",
               peak / kMiB, peak / (2.0 * kGiB), rss0 / kMiB);
+  // Everything the render adds to the loaded scene (World and Embree, eye pass, per-pixel state,
+  // photons, grid, pass sums), per pixel: the method is the renderer's default (SPPM).
+  const double all_in = (peak - rss_loaded) / (1920.0 * 1080.0);
+  std::printf(
+      "  render memory per pixel  %.1f bytes, all included (%s; peak RSS less the loaded"
+      " scene's)\n",
+      all_in, o.method == pb::Method::SPPM ? "SPPM" : "PPM");
   goal("1080p peak RSS (default scene, 1M/pass)", fmt("%.0f MiB", peak / kMiB), "< 2048 MiB",
        peak < 2.0 * kGiB);
+  goal("render memory per pixel, all included (1080p)", fmt("%.1f", all_in), "<= 256",
+       all_in <= 256.0);
   goal("bytes per point incl. grid (1080p)", fmt("%.1f", per_point), "<= 256", per_point <= 256.0);
   goal("grid rebuild / pass (1080p, 1M/pass)", fmt("%.1f%%", 100.0 * t.grid / 2 / pass), "<= 10%",
        t.grid / 2 <= 0.1 * pass);
+}
+
+// SPPM's pass against PPM's at the renderer's defaults (512 wide, 100k photons per pass), each
+// through pb::Renderer::step: SPPM's pass includes its camera paths, PPM's eye pass is once.
+// Passes alternate between the two renderers so that drift in machine load hits both alike.
+void method_pass_ratio(const std::string& path, int passes) {
+  std::printf("\n== SPPM against PPM passes of %s at the default settings (pb::Renderer)\n",
+              path.c_str());
+  const pb::Scene scene = pb::load_gltf(path);
+  pb::RenderOptions o;
+  o.scene = path;
+  o.output = "unused.exr";
+  o.progress = pb::ProgressMode::Never;
+  o.method = pb::Method::SPPM;
+  pb::Renderer sppm(scene, o);
+  o.method = pb::Method::PPM;
+  pb::Renderer ppm(scene, o);
+  for (int k = 0; k < 2; ++k) {  // warm: buffers at size, pages touched
+    sppm.step();
+    ppm.step();
+  }
+  std::vector<double> ts, tp;
+  for (int k = 0; k < passes; ++k) {
+    double t0 = now();
+    sppm.step();
+    ts.push_back(seconds_since(t0));
+    t0 = now();
+    ppm.step();
+    tp.push_back(seconds_since(t0));
+  }
+  const double a = median(ts), b = median(tp);
+  std::printf("  pass (median of %d)      SPPM %.3f s, PPM %.3f s: %.2fx\n", passes, a, b, a / b);
+  goal("SPPM pass / PPM pass (512^2 default scene)", fmt("%.2fx", a / b), "<= 1.3x", a <= 1.3 * b);
 }
 
 // Checkpoint cost at the renderer's default settings (512 wide, 100k photons per pass): what
@@ -366,7 +409,7 @@ int run(int argc, char** argv) {
   Config c;
   std::vector<std::string> scenes;
   std::string phase;
-  bool only_checkpoint = false, only_memory = false;
+  bool only_checkpoint = false, only_memory = false, only_methods = false;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--profile" && i + 1 < argc) {
@@ -375,6 +418,8 @@ int run(int argc, char** argv) {
       only_checkpoint = true;
     } else if (a == "--memory") {
       only_memory = true;
+    } else if (a == "--methods") {
+      only_methods = true;
     } else if (a == "--quick") {
       c.photons = 100000;
       c.raw_rays = size_t(1) << 18;
@@ -382,7 +427,7 @@ int run(int argc, char** argv) {
       c.big_render = false;
     } else if (a == "--help" || a == "-h") {
       std::printf(
-          "usage: photonbound-bench [--quick] [--memory] [--checkpoint] [--profile "
+          "usage: photonbound-bench [--quick] [--memory] [--checkpoint] [--methods] [--profile "
           "raw|trace|pass|grid] "
           "[SCENE ...]\n");
       return 0;
@@ -395,8 +440,9 @@ int run(int argc, char** argv) {
   }
   const std::string cornell = std::string(PHOTONBOUND_SOURCE_DIR) + "/scenes/cornell.gltf";
   if (!phase.empty()) return profile(phase, scenes.empty() ? cornell : scenes[0], c);
-  if (only_checkpoint || only_memory) {
+  if (only_checkpoint || only_memory || only_methods) {
     if (only_memory) big_render(scenes.empty() ? cornell : scenes[0], c);
+    if (only_methods) method_pass_ratio(scenes.empty() ? cornell : scenes[0], c.loop_passes + 2);
     if (only_checkpoint) checkpoint_cost(scenes.empty() ? cornell : scenes[0], c.loop_passes + 2);
     for (const Goal& g : goals)
       std::printf("%-52s %-12s %-11s %s\n", g.what.c_str(), g.measured.c_str(), g.goal.c_str(),
@@ -411,6 +457,7 @@ int run(int argc, char** argv) {
       all, double(c.photons) / 1e3, load_average().c_str());
   if (c.big_render) big_render(cornell, c);
   checkpoint_cost(cornell, c.loop_passes + 2);
+  method_pass_ratio(cornell, c.loop_passes + 2);
   for (const std::string& s : scenes) run_scene(s, c, all);
 
   std::printf(

@@ -96,9 +96,44 @@ inline std::vector<double> pixel_truth(const Renderer& r,
   return truth;
 }
 
+// For the closed box (an axis-aligned box seen from inside): per pixel, whether the surface at
+// the pixel centre lies within `radii` current search radii of an edge of its wall (1), farther
+// (0), or the centre ray misses (-1). The radius is the pixel's (SPPM) or its first point's (PPM)
+// at the time of the call; an edge of the wall is where it meets another wall.
+inline std::vector<int> box_edge_band(const Renderer& r, double radii) {
+  const EyePassResult& eye = r.eye();
+  const size_t pixels = size_t(eye.width) * size_t(eye.height);
+  const Bounds& b = r.world().scene().bounds;
+  std::vector<int> band(pixels, -1);
+  for (size_t p = 0; p < pixels; ++p) {
+    const size_t state = r.options().method == Method::PPM ? size_t(eye.pixel_begin[p]) : p;
+    if (state >= r.states().size() || eye.pixel_begin[p] == eye.pixel_begin[p + 1]) continue;
+    const int x = int(p % size_t(eye.width)), y = int(p / size_t(eye.width));
+    Hit hit;
+    if (!r.world().accel().intersect(r.camera().origin(),
+                                     r.camera().direction(float(x) + 0.5f, float(y) + 0.5f), 0.0f,
+                                     INFINITY, hit))
+      continue;
+    const vec3 q = r.world().surface(hit).position;
+    // The wall is the axis on which q is closest to a face; the edges bound the other two.
+    int wall = 0;
+    double best = INFINITY;
+    for (int a = 0; a < 3; ++a) {
+      const double d = std::min(q[a] - b.lo[a], b.hi[a] - q[a]);
+      if (d < best) best = d, wall = a;
+    }
+    double edge = INFINITY;
+    for (int a = 0; a < 3; ++a)
+      if (a != wall) edge = std::min(edge, double(std::min(q[a] - b.lo[a], b.hi[a] - q[a])));
+    band[p] = edge < radii * std::sqrt(r.states()[state].r2) ? 1 : 0;
+  }
+  return band;
+}
+
 // Actual error and coverage against per-pixel exact values (pixel_truth), over pixel-channels
-// with a known bound.
-inline Accuracy measure(const Renderer& r, const std::vector<double>& truth, double confidence) {
+// with a known bound; with `band`, only the pixels whose band value is `want`.
+inline Accuracy measure(const Renderer& r, const std::vector<double>& truth, double confidence,
+                        const std::vector<int>* band = nullptr, int want = 1) {
   FilmSettings s = r.film_settings();
   s.confidence = confidence;
   FilmImage img;
@@ -108,6 +143,7 @@ inline Accuracy measure(const Renderer& r, const std::vector<double>& truth, dou
   size_t covered = 0;
   for (size_t p = 0; p < truth.size(); ++p) {
     if (std::isnan(truth[p])) continue;  // no measurement point: exact pixel
+    if (band && (*band)[p] != want) continue;
     for (int c = 0; c < 3; ++c) {
       const double bound = img.bound[3 * p + size_t(c)];
       if (!std::isfinite(bound)) continue;

@@ -1,6 +1,7 @@
 // Prints the README's evidence for the error bounds: coverage against the exact answers of the
 // analytic scenes, and renders to halving target errors (specified vs actual error).
-// Run: build/tests/bounds_study [all|coverage|termination|stopping] [ppm|sppm]
+// Run: build/tests/bounds_study [all|coverage|termination|stopping|edges|rules|calibration|
+// correlation] [ppm|sppm] [seeds]
 // (a few minutes on 2 cores)
 #include "analytic.h"
 #include "render_fixture.h"
@@ -117,6 +118,70 @@ void stopping_table() {
     std::printf("| %.0f%% | %.3f | %d / %d | %.2f | %.0f |\n", 100.0 * confidence, target, above,
                 kSeeds, ratio, passes);
     std::fflush(stdout);
+  }
+  std::printf("\n");
+}
+
+// The closed box by where pixels lie (issue "Bounds along geometric edges"): all pixels, the
+// band within two current radii of an edge of their wall, and the interior; coverage, mean
+// error and mean bound / mean error, 4 seeds pooled, and the band's mean error over the
+// interior's.
+void edges_table() {
+  std::printf("### Closed box by distance to an edge (%s, 64x64, 4 seeds pooled)\n\n",
+              g_method == Method::PPM ? "PPM" : "SPPM");
+  std::printf(
+      "| direct | passes | pixels | share | mean error | bound / error at 50%% | 50%% | 90%% | "
+      "95%% |\n|---|---|---|---|---|---|---|---|---|\n");
+  for (DirectMode mode : {DirectMode::Photons, DirectMode::NextEvent}) {
+    // [checkpoint][band: all, edge, interior][confidence] pooled sums
+    struct Sum {
+      double err = 0, bound = 0, covered = 0, n = 0, pixels = 0;
+    };
+    const uint64_t checks[] = {16, 64, 256};
+    const double confs[] = {0.5, 0.9, 0.95};
+    Sum sums[3][3][3];
+    for (uint64_t seed = 1; seed <= 4; ++seed) {
+      RenderOptions o = study_options("closed_box.gltf", 64, 256);
+      o.direct = mode;
+      o.photons_per_pass = 25000;
+      o.seed = seed;
+      const pb::Scene scene = load_gltf(o.scene);
+      Renderer r(scene, o);
+      const std::vector<double> truth = analytic::pixel_truth(r, analytic::closed_box);
+      for (int ci = 0; ci < 3; ++ci) {
+        while (r.passes() < checks[ci]) r.step();
+        const std::vector<int> band = analytic::box_edge_band(r, 2.0);
+        for (int bi = 0; bi < 3; ++bi)
+          for (int k = 0; k < 3; ++k) {
+            const analytic::Accuracy a =
+                bi == 0 ? analytic::measure(r, truth, confs[k])
+                        : analytic::measure(r, truth, confs[k], &band, bi == 1 ? 1 : 0);
+            Sum& s = sums[ci][bi][k];
+            s.err += a.mean_abs_error * double(a.samples);
+            s.bound += a.mean_bound * double(a.samples);
+            s.covered += a.coverage * double(a.samples);
+            s.n += double(a.samples);
+          }
+      }
+    }
+    for (int ci = 0; ci < 3; ++ci) {
+      const char* names[] = {"all", "edge band (< 2 R)", "interior"};
+      for (int bi = 0; bi < 3; ++bi) {
+        const Sum* s = sums[ci][bi];
+        const double err = s[0].err / std::max(s[0].n, 1.0);
+        std::printf("| %s | %llu | %s | %.2f | %.5f | %.2f | %.3f | %.3f | %.3f |\n",
+                    mode == DirectMode::Photons ? "photons" : "nee", (unsigned long long)checks[ci],
+                    names[bi], s[0].n / std::max(sums[ci][0][0].n, 1.0), err,
+                    s[0].bound / std::max(s[0].err, 1e-300), s[0].covered / std::max(s[0].n, 1.0),
+                    s[1].covered / std::max(s[1].n, 1.0), s[2].covered / std::max(s[2].n, 1.0));
+      }
+      const double edge = sums[ci][1][0].err / std::max(sums[ci][1][0].n, 1.0);
+      const double inner = sums[ci][2][0].err / std::max(sums[ci][2][0].n, 1.0);
+      std::printf("| %s | %llu | edge / interior mean error | | %.2f | | | | |\n",
+                  mode == DirectMode::Photons ? "photons" : "nee", (unsigned long long)checks[ci],
+                  edge / inner);
+      std::fflush(stdout);
+    }
   }
   std::printf("\n");
 }
@@ -286,6 +351,7 @@ int main(int argc, char** argv) {
   if (which == "all" || which == "termination") termination_table();
   if (which == "all" || which == "stopping") stopping_table();
   if (which == "correlation") correlation_table();
+  if (which == "all" || which == "edges") edges_table();
   if (which == "calibration") calibration_table(argc > 3 ? std::atoi(argv[3]) : 20);
   if (which == "all" || which == "rules") rules_table(argc > 3 ? std::atoi(argv[3]) : 20);
   return 0;
