@@ -51,6 +51,7 @@ struct Case {
 inline Case by_name(const std::string& name) {
   if (name == "plane") return {"plane_point.gltf", plane_point};
   if (name == "box") return {"closed_box.gltf", closed_box};
+  if (name == "block") return {"closed_block.gltf", closed_box};  // a furnace too: L = 2
   if (name == "glossy") return {"glossy_plane.gltf", glossy_plane};
   throw std::invalid_argument("no analytic scene named " + name);
 }
@@ -96,14 +97,27 @@ inline std::vector<double> pixel_truth(const Renderer& r,
   return truth;
 }
 
-// For the closed box (an axis-aligned box seen from inside): per pixel, whether the surface at
-// the pixel centre lies within `radii` current search radii of an edge of its wall (1), farther
-// (0), or the centre ray misses (-1). The radius is the pixel's (SPPM) or its first point's (PPM)
-// at the time of the call; an edge of the wall is where it meets another wall.
+// For scenes made of axis-aligned boxes (the closed box, and the block inside it): per pixel,
+// whether the surface at the pixel centre lies within `radii` current search radii of an edge of
+// a box, every mesh being one box (1), farther (0), or the centre ray misses (-1). The radius is
+// the pixel's (SPPM) or its first point's (PPM) at the time of the call.
 inline std::vector<int> box_edge_band(const Renderer& r, double radii) {
   const EyePassResult& eye = r.eye();
   const size_t pixels = size_t(eye.width) * size_t(eye.height);
-  const Bounds& b = r.world().scene().bounds;
+  std::vector<std::pair<dvec3, dvec3>> edges;  // the 12 edges of each mesh's bounds
+  for (const Mesh& m : r.world().scene().meshes) {
+    Bounds b;
+    for (const vec3& v : m.positions) b.extend(v);
+    for (int a = 0; a < 3; ++a)
+      for (int k = 0; k < 4; ++k) {
+        dvec3 p0(b.lo), p1(b.lo);
+        const int u = (a + 1) % 3, v = (a + 2) % 3;
+        p0[u] = p1[u] = (k & 1) ? b.hi[u] : b.lo[u];
+        p0[v] = p1[v] = (k & 2) ? b.hi[v] : b.lo[v];
+        p1[a] = b.hi[a];
+        edges.emplace_back(p0, p1);
+      }
+  }
   std::vector<int> band(pixels, -1);
   for (size_t p = 0; p < pixels; ++p) {
     const size_t state = r.options().method == Method::PPM ? size_t(eye.pixel_begin[p]) : p;
@@ -114,18 +128,16 @@ inline std::vector<int> box_edge_band(const Renderer& r, double radii) {
                                      r.camera().direction(float(x) + 0.5f, float(y) + 0.5f), 0.0f,
                                      INFINITY, hit))
       continue;
-    const vec3 q = r.world().surface(hit).position;
-    // The wall is the axis on which q is closest to a face; the edges bound the other two.
-    int wall = 0;
-    double best = INFINITY;
-    for (int a = 0; a < 3; ++a) {
-      const double d = std::min(q[a] - b.lo[a], b.hi[a] - q[a]);
-      if (d < best) best = d, wall = a;
+    const dvec3 q(r.world().surface(hit).position);
+    double d2 = INFINITY;
+    for (const auto& [a, b] : edges) {
+      const dvec3 e = b - a;
+      const double t = std::clamp(glm::dot(q - a, e) / glm::dot(e, e), 0.0, 1.0);
+      const dvec3 c = a + t * e - q;
+      d2 = std::min(d2, glm::dot(c, c));
     }
-    double edge = INFINITY;
-    for (int a = 0; a < 3; ++a)
-      if (a != wall) edge = std::min(edge, double(std::min(q[a] - b.lo[a], b.hi[a] - q[a])));
-    band[p] = edge < radii * std::sqrt(r.states()[state].r2) ? 1 : 0;
+    const double reach = radii * std::sqrt(r.states()[state].r2);
+    band[p] = d2 < reach * reach ? 1 : 0;
   }
   return band;
 }

@@ -36,7 +36,8 @@ void coverage_table() {
   const std::pair<const char*, DirectMode> cases[] = {{"plane", DirectMode::Photons},
                                                       {"glossy", DirectMode::Photons},
                                                       {"box", DirectMode::Photons},
-                                                      {"box", DirectMode::NextEvent}};
+                                                      {"box", DirectMode::NextEvent},
+                                                      {"block", DirectMode::NextEvent}};
   for (const auto& [name, mode] : cases) {
     std::vector<analytic::CoverageRow> pooled;
     for (uint64_t seed = 1; seed <= 4; ++seed) {
@@ -127,12 +128,18 @@ void stopping_table() {
 // error and mean bound / mean error, 4 seeds pooled, and the band's mean error over the
 // interior's.
 void edges_table() {
-  std::printf("### Closed box by distance to an edge (%s, 64x64, 4 seeds pooled)\n\n",
-              g_method == Method::PPM ? "PPM" : "SPPM");
   std::printf(
-      "| direct | passes | pixels | share | mean error | bound / error at 50%% | 50%% | 90%% | "
-      "95%% |\n|---|---|---|---|---|---|---|---|---|\n");
-  for (DirectMode mode : {DirectMode::Photons, DirectMode::NextEvent}) {
+      "### Closed box and the box with a block, by distance to an edge (%s, 64x64, 25k "
+      "photons per pass, 4 seeds pooled)\n\n",
+      g_method == Method::PPM ? "PPM" : "SPPM");
+  std::printf(
+      "| scene | direct | passes | pixels | share | mean error | bound / error at 50%% | 50%% | "
+      "90%% | 95%% |\n|---|---|---|---|---|---|---|---|---|---|\n");
+  const std::pair<const char*, DirectMode> cases[] = {{"box", DirectMode::Photons},
+                                                      {"box", DirectMode::NextEvent},
+                                                      {"block", DirectMode::Photons},
+                                                      {"block", DirectMode::NextEvent}};
+  for (const auto& [scene_name, mode] : cases) {
     // [checkpoint][band: all, edge, interior][confidence] pooled sums
     struct Sum {
       double err = 0, bound = 0, covered = 0, n = 0, pixels = 0;
@@ -141,13 +148,14 @@ void edges_table() {
     const double confs[] = {0.5, 0.9, 0.95};
     Sum sums[3][3][3];
     for (uint64_t seed = 1; seed <= 4; ++seed) {
-      RenderOptions o = study_options("closed_box.gltf", 64, 256);
+      RenderOptions o = study_options(analytic::by_name(scene_name).file, 64, 256);
       o.direct = mode;
       o.photons_per_pass = 25000;
       o.seed = seed;
       const pb::Scene scene = load_gltf(o.scene);
       Renderer r(scene, o);
-      const std::vector<double> truth = analytic::pixel_truth(r, analytic::closed_box);
+      const std::vector<double> truth =
+          analytic::pixel_truth(r, analytic::by_name(scene_name).exact);
       for (int ci = 0; ci < 3; ++ci) {
         while (r.passes() < checks[ci]) r.step();
         const std::vector<int> band = analytic::box_edge_band(r, 2.0);
@@ -169,15 +177,16 @@ void edges_table() {
       for (int bi = 0; bi < 3; ++bi) {
         const Sum* s = sums[ci][bi];
         const double err = s[0].err / std::max(s[0].n, 1.0);
-        std::printf("| %s | %llu | %s | %.2f | %.5f | %.2f | %.3f | %.3f | %.3f |\n",
-                    mode == DirectMode::Photons ? "photons" : "nee", (unsigned long long)checks[ci],
-                    names[bi], s[0].n / std::max(sums[ci][0][0].n, 1.0), err,
+        std::printf("| %s | %s | %llu | %s | %.2f | %.5f | %.2f | %.3f | %.3f | %.3f |\n",
+                    scene_name, mode == DirectMode::Photons ? "photons" : "nee",
+                    (unsigned long long)checks[ci], names[bi],
+                    s[0].n / std::max(sums[ci][0][0].n, 1.0), err,
                     s[0].bound / std::max(s[0].err, 1e-300), s[0].covered / std::max(s[0].n, 1.0),
                     s[1].covered / std::max(s[1].n, 1.0), s[2].covered / std::max(s[2].n, 1.0));
       }
       const double edge = sums[ci][1][0].err / std::max(sums[ci][1][0].n, 1.0);
       const double inner = sums[ci][2][0].err / std::max(sums[ci][2][0].n, 1.0);
-      std::printf("| %s | %llu | edge / interior mean error | | %.2f | | | | |\n",
+      std::printf("| %s | %s | %llu | edge / interior mean error | | %.2f | | | | |\n", scene_name,
                   mode == DirectMode::Photons ? "photons" : "nee", (unsigned long long)checks[ci],
                   edge / inner);
       std::fflush(stdout);

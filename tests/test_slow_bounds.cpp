@@ -46,6 +46,51 @@ TEST(SlowBounds, CoverageOnClosedEmittingBoxWithNextEvent) {
   expect_coverage("box", o);
 }
 
+// The closed box with a block floating inside (a furnace too, L = 2): the block's edges,
+// creases and silhouettes, every pixel counted.
+TEST(SlowBounds, CoverageOnClosedBoxWithBlockWithNextEvent) {
+  RenderOptions o = test::quick_options("closed_block.gltf", 64, 256);
+  o.photons_per_pass = 25000;
+  expect_coverage("block", o);
+}
+
+// Issue "Bounds along geometric edges": the pixels within two radii of an edge (of the walls or
+// the block) as their own set, after 64 passes, 2 seeds pooled (about 2400 edge pixel-channels):
+// coverage at least nominal minus 3 points (a binomial standard error of 0.010 at 50% for
+// independent pixels; neighbours share photons, so the true one is larger), and the band's mean
+// error at most 1.5x the interior's (the edge darkening the boundary correction removes).
+TEST(SlowBounds, EdgeBandOfTheBoxWithABlock) {
+  for (double conf : {0.5, 0.9}) {
+    double edge_err = 0, edge_n = 0, inner_err = 0, inner_n = 0, covered = 0;
+    for (uint64_t seed : {1, 2}) {
+      RenderOptions o = test::quick_options("closed_block.gltf", 64, 64);
+      o.photons_per_pass = 25000;
+      o.seed = seed;
+      o.confidence = conf;
+      const Scene scene = load_gltf(o.scene);
+      Renderer r(scene, o);
+      while (r.passes() < 64) r.step();
+      const std::vector<double> truth = analytic::pixel_truth(r, analytic::closed_box);
+      const std::vector<int> band = analytic::box_edge_band(r, 2.0);
+      const analytic::Accuracy e = analytic::measure(r, truth, conf, &band, 1);
+      const analytic::Accuracy i = analytic::measure(r, truth, conf, &band, 0);
+      edge_err += e.mean_abs_error * double(e.samples);
+      edge_n += double(e.samples);
+      covered += e.coverage * double(e.samples);
+      inner_err += i.mean_abs_error * double(i.samples);
+      inner_n += double(i.samples);
+    }
+    const double coverage = covered / edge_n, ratio = (edge_err / edge_n) / (inner_err / inner_n);
+    std::printf(
+        "block, 64 passes, %.0f%%: edge band %.0f pixel-channels, coverage %.3f, mean "
+        "error edge / interior %.2f\n",
+        100 * conf, edge_n, coverage, ratio);
+    EXPECT_GT(edge_n, 1000.0);
+    EXPECT_GE(coverage, conf - 0.03);
+    EXPECT_LE(ratio, 1.5);
+  }
+}
+
 // Three targets halving in turn, three seeds each, with the default rule (mean-error: the
 // predicted mean |error| at the confidence is at most the target, ESTIMATOR.md section 7).
 // Issue 15's figures: the actual mean error is within the target in at least a fraction C of

@@ -35,6 +35,9 @@ Scenes (analytic answers are radiances in the renderer's units):
                      rho 0.5 emitting Le 1.0. Camera inside at (0,0,0.9) looking -z.
                      Exactly L = Le / (1 - rho) = 2.0 everywhere, in every direction
                      (irradiance 2 pi on every wall; emitted power pi * 1 * 24 m^2 = 24 pi).
+  closed_block.gltf  The closed box with a block floating inside, faces outward, of the same
+                     material: still a closed furnace, L = 2.0 everywhere; the block adds
+                     edges, creases and silhouettes.
   spot.gltf          4 x 4 m floor (rho 0.7) at y=0, spot light I = 20 at (0,2,0) pointing
                      down, inner cone 0.3 rad, outer 0.5 rad. Only direct light; inside the
                      inner cone (r <= 2 tan 0.3 = 0.619 m) exactly
@@ -601,6 +604,18 @@ def build_closed_box():
     return b
 
 
+def build_closed_block():
+    """The closed box with a block floating inside: every surface emits 1 and reflects 0.5,
+    so the enclosure is still a furnace (L = 2 everywhere), and the block adds edges, creases
+    and the silhouettes of one surface in front of another."""
+    b = GltfBuilder()
+    wall = b.lambertian("emissive_wall", (0.5, 0.5, 0.5), radiance=1.0)
+    b.mesh_node("box", [(box((-1.0, -1.0, -1.0), (1.0, 1.0, 1.0), inward=True), wall)])
+    b.mesh_node("block", [(box((-0.45, -0.8, -0.6), (0.25, -0.25, 0.0)), wall)])
+    b.camera_node("camera", eye=(0.0, 0.0, 0.9), target=(0.0, -0.3, 0.0), yfov=1.0)
+    return b
+
+
 def build_spot():
     b = GltfBuilder()
     floor = b.lambertian("floor", (0.7, 0.7, 0.7))
@@ -838,6 +853,13 @@ def check_closed_box(s):
     check(abs(closed_volume(s["prims"][0][1]) + 8.0) < 1e-6, "box must be closed, inward")
 
 
+def check_closed_block(s):
+    check_lambertian(s)
+    check(abs(closed_volume(s["prims"][0][1]) + 8.0) < 1e-6, "box must be closed, inward")
+    check(abs(closed_volume(s["prims"][1][1]) - 0.7 * 0.55 * 0.6) < 1e-6,
+          "block must be closed, outward")
+
+
 def check_spot(s):
     check_faces_up(s)
     check(near(s["lights"][0].direction, (0, -1, 0)), "spot must point down")
@@ -854,7 +876,7 @@ def check_furnace(s):
 
 SCENE_CHECKS = {"cornell.gltf": check_cornell, "sun.gltf": check_sun,
                 "furnace.gltf": check_furnace, "cornell_heavy.glb": check_cornell,
-                "closed_box.gltf": check_closed_box,
+                "closed_box.gltf": check_closed_box, "closed_block.gltf": check_closed_block,
                 "spot.gltf": check_spot, "glass_slab.gltf": check_faces_up,
                 "plane_point.gltf": check_faces_up}
 # No camera; no light but for furnace.gltf, which has a camera and no light.
@@ -911,6 +933,7 @@ OUTPUTS = [  # (file name, builder, writer)
     ("cornell.gltf", build_cornell, GltfBuilder.write_gltf),
     ("plane_point.gltf", build_plane_point, GltfBuilder.write_gltf),
     ("closed_box.gltf", build_closed_box, GltfBuilder.write_gltf),
+    ("closed_block.gltf", build_closed_block, GltfBuilder.write_gltf),
     ("spot.gltf", build_spot, GltfBuilder.write_gltf),
     ("plane_point.glb", build_plane_point, GltfBuilder.write_glb),
     ("plane_point_external.gltf", build_plane_point, GltfBuilder.write_gltf_external),

@@ -115,7 +115,11 @@ class Lights {
   size_t pick(float u) const;
   // Next-event choice weight of emitter k at a receiver (used for small emitter sets).
   float local_weight(size_t k, const vec3& receiver) const;
-  static constexpr size_t kLocalSelectionMax = 16;
+  // Up to this many emitters, the choice is by radiance x solid angle at the receiver; beyond,
+  // by power, which is heavy-tailed where a weak emitter is close: with the 24 emitting
+  // triangles of closed_block.gltf chosen by power, the 90% bound covered 80% after 16 passes
+  // (90% with the local choice). A light tree (pbrt-v4's BVHLightSampler) would remove the cap.
+  static constexpr size_t kLocalSelectionMax = 32;
   static float plane_tolerance(const Triangle& t, const vec3& receiver);
   static float shadow_margin(const Triangle& t, const vec3& receiver, float cos_light);
   vec3 spot_falloff(const PunctualLight& light, const vec3& dir) const;
