@@ -2,13 +2,16 @@
 """Reference images to measure photonbound's actual error against.
 
   tools/reference.py exact plane|box -o REF.exr --resolution WxH [--scene FILE.gltf]
+                     [--pixel area|centre] [--sub N]
   tools/reference.py render SCENE.gltf -o REF.exr --resolution WxH (--time S | --passes N |
                      --target-error E) [--seed S] [--photonbound EXE] [-- MORE RENDER OPTIONS]
 
 `exact` writes the analytic answer of scenes/plane_point.gltf ("plane") or scenes/closed_box.gltf
-("box") at the pixel-centre measurement points photonbound uses (src/camera.cpp), with the
-camera, light, reflectance and emission read from the glTF file (.gltf or .glb, through
-tools/gltf_scene.py). It has every channel of photonbound's layout
+("box"), with the camera, light, reflectance and emission read from the glTF file (.gltf or
+.glb, through tools/gltf_scene.py): with `--pixel area` (the default) each pixel's average over
+its area, from N x N stratified sub-pixel rays (`--sub`, default 16), what `--method sppm`
+estimates; with `--pixel centre` the value at the pixel-centre measurement point `--method ppm`
+uses (src/camera.cpp). It has every channel of photonbound's layout
 (include/photonbound/channels.def); all but the radiance are 0.
 
 `render` runs a long photonbound render (its own error bound channels included) and prints
@@ -100,6 +103,15 @@ def exact_box(gltf, width, height):
     return np.broadcast_to(emission / (1.0 - rho), (height, width, 3)).copy()
 
 
+def exact_image(kind, gltf, width, height, sub=1):
+    """The exact answer per pixel: at the pixel centres (sub = 1), or averaged over sub x sub
+    stratified positions in each pixel. The centres of a sub-times finer image are exactly those
+    positions ((x + (i + 0.5) / sub) / width), so its blocks average to the pixel-area value."""
+    exact = exact_plane if kind == "plane" else exact_box
+    fine = exact(gltf, width * sub, height * sub)
+    return fine.reshape(height, sub, width, sub, 3).mean(axis=(1, 3))
+
+
 def write_reference(path, radiance, metadata):
     """The full channel layout of channels.def: the radiance, and 0 in every other channel
     (bound, bias, noise, variance, photons, radius)."""
@@ -114,13 +126,18 @@ def cmd_exact(args):
     width, height = pbtools.parse_resolution(args.resolution)
     scene = args.scene or os.path.join(pbtools.REPO, "scenes", DEFAULT_SCENES[args.kind])
     gltf = pbtools.Gltf(scene)
-    radiance = (exact_plane if args.kind == "plane" else exact_box)(gltf, width, height)
+    if args.sub < 1 or args.sub > 64:
+        raise ToolError(f"--sub {args.sub}: choose 1 to 64")
+    sub = args.sub if args.pixel == "area" else 1
+    radiance = exact_image(args.kind, gltf, width, height, sub)
     write_reference(args.output, radiance, {
-        "photonbound:reference": f"exact {args.kind}",
+        "photonbound:reference": f"exact {args.kind}, pixel {args.pixel}"
+                                 + (f" ({sub}x{sub} rays)" if args.pixel == "area" else ""),
         "photonbound:scene": scene,
         "photonbound:mean_error_bound": "0",
     })
-    print(f"reference: wrote {args.output} (exact {args.kind}, {width}x{height}, mean radiance "
+    print(f"reference: wrote {args.output} (exact {args.kind}, pixel {args.pixel}, "
+          f"{width}x{height}, mean radiance "
           f"{radiance.mean():.6g})")
 
 
@@ -166,6 +183,11 @@ def main():
     ex.add_argument("-o", "--output", required=True)
     ex.add_argument("--resolution", required=True, help="WxH, as given to photonbound")
     ex.add_argument("--scene", help="the .gltf or .glb file (default: the shipped scene)")
+    ex.add_argument("--pixel", choices=["area", "centre"], default="area",
+                    help="each pixel's average over its area (--method sppm, the default) or "
+                    "its centre's value (--method ppm)")
+    ex.add_argument("--sub", type=int, default=16,
+                    help="with --pixel area: N x N rays per pixel (default 16)")
     rd = sub.add_parser("render", help="a long photonbound render of any scene")
     rd.add_argument("scene")
     rd.add_argument("-o", "--output", required=True)

@@ -3,7 +3,7 @@
 
   tools/study.py OUTDIR [--scenes plane,box,cornell] [--confidences 0.5,0.9]
                  [--targets T1,T2,...] [--resolution WxH] [--run-time-limit S]
-                 [--photonbound EXE]
+                 [--method ppm|sppm] [--stop-rule RULE] [--photonbound EXE]
 
 For each scene, each confidence and each target (four halving targets per scene by default),
 `photonbound render` runs to --target-error with --log and --reference (seed 1). Each final
@@ -20,6 +20,11 @@ long render tools/study/cornell_64x64_reference.exr for the Cornell box. OUTDIR 
   views/              radiance, relative bound, noise/bias and bounded maps of each scene's
                       tightest run at each confidence (tools/views.py)
   runs/, references/  the EXRs and logs
+
+--method ppm (the default: HJJ10's fixed pixel-centre points, against pixel-centre references)
+or sppm (pixel-area references, 16x16 rays per pixel: the plane and the box; the committed
+Cornell reference is a PPM render); --stop-rule is passed on (default mean-bound, HJJ10's rule,
+which the table of issue 4 studies; mean-error is the renderer's default).
 
 --scenes, --targets and --resolution shrink the study (the smoke test runs one scene, two
 targets, a tiny image); --targets and --resolution apply to every scene chosen.
@@ -81,16 +86,21 @@ def float_list(text, what):
     return values
 
 
-def make_reference(name, cfg, resolution, folder):
-    """Path of the scene's reference EXR at `resolution`, generated when it is exact."""
+def make_reference(name, cfg, resolution, folder, method="ppm"):
+    """Path of the scene's reference EXR at `resolution`, generated when it is exact: at the
+    pixel centres for PPM, the pixel-area average for SPPM."""
     if cfg["reference"] == "exact":
-        path = os.path.join(folder, f"{name}_{resolution}_exact.exr")
+        suffix = "exact" if method == "ppm" else "exact_area"
+        path = os.path.join(folder, f"{name}_{resolution}_{suffix}.exr")
         w, h = pbtools.parse_resolution(resolution)
         gltf = pbtools.Gltf(os.path.join(pbtools.REPO, "scenes", cfg["file"]))
-        exact = reference.exact_plane if name == "plane" else reference.exact_box
-        reference.write_reference(path, exact(gltf, w, h),
+        sub = 1 if method == "ppm" else 16
+        reference.write_reference(path, reference.exact_image(name, gltf, w, h, sub),
                                   {"photonbound:reference": f"exact {name}"})
         return path
+    if method != "ppm":
+        raise ToolError(f"{name}: the reference {cfg['reference']} is a PPM (pixel-centre) render; "
+                        "--method sppm studies the plane and the box")
     path = cfg["reference"]
     ref = pbtools.read_exr(path)
     h, w = ref.shape
@@ -114,7 +124,8 @@ def reference_quality(path):
     return float(np.mean(bound[np.isfinite(bound)])), ref.meta("photonbound:confidence"), noise
 
 
-def run_one(exe, name, cfg, resolution, confidence, target, ref, runs, limit):
+def run_one(exe, name, cfg, resolution, confidence, target, ref, runs, limit, method="ppm",
+            rule="mean-bound"):
     stem = f"{name}_c{round(100 * confidence)}_t{target:g}"
     exr, log = os.path.join(runs, stem + ".exr"), os.path.join(runs, stem + ".jsonl")
     cmd = [exe, "render", os.path.join(pbtools.REPO, "scenes", cfg["file"]), "-o", exr,
@@ -122,9 +133,7 @@ def run_one(exe, name, cfg, resolution, confidence, target, ref, runs, limit):
            str(cfg["photons"]), "--confidence",
            f"{confidence:g}", "--target-error", f"{target:g}", "--time", f"{limit:g}", "--seed",
            str(SEED), "--log", log, "--reference", ref, "--quiet",
-           # The study of issue 4 (HJJ10's setting: fixed points, the mean-bound rule); its
-           # references are pixel-centre answers.
-           "--method", "ppm", "--stop-rule", "mean-bound"]
+           "--method", method, "--stop-rule", rule]
     start = time.monotonic()
     p = subprocess.run(cmd, capture_output=True, text=True)
     wall = time.monotonic() - start
@@ -254,6 +263,8 @@ def main():
     ap.add_argument("--resolution", help="WxH for every scene chosen")
     ap.add_argument("--run-time-limit", type=float, default=600.0,
                     help="--time of each render, a safety net (default 600 s)")
+    ap.add_argument("--method", choices=["ppm", "sppm"], default="ppm")
+    ap.add_argument("--stop-rule", default="mean-bound")
     ap.add_argument("--photonbound", default=pbtools.default_photonbound())
     args = ap.parse_args()
     start = time.monotonic()
@@ -280,7 +291,7 @@ def main():
     for name in names:  # all references first: a missing one fails before any render
         cfg = SCENES[name]
         res = args.resolution or cfg["resolution"]
-        path = make_reference(name, cfg, res, ref_dir)
+        path = make_reference(name, cfg, res, ref_dir, args.method)
         refs[name] = (path, *reference_quality(path))
 
     rows, exrs, logs = [], [], []
@@ -289,7 +300,8 @@ def main():
         for conf in confidences:
             for target in sorted(targets or cfg["targets"], reverse=True):
                 row, exr, log = run_one(exe, name, cfg, args.resolution or cfg["resolution"],
-                                        conf, target, refs[name][0], runs, args.run_time_limit)
+                                        conf, target, refs[name][0], runs, args.run_time_limit,
+                                        args.method, args.stop_rule)
                 rows.append(row)
                 exrs.append(exr)
                 logs.append(log)
