@@ -45,14 +45,27 @@ SavedRender saved_after(const RenderOptions& o, uint64_t passes) {
 }
 
 // Continuing from a state file gives the image of an uninterrupted render, bit for bit.
+void expect_resume_bit_identical(const RenderOptions& o, const std::string& state_path);
+
 TEST_F(Checkpoints, ResumeIsBitIdentical) {
-  const RenderOptions o = small_options();
+  expect_resume_bit_identical(small_options(), path("half.pbstate"));
+}
+
+// SPPM: the per-pixel states, visible-pass counters and kernel masses go through the state file
+// too, and the camera paths after the resume are keyed by the same (seed, pass, pixel).
+TEST_F(Checkpoints, ResumeIsBitIdenticalWithSppm) {
+  RenderOptions o = small_options();
+  o.method = Method::SPPM;
+  expect_resume_bit_identical(o, path("half.pbstate"));
+}
+
+void expect_resume_bit_identical(const RenderOptions& o, const std::string& state_path) {
   const Scene scene = load_gltf(o.scene);
   Renderer straight(scene, o);
   const RenderReport full = test::run_to_stop(straight);
 
-  save_state(path("half.pbstate"), saved_after(o, 3));
-  const SavedRender loaded = load_state(path("half.pbstate"));
+  save_state(state_path, saved_after(o, 3));
+  const SavedRender loaded = load_state(state_path);
   Renderer resumed(scene, o);
   resumed.restore(loaded.render);
   EXPECT_EQ(resumed.passes(), 3u);
