@@ -41,11 +41,10 @@ extern "C" void on_signal(int sig) {
 // What the stop line reports: the quantity the stop rule tests, then the mean bound.
 std::string stop_figures(const pb::RenderOptions& o, const pb::FilmSummary& s) {
   std::ostringstream out;
-  const std::string conf = pb::number_text(100.0 * o.confidence) + "%";
-  if (o.stop_rule == pb::StopRule::MeanError && std::isfinite(s.predicted_error_upper))
-    out << "mean error at most " << s.predicted_error_upper << " (predicted, " << conf << "), ";
-  if (o.stop_rule == pb::StopRule::Pixels && std::isfinite(s.pixel_quantile_bound))
-    out << pb::tested_name(o) << " within " << s.pixel_quantile_bound << " (" << conf << "), ";
+  const double tested = pb::tested_quantity(o, s);  // what the progress line shows, too
+  if (o.stop_rule != pb::StopRule::MeanBound && std::isfinite(tested))
+    out << pb::tested_name(o) << " <= " << tested << " at " << pb::number_text(100.0 * o.confidence)
+        << "%, ";
   out << "mean bound " << s.mean_bound;
   return out.str();
 }

@@ -95,6 +95,17 @@ def radiance_view(plt, exr, path, exposure):
             os.remove(tmp)
 
 
+def finish_map(plt, fig, ax, image, norm, cmap, bar_label, exact, unknown, path):
+    """The end every colour-bar view shares: the image, its colour bar, the legend of exact and
+    unknown pixels, and the PNG."""
+    ax.imshow(image, interpolation="nearest")
+    bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, extend="both",
+                       shrink=0.9)
+    bar.set_label(bar_label)
+    add_class_legend(ax, exact, unknown)
+    pbtools.save_figure(fig, path)
+
+
 def bound_view(plt, exr, path, label):
     import matplotlib.colors as mcolors
     radiance, bound = exr.rgb(), exr.rgb("ErrorBound")
@@ -115,12 +126,8 @@ def bound_view(plt, exr, path, label):
     mean_rel = float(np.mean(rel[known])) if known.any() else float("nan")
     fig, ax = map_figure(plt, rel.shape, f"{label}\nrelative error bound at "
                          f"{confidence_text(exr)} confidence (pixel mean {mean_rel:.3g})")
-    ax.imshow(paint(colours, exact, unknown), interpolation="nearest")
-    bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, extend="both",
-                       shrink=0.9)
-    bar.set_label("ErrorBound / max(L, 0.01 mean L), max over R, G, B")
-    add_class_legend(ax, exact, unknown)
-    pbtools.save_figure(fig, path)
+    finish_map(plt, fig, ax, paint(colours, exact, unknown), norm, cmap,
+               "ErrorBound / max(L, 0.01 mean L), max over R, G, B", exact, unknown, path)
 
 
 def target_ratio_view(plt, exr, path, label):
@@ -139,12 +146,8 @@ def target_ratio_view(plt, exr, path, label):
     target = exr.meta("photonbound:target_error", "none")
     fig, ax = map_figure(plt, ratio.shape, f"{label}\nbound / target ({target}) at "
                          f"{confidence_text(exr)} confidence ({100 * within:.1f}% within)")
-    ax.imshow(paint(colours, exact, unknown), interpolation="nearest")
-    bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, extend="both",
-                       shrink=0.9)
-    bar.set_label("TargetRatio, max over R, G, B (1 = at the target)")
-    add_class_legend(ax, exact, unknown)
-    pbtools.save_figure(fig, path)
+    finish_map(plt, fig, ax, paint(colours, exact, unknown), norm, cmap,
+               "TargetRatio, max over R, G, B (1 = at the target)", exact, unknown, path)
 
 
 def noise_bias_view(plt, exr, path, label):
@@ -164,12 +167,8 @@ def noise_bias_view(plt, exr, path, label):
     dominated = float(np.mean(bias[known] > noise[known])) if known.any() else 0.0
     fig, ax = map_figure(plt, ratio.shape, f"{label}\n|bias| / noise half-width "
                          f"({100 * dominated:.1f}% of bounded pixels bias-dominated)")
-    ax.imshow(colours, interpolation="nearest")
-    bar = fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, extend="both",
-                       shrink=0.9)
-    bar.set_label("|bias| / noise  (< 1 noise-dominated, > 1 bias-dominated)")
-    add_class_legend(ax, exact, unknown)
-    pbtools.save_figure(fig, path)
+    finish_map(plt, fig, ax, colours, norm, cmap,
+               "|bias| / noise  (< 1 noise-dominated, > 1 bias-dominated)", exact, unknown, path)
 
 
 def bounded_view(plt, exr, ref, path, label):
