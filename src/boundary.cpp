@@ -267,6 +267,8 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
     for (size_t i = b; i < e; ++i) {
       const Pending& f = found[i];
       segments_[i] = f.s;
+      segments_[i].mid = 0.5f * (f.s.a + f.s.b);
+      segments_[i].half = 0.5f * glm::length(f.s.b - f.s.a);
       const vec3& nh = world.face_normal(f.triangle);
       const vec3 mid = 0.5f * (f.s.a + f.s.b);
       const float radius = 0.5f * glm::length(f.s.b - f.s.a) + max_radius;
@@ -294,6 +296,34 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
   for (uint32_t t = 0; t < n; ++t) start_[t + 1] += start_[t];
   list_.resize(pairs.size());
   for (size_t k = 0; k < pairs.size(); ++k) list_[k] = pairs[k].second;
+  for (int level = 0; level < 2; ++level) {
+    const uint32_t span = level == 0 ? kGroup : kGroup * kGroup;  // list entries per run
+    std::vector<uint32_t>& gs = group_start_[level];
+    gs.assign(size_t(n) + 1, 0);
+    for (uint32_t t = 0; t < n; ++t)
+      gs[t + 1] = gs[t] + (start_[t + 1] - start_[t] + span - 1) / span;
+    groups_[level].resize(gs[n]);
+    parallel_for(n, 4096, [&](size_t b, size_t e) {
+      for (size_t t = b; t < e; ++t) {
+        for (uint32_t g = gs[t]; g < gs[t + 1]; ++g) {
+          const uint32_t first = start_[t] + (g - gs[t]) * span;
+          const uint32_t last = std::min(first + span, start_[t + 1]);
+          Bounds box;
+          for (uint32_t k = first; k < last; ++k) {
+            box.extend(segments_[list_[k]].a);
+            box.extend(segments_[list_[k]].b);
+          }
+          const vec3 c = 0.5f * (box.lo + box.hi);
+          float radius = 0.0f;
+          for (uint32_t k = first; k < last; ++k) {
+            const Segment& sg = segments_[list_[k]];
+            radius = std::max(radius, glm::length(sg.mid - c) + sg.half);
+          }
+          groups_[level][g] = {c, radius};
+        }
+      }
+    });
+  }
   // Centres of the triangles with segments, to tell which side of a segment through a point is
   // its surface (moments()).
   centre_.assign(n, vec3(0.0f));
@@ -309,7 +339,22 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
 
 size_t BoundaryIndex::memory_bytes() const {
   return segments_.capacity() * sizeof(Segment) + start_.capacity() * sizeof(uint32_t) +
+         (group_start_[0].capacity() + group_start_[1].capacity()) * sizeof(uint32_t) +
+         (groups_[0].capacity() + groups_[1].capacity()) * sizeof(Group) +
          list_.capacity() * sizeof(uint32_t) + centre_.capacity() * sizeof(vec3);
+}
+
+float BoundaryIndex::clearance(uint32_t triangle, const vec3& p, float r) const {
+  if (start_.empty()) return r;
+  double nearest = double(r) * double(r);
+  for (uint32_t k = start_[triangle]; k < start_[triangle + 1]; ++k) {
+    const Segment& s = segments_[list_[k]];
+    nearest = std::min(nearest, segment_distance2(p, s.a, s.b));
+  }
+  if (nearest >= double(r) * double(r)) return r;
+  // Rounded down, so that a radius at or below it squares to less than every segment's
+  // distance squared, as moments() tests.
+  return std::nextafter(float(std::sqrt(nearest)), 0.0f) * (1.0f - 1e-6f);
 }
 
 DiscMoments BoundaryIndex::moments(uint32_t triangle, const vec3& p, const vec3& n, float r) const {
@@ -322,8 +367,31 @@ DiscMoments BoundaryIndex::moments(uint32_t triangle, const vec3& p, const vec3&
   const double r2 = double(r) * double(r);
   vec3 t1, t2;
   orthonormal_basis(n, t1, t2);
+  // Beyond radius + r from a bounding sphere's centre nothing inside it is within r (a 1e-4
+  // relative margin covers float rounding; the exact distance decides the rest).
+  const auto far = [&](const vec3& c, float radius) {
+    const vec3 d = p - c;
+    const float reach = (radius + r) * 1.0001f;
+    return glm::dot(d, d) > reach * reach;
+  };
   for (uint32_t k = start_[triangle]; k < start_[triangle + 1] && count < kMaxNear; ++k) {
+    const uint32_t at = k - start_[triangle];
+    if (at % (kGroup * kGroup) == 0) {
+      const Group& g = groups_[1][group_start_[1][triangle] + at / (kGroup * kGroup)];
+      if (far(g.centre, g.radius)) {
+        k += kGroup * kGroup - 1;  // the run's last entry; the loop's ++k starts the next run
+        continue;
+      }
+    }
+    if (at % kGroup == 0) {
+      const Group& g = groups_[0][group_start_[0][triangle] + at / kGroup];
+      if (far(g.centre, g.radius)) {
+        k += kGroup - 1;
+        continue;
+      }
+    }
     const Segment& s = segments_[list_[k]];
+    if (far(s.mid, s.half)) continue;
     if (segment_distance2(p, s.a, s.b) >= r2) continue;
     const dvec3 a = dvec3(s.a) - dvec3(p), b = dvec3(s.b) - dvec3(p);
     ax[count] = glm::dot(a, dvec3(t1));
@@ -358,21 +426,45 @@ DiscMoments BoundaryIndex::moments(uint32_t triangle, const vec3& p, const vec3&
     }
   }
   // Polar quadrature about p: in each direction the visible extent rho (the first segment the
-  // ray meets, or r), and the radial integrals to rho / r (midpoint rule in the angle).
+  // ray meets, or r), and the radial integrals to rho / r (midpoint rule in the angle). A segment
+  // not through p subtends less than pi, so only the directions within the arc between its end
+  // points' angles (one more each side, for rounding) can meet it; the exact test decides.
   const Directions& dir = directions();
-  double mass = 0.0, second = 0.0, lap = 0.0, lap2 = 0.0;
-  for (int k = 0; k < kK; ++k) {
-    const double dx = dir.c[k], dy = dir.s[k];
-    double rho = double(r);
-    for (int i = 0; i < count; ++i) {
+  double rho[kK];
+  std::fill(rho, rho + kK, double(r));
+  constexpr double step = 2.0 * kPiD / kK;
+  for (int i = 0; i < count; ++i) {
+    const double ta = std::atan2(ay[i], ax[i]), tb = std::atan2(ay[i] + ey[i], ax[i] + ex[i]);
+    double width = tb - ta;
+    if (width > kPiD) width -= 2.0 * kPiD;
+    if (width < -kPiD) width += 2.0 * kPiD;
+    const double from = width >= 0.0 ? ta : tb;
+    // Direction k sits at (k + 0.5) step.
+    const int k0 = int(std::floor(from / step - 0.5)) - 1;
+    const int k1 = int(std::ceil((from + std::fabs(width)) / step - 0.5)) + 1;
+    for (int kk = k0; kk <= k1 && kk < k0 + kK; ++kk) {
+      const int k = ((kk % kK) + kK) % kK;
+      const double dx = dir.c[k], dy = dir.s[k];
       // p + t d = a + s e: t = cross(a, e) / cross(d, e), s = cross(a, d) / cross(d, e).
       const double den = dx * ey[i] - dy * ex[i];
       if (std::fabs(den) < 1e-300) continue;
       const double t = (ax[i] * ey[i] - ay[i] * ex[i]) / den;
       const double s = (ax[i] * dy - ay[i] * dx) / den;
-      if (t >= 0.0 && s >= 0.0 && s <= 1.0) rho = std::min(rho, t);
+      if (t >= 0.0 && s >= 0.0 && s <= 1.0) rho[k] = std::min(rho[k], t);
     }
-    const double a = rho / double(r);
+  }
+  static const double full[4] = {kernel_mass_to(1.0), kernel_second_to(1.0), laplacian_mass_to(1.0),
+                                 laplacian_second_to(1.0)};
+  double mass = 0.0, second = 0.0, lap = 0.0, lap2 = 0.0;
+  for (int k = 0; k < kK; ++k) {
+    if (rho[k] >= double(r)) {
+      mass += full[0];
+      second += full[1];
+      lap += full[2];
+      lap2 += full[3];
+      continue;
+    }
+    const double a = rho[k] / double(r);
     mass += kernel_mass_to(a);
     second += kernel_second_to(a);
     lap += laplacian_mass_to(a);

@@ -142,7 +142,8 @@ dvec3 direct_light(const World& world, const MeasurementPoint& point, const Glos
 
 void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
                  const HashGrid& grid, const std::vector<PhotonHit>& hits,
-                 const BoundaryIndex* boundary, GlossyTable glossy, std::span<PassGather> out) {
+                 const BoundaryIndex* boundary, GlossyTable glossy, std::span<PassGather> out,
+                 std::span<const float> clearance) {
   GlossyCursor cursor(glossy, points.size());
   for (size_t k = 0; k < points.size(); ++k) {
     const MeasurementPoint& p = points[k];
@@ -151,9 +152,9 @@ void gather_pass(std::span<const MeasurementPoint> points, std::span<const Point
       gather_photons(p, *g, states[k].r2, grid, hits, out[k]);
     else
       gather_photons(p, states[k].r2, grid, hits, out[k]);
-    if (boundary)
-      out[k].disc =
-          boundary->moments(p.triangle, p.position, p.normal, search_radius(states[k].r2));
+    const float r = search_radius(states[k].r2);
+    if (boundary && (clearance.empty() || r > clearance[k]))
+      out[k].disc = boundary->moments(p.triangle, p.position, p.normal, r);
   }
 }
 
@@ -192,7 +193,8 @@ void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> poi
       const GlossyTable glossy{in.glossy, first + b};
       gather_pass(points.subspan(first + b, e - b),
                   std::span<const PointState>(states).subspan(first + b, e - b), in.grid, in.hits,
-                  in.boundary, glossy, out);
+                  in.boundary, glossy, out,
+                  in.clearance.empty() ? in.clearance : in.clearance.subspan(first + b, e - b));
       if (in.next_event)
         next_event_pass(in.world, points.subspan(first + b, e - b), glossy, in.seed, in.pass,
                         first + b, out);

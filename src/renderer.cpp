@@ -74,6 +74,16 @@ Renderer::Renderer(Scene scene, const RenderOptions& options)
   // Radii only shrink: segments farther than the initial radius (as a float, what queries use)
   // from a triangle never matter to its points.
   boundary_ = BoundaryIndex(world_, std::nextafter(float(initial_radius_), INFINITY));
+  if (options_.method == Method::PPM) {
+    clearance_.resize(eye_.points.size());
+    const float r0 = search_radius(initial_radius_ * initial_radius_);
+    parallel_for(eye_.points.size(), 4096, [&](size_t b, size_t e) {
+      for (size_t k = b; k < e; ++k) {
+        const MeasurementPoint& p = eye_.points[k];
+        clearance_[k] = boundary_.clearance(p.triangle, p.position, r0);
+      }
+    });
+  }
   max_photon_power_ = world_.lights().max_photon_flux();
   // The largest BRDF of any Lambertian surface a visible point can lie on (the sparse-photon
   // bound); glossy points bound theirs with Bsdf::max_f (capped_points_, glossy_f_).
@@ -131,8 +141,9 @@ void Renderer::step(std::vector<PointState>* copy) {
   t = Clock::now();
   const bool nee = options_.direct == DirectMode::NextEvent;
   if (copy) copy->resize(n);
-  const PassInputs in{world_,        grid_, hits_, params_,    &boundary_,
-                      options_.seed, pass,  nee,   eye_.glossy};
+  const BoundaryIndex* boundary = boundary_on_ ? &boundary_ : nullptr;
+  const PassInputs in{world_,        grid_, hits_, params_,     boundary,
+                      options_.seed, pass,  nee,   eye_.glossy, clearance_};
   PointState* const out = copy ? copy->data() : nullptr;
   if (options_.method == Method::PPM) {
     gather_and_fold(in, eye_.points, states_, radii_, sums_, out);

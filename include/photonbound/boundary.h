@@ -43,6 +43,11 @@ class BoundaryIndex {
   // The disc of radius r about p, a point of triangle `triangle` whose normal on the side it is
   // seen from is n. r must not exceed the index's max_radius.
   DiscMoments moments(uint32_t triangle, const vec3& p, const vec3& n, float r) const;
+  // A radius up to which moments(triangle, p, n, radius) is the whole disc: the distance from p
+  // to the nearest segment within r, rounded down, or r when none is. PPM's points are fixed
+  // and their radii only shrink, so one call per point at the initial radius spares every later
+  // pass the segment scan of the points far from an edge.
+  float clearance(uint32_t triangle, const vec3& p, float r) const;
 
   size_t segment_count() const { return segments_.size(); }
   size_t memory_bytes() const;
@@ -53,10 +58,25 @@ class BoundaryIndex {
  private:
   struct Segment {
     vec3 a, b;
+    // Its bounding sphere (midpoint, half length): moments() rejects the far segments of a
+    // large triangle's list with it before the exact distance.
+    vec3 mid{0.0f};
+    float half = 0.0f;
   };
   std::vector<Segment> segments_;
   std::vector<uint32_t> start_;  // triangle t's segments: list_[start_[t], start_[t + 1])
   std::vector<uint32_t> list_;
+  // The list in runs of kGroup entries, each with a bounding sphere of its segments, and the
+  // runs in runs of kGroup again (kGroup^2 entries): a floor under a tessellated sphere lists
+  // hundreds of short cuts of the sphere's foot, and a point far from them skips each run with
+  // one test. Triangle t's runs of level l: groups_[l][group_start_[l][t], ...).
+  static constexpr uint32_t kGroup = 8;
+  struct Group {
+    vec3 centre{0.0f};
+    float radius = 0.0f;
+  };
+  std::vector<uint32_t> group_start_[2];
+  std::vector<Group> groups_[2];
   std::vector<vec3> centre_;  // of triangles with segments (zero elsewhere)
 };
 

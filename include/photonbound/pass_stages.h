@@ -65,10 +65,13 @@ struct GlossyTable {
 // states[k].r2 is the radius of the pass. A point with f = 0 (SPPM: no visible point this
 // pass) gathers nothing and so does not shrink its radius. Points in `glossy` evaluate their
 // Bsdf per photon. With `boundary`, also the kernel's moments over the reachable part of each
-// point's disc (ESTIMATOR.md section 11); without, every disc counts as whole.
+// point's disc (ESTIMATOR.md section 11); without, every disc counts as whole. `clearance`
+// (PPM; empty otherwise) holds per point BoundaryIndex::clearance: the radius up to which its
+// disc is whole without asking.
 void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
                  const HashGrid& grid, const std::vector<PhotonHit>& hits,
-                 const BoundaryIndex* boundary, GlossyTable glossy, std::span<PassGather> out);
+                 const BoundaryIndex* boundary, GlossyTable glossy, std::span<PassGather> out,
+                 std::span<const float> clearance = {});
 
 // Stage 4: adds one next-event sample at points[k] to out[k].direct, drawn from
 // Rng(seed, pass, first + k, Stream::DirectLight): point (or pixel) first + k's own stream.
@@ -95,6 +98,7 @@ struct PassInputs {
   uint64_t seed = 0, pass = 0;
   bool next_event = true;
   std::span<const GlossyPoint> glossy{};  // PPM: EyePassResult::glossy (indices into the points)
+  std::span<const float> clearance{};     // PPM: per point, BoundaryIndex::clearance
 };
 void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> points,
                      std::span<PointState> states, std::span<float> radii,

@@ -103,6 +103,9 @@ class Renderer {
   const PinholeCamera& camera() const { return camera_; }
   double initial_radius() const { return initial_radius_; }
   const BoundaryIndex& boundary() const { return boundary_; }
+  // The bench's probe-cost comparison (issue 14) alone switches the boundary moments off: every
+  // disc then counts as whole, which is biased along edges (ESTIMATOR.md section 11).
+  void use_boundary_moments(bool on) { boundary_on_ = on; }
 
  private:
   // The current state or a snapshot's, without copying either.
@@ -135,6 +138,8 @@ class Renderer {
   PhotonTracer tracer_;
   HashGrid grid_;
   BoundaryIndex boundary_;  // where surfaces end, for discs up to the initial radius
+  bool boundary_on_ = true;
+  std::vector<float> clearance_;  // PPM: per point, BoundaryIndex::clearance at the initial radius
   std::vector<PhotonHit> hits_;
   std::vector<vec3> hit_positions_;
   std::vector<float> radii_;       // search_radius(r2) per point, for the grid build
