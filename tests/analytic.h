@@ -213,8 +213,9 @@ struct TerminationRow {
   double confidence = 0.0;
   uint64_t passes = 0;
   double seconds = 0.0;
-  double mean_bound = 0.0;  // the renderer's own image mean bound at the stop
-  double actual = 0.0;      // mean over pixels and channels of |L - L_exact|
+  double mean_bound = 0.0;     // the renderer's own image mean bound at the stop
+  double actual = 0.0;         // mean over pixels and channels of |L - L_exact|
+  double pixels_within = 0.0;  // share of pixels whose every channel is within the target
   std::string stop_reason;
 };
 
@@ -234,14 +235,20 @@ inline TerminationRow termination_run(const std::string& name, RenderOptions o) 
   r.develop(&img);
   const std::vector<double> truth = pixel_truth(r, sc.exact);
   double sum = 0.0;
-  size_t n = 0;
+  size_t n = 0, within = 0;
   for (size_t p = 0; p < truth.size(); ++p) {
     if (std::isnan(truth[p])) continue;
-    for (int c = 0; c < 3; ++c)
-      sum += std::fabs(double(img.radiance[3 * p + size_t(c)]) - truth[p]);
+    double worst = 0.0;
+    for (int c = 0; c < 3; ++c) {
+      const double e = std::fabs(double(img.radiance[3 * p + size_t(c)]) - truth[p]);
+      sum += e;
+      worst = std::max(worst, e);
+    }
+    within += worst <= row.target;
     n += 3;
   }
   row.actual = n ? sum / double(n) : 0.0;
+  row.pixels_within = n ? double(within) / double(n / 3) : 0.0;
   return row;
 }
 

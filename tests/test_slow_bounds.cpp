@@ -2,6 +2,7 @@
 // section 9): coverage at 50% and 90% confidence, and renders to halving target errors.
 // Labelled slow. build/tests/bounds_study prints the same figures as tables for the README.
 #include "analytic.h"
+#include "reference_truth.h"
 #include "render_fixture.h"
 
 #include <gtest/gtest.h>
@@ -91,6 +92,63 @@ TEST(SlowBounds, EdgeBandOfTheBoxWithABlock) {
   }
 }
 
+// Issue "Bounds along geometric edges" on the Cornell box, against its reference (a long SPPM
+// render, tools/study/cornell_64x64_sppm_reference.exr; README "Coverage" says how it was made).
+// SPPM at 10k photons per pass, 2 seeds pooled, every pixel counted, the reference's own noise
+// counted (reference::Accuracy): coverage within 2 points of nominal at 16, 64 and 256 passes
+// (8,000+ correlated pixel-channels per check: a binomial standard error of 0.006 at 50% for
+// independent ones, and the same pixels are measured at three pass counts), and the band within
+// two radii of an edge (about 40% of the pixels) at least nominal minus 3. The band's mean
+// relative error after 64 passes is at most 1.5x the interior's: the absolute ratio measures the
+// brightness of the light's rim and the corners, not a darkening, so brightness is divided out.
+TEST(SlowBounds, CoverageOnCornellBoxAgainstItsReference) {
+  const reference::Truth truth =
+      reference::load(std::string(PHOTONBOUND_REFERENCES) + "/cornell_64x64_sppm_reference.exr");
+  const uint64_t checks[] = {16, 64, 256};
+  const double confs[] = {0.5, 0.9, 0.95};
+  // [check][band: all, edge, interior][confidence]: covered, samples; and relative errors.
+  double covered[3][3][3] = {}, samples[3][3][3] = {}, rel[3] = {}, rel_n[3] = {};
+  for (uint64_t seed : {1, 2}) {
+    RenderOptions o = test::quick_options("cornell.gltf", 64, 256);
+    o.method = Method::SPPM;
+    o.photons_per_pass = 10000;
+    o.seed = seed;
+    const Scene scene = load_gltf(o.scene);
+    Renderer r(scene, o);
+    for (int ci = 0; ci < 3; ++ci) {
+      while (r.passes() < checks[ci]) r.step();
+      const std::vector<int> band = reference::edge_band(r, 2.0);
+      for (int bi = 0; bi < 3; ++bi)
+        for (int k = 0; k < 3; ++k) {
+          const reference::Accuracy a =
+              bi == 0 ? reference::measure(r, truth, confs[k])
+                      : reference::measure(r, truth, confs[k], &band, bi == 1 ? 1 : 0);
+          covered[ci][bi][k] += a.coverage_with_reference_noise * double(a.samples);
+          samples[ci][bi][k] += double(a.samples);
+          if (ci == 1 && k == 0 && bi > 0) {
+            rel[bi] += a.mean_rel_error * double(a.samples);
+            rel_n[bi] += double(a.samples);
+          }
+        }
+    }
+  }
+  for (int ci = 0; ci < 3; ++ci)
+    for (int bi = 0; bi < 2; ++bi)
+      for (int k = 0; k < 3; ++k) {
+        const double c = covered[ci][bi][k] / samples[ci][bi][k];
+        std::printf("cornell, %3llu passes, %s, %.0f%%: coverage %.3f over %.0f\n",
+                    (unsigned long long)checks[ci], bi == 0 ? "all" : "edge band", 100 * confs[k],
+                    c, samples[ci][bi][k]);
+        EXPECT_GT(samples[ci][bi][k], bi == 0 ? 8000.0 : 2000.0);
+        EXPECT_GE(c, confs[k] - (bi == 0 ? 0.02 : 0.03))
+            << checks[ci] << " passes, band " << bi << ", confidence " << confs[k];
+        if (bi == 0) EXPECT_LE(c, confs[k] + 0.02) << checks[ci] << " passes, " << confs[k];
+      }
+  const double ratio = (rel[1] / rel_n[1]) / (rel[2] / rel_n[2]);
+  std::printf("cornell, 64 passes: mean relative error edge / interior %.2f\n", ratio);
+  EXPECT_LE(ratio, 1.5);
+}
+
 // Three targets halving in turn, three seeds each, with the default rule (mean-error: the
 // predicted mean |error| at the confidence is at most the target, ESTIMATOR.md section 7).
 // Issue 15's figures: the actual mean error is within the target in at least a fraction C of
@@ -141,6 +199,39 @@ TEST(SlowBounds, TerminationAtHalvingTargetsNinetyPercent) {
 
 TEST(SlowBounds, TerminationAtHalvingTargetsNinetyPercentPpm) {
   expect_termination(Method::PPM, 0.9, {0.016, 0.008, 0.004});
+}
+
+// pixels:0.9 at 90% (issue 15): at least 90% of the pixels have a bound at or below the target,
+// and each bound holds with probability 0.9, so at least 0.81 of the pixels are within the
+// target for a calibrated bound even if every failure fell on a pixel whose bound was just at
+// the target; in practice most bounds at the stop are well below it. The closed box (32x32, next
+// event, 5k photons per pass), targets 0.06 and 0.03, three seeds: every run keeps at least 0.85
+// of its pixels within the target, and the mean over the six at least 0.9.
+TEST(SlowBounds, PixelsRuleAtNinetyPercentKeepsNinetyPercentOfPixelsWithinTheTarget) {
+  double mean = 0.0;
+  int runs = 0;
+  for (double target : {0.06, 0.03})
+    for (uint64_t seed : {1, 2, 3}) {
+      RenderOptions o = test::quick_options("closed_box.gltf", 32, 1000000);
+      o.method = Method::SPPM;
+      o.photons_per_pass = 5000;
+      o.confidence = 0.9;
+      o.target_error = target;
+      o.stop_rule = StopRule::Pixels;
+      o.stop_fraction = 0.9;
+      o.seed = seed;
+      const analytic::TerminationRow r = analytic::termination_run("box", o);
+      std::printf(
+          "box, pixels:0.9 at 90%%, target %.3f, seed %llu: %llu passes, %.3f of pixels "
+          "within the target, mean error %.4f\n",
+          target, (unsigned long long)seed, (unsigned long long)r.passes, r.pixels_within,
+          r.actual);
+      EXPECT_EQ(r.stop_reason, "target-error");
+      EXPECT_GE(r.pixels_within, 0.85);
+      mean += r.pixels_within;
+      ++runs;
+    }
+  EXPECT_GE(mean / runs, 0.9);
 }
 
 // HJJ10's rule (mean-bound): the mean of the per-pixel 90% bounds at the target. It is
