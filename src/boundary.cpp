@@ -347,7 +347,23 @@ size_t BoundaryIndex::memory_bytes() const {
 float BoundaryIndex::clearance(uint32_t triangle, const vec3& p, float r) const {
   if (start_.empty()) return r;
   double nearest = double(r) * double(r);
+  // A run whose bounding sphere is farther than the nearest segment so far holds none nearer
+  // (with a 1e-4 relative margin for float rounding).
+  const auto beyond = [&](const Group& g) {
+    const float d = glm::length(p - g.centre) - g.radius;
+    return d > 0.0f && double(d) * double(d) > nearest * 1.0002;
+  };
   for (uint32_t k = start_[triangle]; k < start_[triangle + 1]; ++k) {
+    const uint32_t at = k - start_[triangle];
+    if (at % (kGroup * kGroup) == 0 &&
+        beyond(groups_[1][group_start_[1][triangle] + at / (kGroup * kGroup)])) {
+      k += kGroup * kGroup - 1;
+      continue;
+    }
+    if (at % kGroup == 0 && beyond(groups_[0][group_start_[0][triangle] + at / kGroup])) {
+      k += kGroup - 1;
+      continue;
+    }
     const Segment& s = segments_[list_[k]];
     nearest = std::min(nearest, segment_distance2(p, s.a, s.b));
   }

@@ -203,14 +203,14 @@ PixelLayout Renderer::layout(const View& v) const {
   } else {
     if (!capped_points_.empty()) l.points = capped_points_;
     // Each point's disc's kernel mass at the current radius (the sparse-photon bound and the
-    // validity of the bias model need it; interior points cost a list scan).
+    // validity of the bias model need it; points within their clearance are whole).
     l.mass.assign(v.states.size(), 1.0f);
     parallel_for(v.states.size(), 1024, [&](size_t b, size_t e) {
       for (size_t k = b; k < e; ++k) {
         const MeasurementPoint& p = eye_.points[k];
-        l.mass[k] =
-            float(boundary_.moments(p.triangle, p.position, p.normal, search_radius(v.states[k].r2))
-                      .mass);
+        const float r = search_radius(v.states[k].r2);
+        if (!clearance_.empty() && r <= clearance_[k]) continue;  // the whole disc: mass 1
+        l.mass[k] = float(boundary_.moments(p.triangle, p.position, p.normal, r).mass);
       }
     });
   }

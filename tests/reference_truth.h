@@ -68,11 +68,11 @@ inline std::vector<int> edge_band(const Renderer& r, double radii) {
 }
 
 struct Accuracy {
-  double mean_abs_error = 0.0;  // mean over pixel-channels of |L - L_reference|
-  double mean_rel_error = 0.0;  // of |L - L_ref| / max(L_ref, 0.01): brightness aside
+  double mean_abs_error = 0.0;     // mean over pixel-channels of |L - L_reference|
+  double mean_rel_error = 0.0;     // of |L - L_ref| / max(L_ref, 0.01): brightness aside
   double mean_signed_error = 0.0;  // of L - L_ref: below 0 where the image is darker
-  double mean_bound = 0.0;      // mean over the same of the render's bound
-  double coverage = 0.0;        // fraction with |L - L_reference| <= bound
+  double mean_bound = 0.0;         // mean over the same of the render's bound
+  double coverage = 0.0;           // fraction with |L - L_reference| <= bound
   // The same with the reference's own noise counted: |L - L_ref| <= sqrt(bound^2 + (z sigma)^2),
   // sigma^2 the reference's Variance and z the two-sided normal quantile of the confidence (the
   // half-width its noise needs at that confidence, both errors near normal and independent).

@@ -6,6 +6,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 namespace pb {
@@ -137,6 +138,68 @@ TEST_F(BoundaryMoments, PointOnTheWallFootSeesHalfTheWall) {
   const uint32_t t = world_.triangle_index(1, 0);
   const DiscMoments m = index_.moments(t, vec3(1.0f, 0.3f, 0.0f), vec3(-1, 0, 0), 0.2f);
   EXPECT_NEAR(m.mass, 0.5, 5e-3);
+}
+
+// The floor of floor_and_wall with a comb of 40 thin quads standing through it (x = -0.8 +
+// 0.04 k, y in [0.2, 0.3], z in [-0.5, 0.5]): each crossing is a blocker segment of the floor, so
+// the floor's triangles list more segments than one run of the index holds.
+Scene floor_with_comb() {
+  Scene s = floor_and_wall();
+  Mesh comb;
+  comb.name = "comb";
+  for (int k = 0; k < 40; ++k) {
+    const float x = -0.8f + 0.04f * float(k);
+    const uint32_t b = uint32_t(comb.positions.size());
+    comb.positions.insert(comb.positions.end(),
+                          {{x, 0.2f, -0.5f}, {x, 0.3f, -0.5f}, {x, 0.3f, 0.5f}, {x, 0.2f, 0.5f}});
+    comb.indices.insert(comb.indices.end(), {b, b + 1, b + 2, b, b + 2, b + 3});
+  }
+  s.meshes.push_back(comb);
+  for (const vec3& p : s.meshes.back().positions) s.bounds.extend(p);
+  return s;
+}
+
+// Distance from (px, py) on the floor to the nearest place it ends: its square's border (the
+// crease x = 1 included) or a tooth of the comb (the segment x = x_k, y in [0.2, 0.3]).
+double nearest_end(double px, double py) {
+  double d = std::min({1.0 - px, px + 1.0, 1.0 - py, py + 1.0});
+  for (int k = 0; k < 40; ++k) {
+    const double x = -0.8 + 0.04 * k, y = std::clamp(py, 0.2, 0.3);
+    d = std::min(d, std::hypot(px - x, py - y));
+  }
+  return d;
+}
+
+// clearance() against the brute-force distance, over a grid of floor points and three radii,
+// and consistent with moments(): the disc is whole up to the clearance and cut just beyond it.
+TEST(BoundaryClearance, IsTheDistanceToTheNearestEndWithinTheRadius) {
+  const World world(floor_with_comb());
+  const BoundaryIndex index(world, 0.5f);
+  int cut = 0, checked = 0;
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j) {
+      const double px = -0.975 + 0.05 * i, py = -0.975 + 0.05 * j;
+      // Floor triangle 0 holds y < x, triangle 1 the rest (floor.indices).
+      const uint32_t t = world.triangle_index(0, py < px ? 0 : 1);
+      if (std::fabs(py - px) < 1e-3) continue;  // on the diagonal: either triangle
+      const vec3 p(float(px), float(py), 0.0f);
+      for (float r : {0.05f, 0.2f, 0.45f}) {
+        const float c = index.clearance(t, p, r);
+        const double expected = std::min(nearest_end(px, py), double(r));
+        // The comb's cuts lie just above the floor (at half the index's tolerance, 3.3e-4
+        // here), and distances are 3D: within 1e-3 of the planar distance.
+        EXPECT_NEAR(c, expected, 1e-3) << px << ", " << py << ", r " << r;
+        EXPECT_LE(c, r);
+        EXPECT_TRUE(index.moments(t, p, vec3(0, 0, 1), c).full) << px << ", " << py;
+        if (c < r) {
+          EXPECT_FALSE(index.moments(t, p, vec3(0, 0, 1), std::min(r, c * 1.01f)).full)
+              << px << ", " << py << ", r " << r;
+          ++cut;
+        }
+        ++checked;
+      }
+    }
+  EXPECT_GT(cut, checked / 4);  // the grid exercises both sides
 }
 
 }  // namespace
