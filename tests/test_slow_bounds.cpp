@@ -94,13 +94,14 @@ TEST(SlowBounds, EdgeBandOfTheBoxWithABlock) {
 
 // Issue "Bounds along geometric edges" on the Cornell box, against its reference (a long SPPM
 // render, tools/study/cornell_64x64_sppm_reference.exr; README "Coverage" says how it was made).
-// SPPM at 10k photons per pass, 2 seeds pooled, every pixel counted, the reference's own noise
+// SPPM at 10k photons per pass, 4 seeds pooled, every pixel counted, the reference's own noise
 // counted (reference::Accuracy): coverage within 2 points of nominal at 16, 64 and 256 passes
-// (8,000+ correlated pixel-channels per check: a binomial standard error of 0.006 at 50% for
+// (16,000+ correlated pixel-channels per check: a binomial standard error of 0.004 at 50% for
 // independent ones, and the same pixels are measured at three pass counts), and the band within
 // two radii of an edge (about 40% of the pixels) at least nominal minus 3. The band's mean
 // relative error after 64 passes is at most 1.5x the interior's: the absolute ratio measures the
-// brightness of the light's rim and the corners, not a darkening, so brightness is divided out.
+// brightness of the light's rim and the corners, not a darkening, so brightness is divided out
+// (measured: 1.42 pooled, 1.42 and 1.47 for one and two seeds; absolute ratio 3.97).
 TEST(SlowBounds, CoverageOnCornellBoxAgainstItsReference) {
   const reference::Truth truth =
       reference::load(std::string(PHOTONBOUND_REFERENCES) + "/cornell_64x64_sppm_reference.exr");
@@ -108,7 +109,7 @@ TEST(SlowBounds, CoverageOnCornellBoxAgainstItsReference) {
   const double confs[] = {0.5, 0.9, 0.95};
   // [check][band: all, edge, interior][confidence]: covered, samples; and relative errors.
   double covered[3][3][3] = {}, samples[3][3][3] = {}, rel[3] = {}, rel_n[3] = {};
-  for (uint64_t seed : {1, 2}) {
+  for (uint64_t seed : {1, 2, 3, 4}) {
     RenderOptions o = test::quick_options("cornell.gltf", 64, 256);
     o.method = Method::SPPM;
     o.photons_per_pass = 10000;
@@ -139,7 +140,7 @@ TEST(SlowBounds, CoverageOnCornellBoxAgainstItsReference) {
         std::printf("cornell, %3llu passes, %s, %.0f%%: coverage %.3f over %.0f\n",
                     (unsigned long long)checks[ci], bi == 0 ? "all" : "edge band", 100 * confs[k],
                     c, samples[ci][bi][k]);
-        EXPECT_GT(samples[ci][bi][k], bi == 0 ? 8000.0 : 2000.0);
+        EXPECT_GT(samples[ci][bi][k], bi == 0 ? 16000.0 : 4000.0);
         EXPECT_GE(c, confs[k] - (bi == 0 ? 0.02 : 0.03))
             << checks[ci] << " passes, band " << bi << ", confidence " << confs[k];
         if (bi == 0) EXPECT_LE(c, confs[k] + 0.02) << checks[ci] << " passes, " << confs[k];
