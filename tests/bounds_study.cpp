@@ -302,7 +302,7 @@ void rules_table(int seeds, int other_seeds) {
   const SceneCase scenes[] = {
       {"plane", "plane_point.gltf", 32, DirectMode::Photons, 5000, {0.04, 0.02, 0.01}},
       {"box", "closed_box.gltf", 32, DirectMode::NextEvent, 5000, {0.06, 0.03, 0.015}},
-      {"cornell", "cornell.gltf", 64, DirectMode::NextEvent, 2500, {0.04, 0.02, 0.01}}};
+      {"cornell", "cornell.gltf", 64, DirectMode::NextEvent, 2500, {0.025, 0.0125, 0.00625}}};
   const std::pair<StopRule, const char*> rules[] = {{StopRule::MeanError, "mean-error"},
                                                     {StopRule::MeanBound, "mean-bound"},
                                                     {StopRule::Pixels, "pixels:0.9"}};
