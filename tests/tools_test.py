@@ -153,6 +153,17 @@ def cornell_reference_margin(exe, tmp):
     smallest = min(r["actual"] for r in rows)
     check(len(rows) == 8 and bound > 0 and smallest >= study.REFERENCE_MARGIN * bound,
           f"Cornell reference bound {bound:.3g} is not 10x below the smallest error {smallest:.3g}")
+    # --method sppm judges the Cornell box by its SPPM (pixel-area) reference: one short run.
+    out = os.path.join(tmp, "cornell_sppm")
+    p = run_tool("study.py", out, "--scenes", "cornell", "--method", "sppm", "--stop-rule",
+                 "mean-error", "--targets", "0.04", "--confidences", "0.5", "--photonbound", exe)
+    check(p.returncode == 0, f"SPPM Cornell study failed ({p.returncode}): {p.stderr.strip()}")
+    if p.returncode == 0:
+        rows = json.load(open(os.path.join(out, "results.json")))
+        check(len(rows) == 1 and 0.0 < rows[0]["actual"] < 0.08,
+              f"SPPM Cornell study: rows {rows}")
+        check("cornell_64x64_sppm_reference.exr" in open(os.path.join(out, "table.md")).read(),
+              "SPPM Cornell study: the table does not name the SPPM reference")
     # The warning itself: given for a loose reference, not for a tight or an exact one.
     check(study.reference_warning("x", 0.002, 0.01) is not None, "no warning at 5x")
     check(study.reference_warning("x", 0.0005, 0.01) is None, "warning at 20x")
