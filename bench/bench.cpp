@@ -173,9 +173,28 @@ void big_render(const std::string& path, const Config& c) {
               double(c.photons) / 1e3, at_big);
 }
 
+// Median pass times of two renderers, after 2 warm passes each (buffers at size, pages touched),
+// over `passes` passes alternating between them so that drift in machine load hits both alike.
+std::pair<double, double> alternating_pass_medians(pb::Renderer& a, pb::Renderer& b, int passes) {
+  for (int k = 0; k < 2; ++k) {
+    a.step();
+    b.step();
+  }
+  std::vector<double> ta, tb;
+  for (int k = 0; k < passes; ++k) {
+    double t0 = now();
+    a.step();
+    ta.push_back(seconds_since(t0));
+    t0 = now();
+    b.step();
+    tb.push_back(seconds_since(t0));
+  }
+  return {median(ta), median(tb)};
+}
+
 // Issue 14's probe cost: passes with and without the boundary moments (BoundaryIndex::moments
 // per point within a radius of a segment), both methods at the renderer's defaults (512 wide,
-// 100k photons per pass), alternating so that drift in machine load hits both alike.
+// 100k photons per pass).
 void probe_cost(const std::string& path, int passes) {
   std::printf("\n== boundary moments in passes of %s at the default settings (pb::Renderer)\n",
               path.c_str());
@@ -188,22 +207,9 @@ void probe_cost(const std::string& path, int passes) {
     o.method = m;
     pb::Renderer with(scene, o), without(scene, o);
     without.use_boundary_moments(false);
-    for (int k = 0; k < 2; ++k) {  // warm: buffers at size, pages touched
-      with.step();
-      without.step();
-    }
-    std::vector<double> tw, to;
-    for (int k = 0; k < passes; ++k) {
-      double t0 = now();
-      with.step();
-      tw.push_back(seconds_since(t0));
-      t0 = now();
-      without.step();
-      to.push_back(seconds_since(t0));
-    }
-    const double a = median(tw), b = median(to);
+    const auto [a, b] = alternating_pass_medians(with, without, passes);
     const char* name = m == pb::Method::SPPM ? "SPPM" : "PPM";
-    std::printf("  %-4s pass (median of %d) with %.3f s, without %.3f s: +%.1f%%\n", name, passes,
+    std::printf("  %-4s pass (median of %d) with %.3f s, without %.3f s: %+.1f%%\n", name, passes,
                 a, b, 100.0 * (a / b - 1.0));
     goal(std::string("boundary moments, ") + name + " pass (512^2 default scene)",
          fmt("%+.1f%%", 100.0 * (a / b - 1.0)), "<= +10%", a <= 1.1 * b);
@@ -212,7 +218,6 @@ void probe_cost(const std::string& path, int passes) {
 
 // SPPM's pass against PPM's at the renderer's defaults (512 wide, 100k photons per pass), each
 // through pb::Renderer::step: SPPM's pass includes its camera paths, PPM's eye pass is once.
-// Passes alternate between the two renderers so that drift in machine load hits both alike.
 void method_pass_ratio(const std::string& path, int passes) {
   std::printf("\n== SPPM against PPM passes of %s at the default settings (pb::Renderer)\n",
               path.c_str());
@@ -225,20 +230,7 @@ void method_pass_ratio(const std::string& path, int passes) {
   pb::Renderer sppm(scene, o);
   o.method = pb::Method::PPM;
   pb::Renderer ppm(scene, o);
-  for (int k = 0; k < 2; ++k) {  // warm: buffers at size, pages touched
-    sppm.step();
-    ppm.step();
-  }
-  std::vector<double> ts, tp;
-  for (int k = 0; k < passes; ++k) {
-    double t0 = now();
-    sppm.step();
-    ts.push_back(seconds_since(t0));
-    t0 = now();
-    ppm.step();
-    tp.push_back(seconds_since(t0));
-  }
-  const double a = median(ts), b = median(tp);
+  const auto [a, b] = alternating_pass_medians(sppm, ppm, passes);
   std::printf("  pass (median of %d)      SPPM %.3f s, PPM %.3f s: %.2fx\n", passes, a, b, a / b);
   goal("SPPM pass / PPM pass (512^2 default scene)", fmt("%.2fx", a / b), "<= 1.3x", a <= 1.3 * b);
 }

@@ -215,60 +215,29 @@ void cornell_table(int seeds) {
       "| passes | pixels | share | mean error | bound / error at 50%% | 50%% | 90%% | 95%% | "
       "with the reference's noise: 50%% | 90%% | 95%% |\n"
       "|---|---|---|---|---|---|---|---|---|---|---|\n");
-  struct Sum {
-    double err = 0, rel = 0, sgn = 0, bound = 0, covered = 0, covered_ref = 0, n = 0;
-  };
-  const uint64_t checks[] = {16, 64, 256};
-  const double confs[] = {0.5, 0.9, 0.95};
-  Sum sums[3][3][3];  // [checkpoint][band: all, edge, interior][confidence]
-  for (int seed = 1; seed <= seeds; ++seed) {
-    RenderOptions o = study_options("cornell.gltf", 64, 256);
-    o.photons_per_pass = 10000;
-    o.seed = uint64_t(seed);
-    const pb::Scene scene = load_gltf(o.scene);
-    Renderer r(scene, o);
-    for (int ci = 0; ci < 3; ++ci) {
-      while (r.passes() < checks[ci]) r.step();
-      const std::vector<int> band = reference::edge_band(r, 2.0);
-      for (int bi = 0; bi < 3; ++bi)
-        for (int k = 0; k < 3; ++k) {
-          const reference::Accuracy a =
-              bi == 0 ? reference::measure(r, truth, confs[k])
-                      : reference::measure(r, truth, confs[k], &band, bi == 1 ? 1 : 0);
-          Sum& s = sums[ci][bi][k];
-          const double n = double(a.samples);
-          s.err += a.mean_abs_error * n;
-          s.rel += a.mean_rel_error * n;
-          s.sgn += a.mean_signed_error * n;
-          s.bound += a.mean_bound * n;
-          s.covered += a.coverage * n;
-          s.covered_ref += a.coverage_with_reference_noise * n;
-          s.n += n;
-        }
-    }
-  }
-  for (int ci = 0; ci < 3; ++ci) {
+  RenderOptions o = study_options("cornell.gltf", 64, 256);
+  o.photons_per_pass = 10000;
+  reference::PooledCoverage pc =
+      reference::pooled_coverage(o, seeds, truth, {16, 64, 256}, {0.5, 0.9, 0.95});
+  using S = reference::Sums;
+  for (size_t ci = 0; ci < 3; ++ci) {
     const char* names[] = {"all", "edge band (< 2 R)", "interior"};
     for (int bi = 0; bi < 3; ++bi) {
-      const Sum* s = sums[ci][bi];
-      const auto f = [](double a, double n) { return a / std::max(n, 1.0); };
+      const S& s = pc.at(ci, bi, 0);
       std::printf("| %llu | %s | %.2f | %.5f | %.2f | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f |\n",
-                  (unsigned long long)checks[ci], names[bi], f(s[0].n, sums[ci][0][0].n),
-                  f(s[0].err, s[0].n), s[0].bound / std::max(s[0].err, 1e-300),
-                  f(s[0].covered, s[0].n), f(s[1].covered, s[1].n), f(s[2].covered, s[2].n),
-                  f(s[0].covered_ref, s[0].n), f(s[1].covered_ref, s[1].n),
-                  f(s[2].covered_ref, s[2].n));
+                  (unsigned long long)pc.checks[ci], names[bi],
+                  s.n / std::max(pc.at(ci, 0, 0).n, 1.0), s.mean(&S::err),
+                  s.bound / std::max(s.err, 1e-300), s.mean(&S::covered),
+                  pc.at(ci, bi, 1).mean(&S::covered), pc.at(ci, bi, 2).mean(&S::covered),
+                  s.mean(&S::covered_ref), pc.at(ci, bi, 1).mean(&S::covered_ref),
+                  pc.at(ci, bi, 2).mean(&S::covered_ref));
     }
-    const double edge = sums[ci][1][0].err / std::max(sums[ci][1][0].n, 1.0);
-    const double inner = sums[ci][2][0].err / std::max(sums[ci][2][0].n, 1.0);
-    const double edge_rel = sums[ci][1][0].rel / std::max(sums[ci][1][0].n, 1.0);
-    const double inner_rel = sums[ci][2][0].rel / std::max(sums[ci][2][0].n, 1.0);
+    const S &edge = pc.at(ci, 1, 0), &inner = pc.at(ci, 2, 0);
     std::printf(
         "| %llu | edge / interior mean error; relative error; mean signed error edge, interior | "
         "| %.2f; %.2f; %+.5f, %+.5f | | | | | | | |\n",
-        (unsigned long long)checks[ci], edge / inner, edge_rel / inner_rel,
-        sums[ci][1][0].sgn / std::max(sums[ci][1][0].n, 1.0),
-        sums[ci][2][0].sgn / std::max(sums[ci][2][0].n, 1.0));
+        (unsigned long long)pc.checks[ci], edge.mean(&S::err) / inner.mean(&S::err),
+        edge.mean(&S::rel) / inner.mean(&S::rel), edge.mean(&S::sgn), inner.mean(&S::sgn));
     std::fflush(stdout);
   }
   std::printf("\n");

@@ -7,9 +7,11 @@
 #include "photonbound/error_model.h"
 #include "photonbound/eye_pass.h"
 #include "photonbound/film.h"
+#include "photonbound/gltf_loader.h"
 #include "photonbound/image_io.h"
 #include "photonbound/renderer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -117,6 +119,51 @@ inline Accuracy measure(const Renderer& r, const Truth& truth, double confidence
     a.coverage_with_reference_noise = covered_ref / n;
   }
   return a;
+}
+
+// Sums of the above over renders: for each pass count, band (0 every pixel, 1 the edge band, 2
+// the interior; edge_band(r, 2)) and confidence, the accuracy figures times their samples.
+struct Sums {
+  double err = 0, rel = 0, sgn = 0, bound = 0, covered = 0, covered_ref = 0, n = 0;
+  void add(const Accuracy& a) {
+    const double m = double(a.samples);
+    err += a.mean_abs_error * m;
+    rel += a.mean_rel_error * m;
+    sgn += a.mean_signed_error * m;
+    bound += a.mean_bound * m;
+    covered += a.coverage * m;
+    covered_ref += a.coverage_with_reference_noise * m;
+    n += m;
+  }
+  double mean(double Sums::*field) const { return this->*field / std::max(n, 1.0); }
+};
+struct PooledCoverage {
+  std::vector<uint64_t> checks;
+  std::vector<double> confidences;
+  std::vector<Sums> sums;  // [check][band][confidence]
+  Sums& at(size_t check, int band, size_t confidence) {
+    return sums[(check * 3 + size_t(band)) * confidences.size() + confidence];
+  }
+};
+// Renders `o` with seeds 1..seeds to each of `checks` (ascending) and pools the accuracy there.
+inline PooledCoverage pooled_coverage(RenderOptions o, int seeds, const Truth& truth,
+                                      const std::vector<uint64_t>& checks,
+                                      const std::vector<double>& confidences) {
+  PooledCoverage p{checks, confidences, std::vector<Sums>(checks.size() * 3 * confidences.size())};
+  const pb::Scene scene = load_gltf(o.scene);
+  for (int seed = 1; seed <= seeds; ++seed) {
+    o.seed = uint64_t(seed);
+    Renderer r(scene, o);
+    for (size_t ci = 0; ci < checks.size(); ++ci) {
+      while (r.passes() < checks[ci]) r.step();
+      const std::vector<int> band = edge_band(r, 2.0);
+      for (int bi = 0; bi < 3; ++bi)
+        for (size_t k = 0; k < confidences.size(); ++k)
+          p.at(ci, bi, k).add(bi == 0 ? measure(r, truth, confidences[k])
+                                      : measure(r, truth, confidences[k], &band, bi == 1 ? 1 : 0));
+    }
+  }
+  return p;
 }
 
 }  // namespace pb::reference

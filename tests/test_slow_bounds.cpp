@@ -105,47 +105,26 @@ TEST(SlowBounds, EdgeBandOfTheBoxWithABlock) {
 TEST(SlowBounds, CoverageOnCornellBoxAgainstItsReference) {
   const reference::Truth truth =
       reference::load(std::string(PHOTONBOUND_REFERENCES) + "/cornell_64x64_sppm_reference.exr");
-  const uint64_t checks[] = {16, 64, 256};
-  const double confs[] = {0.5, 0.9, 0.95};
-  // [check][band: all, edge, interior][confidence]: covered, samples; and relative errors.
-  double covered[3][3][3] = {}, samples[3][3][3] = {}, rel[3] = {}, rel_n[3] = {};
-  for (uint64_t seed : {1, 2, 3, 4}) {
-    RenderOptions o = test::quick_options("cornell.gltf", 64, 256);
-    o.method = Method::SPPM;
-    o.photons_per_pass = 10000;
-    o.seed = seed;
-    const Scene scene = load_gltf(o.scene);
-    Renderer r(scene, o);
-    for (int ci = 0; ci < 3; ++ci) {
-      while (r.passes() < checks[ci]) r.step();
-      const std::vector<int> band = reference::edge_band(r, 2.0);
-      for (int bi = 0; bi < 3; ++bi)
-        for (int k = 0; k < 3; ++k) {
-          const reference::Accuracy a =
-              bi == 0 ? reference::measure(r, truth, confs[k])
-                      : reference::measure(r, truth, confs[k], &band, bi == 1 ? 1 : 0);
-          covered[ci][bi][k] += a.coverage_with_reference_noise * double(a.samples);
-          samples[ci][bi][k] += double(a.samples);
-          if (ci == 1 && k == 0 && bi > 0) {
-            rel[bi] += a.mean_rel_error * double(a.samples);
-            rel_n[bi] += double(a.samples);
-          }
-        }
-    }
-  }
-  for (int ci = 0; ci < 3; ++ci)
+  RenderOptions o = test::quick_options("cornell.gltf", 64, 256);
+  o.method = Method::SPPM;
+  o.photons_per_pass = 10000;
+  reference::PooledCoverage pc =
+      reference::pooled_coverage(o, 4, truth, {16, 64, 256}, {0.5, 0.9, 0.95});
+  using S = reference::Sums;
+  for (size_t ci = 0; ci < 3; ++ci)
     for (int bi = 0; bi < 2; ++bi)
-      for (int k = 0; k < 3; ++k) {
-        const double c = covered[ci][bi][k] / samples[ci][bi][k];
+      for (size_t k = 0; k < 3; ++k) {
+        const S& s = pc.at(ci, bi, k);
+        const double c = s.mean(&S::covered_ref), conf = pc.confidences[k];
         std::printf("cornell, %3llu passes, %s, %.0f%%: coverage %.3f over %.0f\n",
-                    (unsigned long long)checks[ci], bi == 0 ? "all" : "edge band", 100 * confs[k],
-                    c, samples[ci][bi][k]);
-        EXPECT_GT(samples[ci][bi][k], bi == 0 ? 16000.0 : 4000.0);
-        EXPECT_GE(c, confs[k] - (bi == 0 ? 0.02 : 0.03))
-            << checks[ci] << " passes, band " << bi << ", confidence " << confs[k];
-        if (bi == 0) EXPECT_LE(c, confs[k] + 0.02) << checks[ci] << " passes, " << confs[k];
+                    (unsigned long long)pc.checks[ci], bi == 0 ? "all" : "edge band", 100 * conf, c,
+                    s.n);
+        EXPECT_GT(s.n, bi == 0 ? 16000.0 : 4000.0);
+        EXPECT_GE(c, conf - (bi == 0 ? 0.02 : 0.03))
+            << pc.checks[ci] << " passes, band " << bi << ", confidence " << conf;
+        if (bi == 0) EXPECT_LE(c, conf + 0.02) << pc.checks[ci] << " passes, " << conf;
       }
-  const double ratio = (rel[1] / rel_n[1]) / (rel[2] / rel_n[2]);
+  const double ratio = pc.at(1, 1, 0).mean(&S::rel) / pc.at(1, 2, 0).mean(&S::rel);
   std::printf("cornell, 64 passes: mean relative error edge / interior %.2f\n", ratio);
   EXPECT_LE(ratio, 1.5);
 }
