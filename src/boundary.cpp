@@ -266,13 +266,12 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
   parallel_for(found.size(), 64, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
       const Pending& f = found[i];
-      segments_[i] = f.s;
-      segments_[i].mid = 0.5f * (f.s.a + f.s.b);
-      segments_[i].half = 0.5f * glm::length(f.s.b - f.s.a);
+      Segment& s = segments_[i];
+      s = f.s;
+      s.mid = 0.5f * (s.a + s.b);
+      s.half = 0.5f * glm::length(s.b - s.a);
       const vec3& nh = world.face_normal(f.triangle);
-      const vec3 mid = 0.5f * (f.s.a + f.s.b);
-      const float radius = 0.5f * glm::length(f.s.b - f.s.a) + max_radius;
-      world.accel().query_sphere(mid, radius, [&](uint32_t mesh, uint32_t prim) {
+      world.accel().query_sphere(s.mid, s.half + max_radius, [&](uint32_t mesh, uint32_t prim) {
         const uint32_t t = world.triangle_index(mesh, prim);
         if (!host[t] || !compatible(world.face_normal(t), nh)) return;
         vec3 v[3];
@@ -344,29 +343,39 @@ size_t BoundaryIndex::memory_bytes() const {
          list_.capacity() * sizeof(uint32_t) + centre_.capacity() * sizeof(vec3);
 }
 
+template <class Skip, class Visit>
+void BoundaryIndex::scan(uint32_t triangle, Skip&& skip, Visit&& visit) const {
+  const uint32_t begin = start_[triangle], end = start_[triangle + 1];
+  for (uint32_t k = begin; k < end; ++k) {
+    const uint32_t at = k - begin;
+    if (at % (kGroup * kGroup) == 0 &&
+        skip(groups_[1][group_start_[1][triangle] + at / (kGroup * kGroup)])) {
+      k += kGroup * kGroup - 1;  // the run's last entry; the loop's ++k starts the next run
+      continue;
+    }
+    if (at % kGroup == 0 && skip(groups_[0][group_start_[0][triangle] + at / kGroup])) {
+      k += kGroup - 1;
+      continue;
+    }
+    if (!visit(segments_[list_[k]])) return;
+  }
+}
+
 float BoundaryIndex::clearance(uint32_t triangle, const vec3& p, float r) const {
   if (start_.empty()) return r;
   double nearest = double(r) * double(r);
   // A run whose bounding sphere is farther than the nearest segment so far holds none nearer
   // (with a 1e-4 relative margin for float rounding).
-  const auto beyond = [&](const Group& g) {
-    const float d = glm::length(p - g.centre) - g.radius;
-    return d > 0.0f && double(d) * double(d) > nearest * 1.0002;
-  };
-  for (uint32_t k = start_[triangle]; k < start_[triangle + 1]; ++k) {
-    const uint32_t at = k - start_[triangle];
-    if (at % (kGroup * kGroup) == 0 &&
-        beyond(groups_[1][group_start_[1][triangle] + at / (kGroup * kGroup)])) {
-      k += kGroup * kGroup - 1;
-      continue;
-    }
-    if (at % kGroup == 0 && beyond(groups_[0][group_start_[0][triangle] + at / kGroup])) {
-      k += kGroup - 1;
-      continue;
-    }
-    const Segment& s = segments_[list_[k]];
-    nearest = std::min(nearest, segment_distance2(p, s.a, s.b));
-  }
+  scan(
+      triangle,
+      [&](const Group& g) {
+        const float d = glm::length(p - g.centre) - g.radius;
+        return d > 0.0f && double(d) * double(d) > nearest * 1.0002;
+      },
+      [&](const Segment& s) {
+        nearest = std::min(nearest, segment_distance2(p, s.a, s.b));
+        return true;
+      });
   if (nearest >= double(r) * double(r)) return r;
   // Rounded down, so that a radius at or below it squares to less than every segment's
   // distance squared, as moments() tests.
@@ -390,32 +399,17 @@ DiscMoments BoundaryIndex::moments(uint32_t triangle, const vec3& p, const vec3&
     const float reach = (radius + r) * 1.0001f;
     return glm::dot(d, d) > reach * reach;
   };
-  for (uint32_t k = start_[triangle]; k < start_[triangle + 1] && count < kMaxNear; ++k) {
-    const uint32_t at = k - start_[triangle];
-    if (at % (kGroup * kGroup) == 0) {
-      const Group& g = groups_[1][group_start_[1][triangle] + at / (kGroup * kGroup)];
-      if (far(g.centre, g.radius)) {
-        k += kGroup * kGroup - 1;  // the run's last entry; the loop's ++k starts the next run
-        continue;
-      }
-    }
-    if (at % kGroup == 0) {
-      const Group& g = groups_[0][group_start_[0][triangle] + at / kGroup];
-      if (far(g.centre, g.radius)) {
-        k += kGroup - 1;
-        continue;
-      }
-    }
-    const Segment& s = segments_[list_[k]];
-    if (far(s.mid, s.half)) continue;
-    if (segment_distance2(p, s.a, s.b) >= r2) continue;
-    const dvec3 a = dvec3(s.a) - dvec3(p), b = dvec3(s.b) - dvec3(p);
-    ax[count] = glm::dot(a, dvec3(t1));
-    ay[count] = glm::dot(a, dvec3(t2));
-    ex[count] = glm::dot(b, dvec3(t1)) - ax[count];
-    ey[count] = glm::dot(b, dvec3(t2)) - ay[count];
-    ++count;
-  }
+  scan(
+      triangle, [&](const Group& g) { return far(g.centre, g.radius); },
+      [&](const Segment& s) {
+        if (far(s.mid, s.half) || segment_distance2(p, s.a, s.b) >= r2) return true;
+        const dvec3 a = dvec3(s.a) - dvec3(p), b = dvec3(s.b) - dvec3(p);
+        ax[count] = glm::dot(a, dvec3(t1));
+        ay[count] = glm::dot(a, dvec3(t2));
+        ex[count] = glm::dot(b, dvec3(t1)) - ax[count];
+        ey[count] = glm::dot(b, dvec3(t2)) - ay[count];
+        return ++count < kMaxNear;
+      });
   if (count == 0) return m;
   // A point on a segment (a pixel centre that sees exactly the line where two walls meet) sees
   // nothing along it: every ray meets the segment at t = 0. Such a point belongs to the side of

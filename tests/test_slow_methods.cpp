@@ -2,7 +2,7 @@
 // the pixel, and agree where the image is smooth across the pixel (issue "Stochastic progressive
 // photon mapping": a long render of each on a glass sphere in a box agrees on the smooth
 // interior pixels within their bounds). Labelled slow.
-#include "reference_truth.h"
+#include "photonbound/film.h"
 #include "render_fixture.h"
 
 #include <gtest/gtest.h>

@@ -77,6 +77,11 @@ class BoundaryIndex {
   };
   std::vector<uint32_t> group_start_[2];
   std::vector<Group> groups_[2];
+  // Calls visit(segment) for triangle t's listed segments in list order, skipping every run
+  // (of kGroup^2, then of kGroup) whose bounding sphere skip(group) rejects, until visit returns
+  // false. moments() and clearance() both scan this way.
+  template <class Skip, class Visit>
+  void scan(uint32_t triangle, Skip&& skip, Visit&& visit) const;
   std::vector<vec3> centre_;  // of triangles with segments (zero elsewhere)
 };
 
