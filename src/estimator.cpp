@@ -58,6 +58,9 @@ void accumulate_pass(PointState& s, const PassGather& g, const EstimatorParams& 
   s.c_xr += dx * (r2_bias - s.mean_r2);
   s.c_rr += dr * (r2_bias - s.mean_r2);
   s.photons += g.count;
+  const double sign = (pass & 1u) ? 1.0 : -1.0;
+  s.alt_x += sign * x;
+  s.alt_r2 += sign * r2_bias;
 
   // PPM update (section 3, HOJ08): only photons that could contribute shrink the radius.
   const double applied = ppm_radius_update(s.n, s.r2, double(g.count), params.alpha, params.min_r2);
@@ -87,6 +90,13 @@ PointEstimate estimate(const PointState& s, uint64_t passes, double photons_per_
     // Retroactive correction X'_j = X_j - a R_j^2 with the newest a (section 4).
     const dvec3 s2 = glm::max(dvec3(0.0), (s.c_xx - 2.0 * a * s.c_xr + a * a * s.c_rr) / (i - 1.0));
     e.variance = s2 / i;
+    // sum_j s_j (X'_j - mean X') / i with s_j = +1 on odd passes and -1 on even ones: the
+    // corrected samples' deviations with alternating signs. For independent samples its variance
+    // is (i - sbar^2 i) Var X / i^2 (sbar = sum s_j / i, 1 / i or 0), that of the mean's noise to
+    // within 1 / i^2, and its covariance with another point's replica is the noises' covariance
+    // to the same order; a slow drift of the mean cancels pairwise.
+    const double odd = (passes & 1u) ? 1.0 : 0.0;
+    e.replica = (s.alt_x - a * s.alt_r2 - odd * (s.mean_x - a * s.mean_r2)) / i;
     // Var(B) from the variance of the mean by the kernels' noise ratio; the radius shrank over
     // the passes, and the Laplacian's noise grows as 1/R^3 against the estimate's 1/R, so the
     // ratio is scaled by (mean R^2 / R^2)^2 (section 6b). An upper estimate where next-event

@@ -15,6 +15,7 @@ struct PixelResult {
   dvec3 radiance{0.0}, bias{0.0}, variance{0.0};
   dvec3 bias_variance{0.0};  // of the bias estimate (ESTIMATOR.md section 6b)
   dvec3 sparse{0.0};         // bound of the photon part of states with few photons (section 12)
+  dvec3 replica{0.0};        // a replica of the noise (sum_k W_k of the states', section 7)
   double photons = 0.0;
   float radius = 0.0f;
   bool exact = false;  // PPM: no point, so nothing random (background, exact emission)
@@ -46,6 +47,7 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
     r.bias = e.bias;
     r.variance = e.variance;
     r.bias_variance = e.bias_variance;
+    r.replica = e.replica;
     r.photons = double(states[pixel].photons);
     r.radius = float(std::sqrt(states[pixel].r2));
     // A pixel that never had a visible point has no photon part to wait for: its samples are
@@ -68,6 +70,7 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
     r.bias += e.bias;
     r.variance += e.variance;
     r.bias_variance += e.bias_variance;
+    r.replica += e.replica;
     r.photons += double(states[k].photons);
     if (r.exact) r.radius = float(std::sqrt(states[k].r2));
     r.exact = false;
@@ -115,6 +118,33 @@ std::vector<dvec3> bias_prior(const std::vector<PixelResult>& results, int width
       }
   });
   return tau2;
+}
+
+// Sum over pixel pairs p, q within `reach` pixels of each other (both orders, q = p included)
+// of u_p u_q, by a summed-area table: the window estimate of Var(sum_p u_p) for a field u whose
+// correlation does not reach further (as in a Newey-West estimate of a correlated sum). Returns
+// the pairs q != p only, never below 0: a negative sum is the estimate's own noise.
+double windowed_cross_sum(const std::vector<double>& u, int width, int height, int reach) {
+  const size_t w1 = size_t(width) + 1;
+  std::vector<double> sat((size_t(height) + 1) * w1, 0.0);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const size_t at = size_t(y + 1) * w1 + size_t(x + 1), up = size_t(y) * w1 + size_t(x + 1);
+      sat[at] = u[size_t(y) * size_t(width) + size_t(x)] + sat[at - 1] + sat[up] - sat[up - 1];
+    }
+  double cross = 0.0;
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) {
+      const double v = u[size_t(y) * size_t(width) + size_t(x)];
+      if (v == 0.0) continue;
+      const size_t xa = size_t(std::max(0, x - reach)), ya = size_t(std::max(0, y - reach));
+      const size_t xb = size_t(std::min(width, x + reach + 1));
+      const size_t yb = size_t(std::min(height, y + reach + 1));
+      const double box =
+          sat[yb * w1 + xb] - sat[ya * w1 + xb] - sat[yb * w1 + xa] + sat[ya * w1 + xa];
+      cross += v * (box - v);
+    }
+  return std::max(0.0, cross);
 }
 
 }  // namespace
@@ -192,6 +222,10 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
   const double t_var = nu > 2.0 ? nu / (nu - 2.0) : 3.0;  // Var(T_nu); 3 stands in below nu = 3
   uint64_t known = 0, below = 0;
   std::vector<float> pixel_bounds(pixels, 0.0f);  // largest channel, in the metric
+  // The noise replicas, standardised and weighted by what of a pixel's |error| moves linearly
+  // with its noise and what otherwise (section 7): their cross products between neighbours
+  // bound the covariances of the neighbours' |error|.
+  std::vector<double> replica_linear(pixels, 0.0), replica_rest(pixels, 0.0);
   for (size_t p = 0; p < pixels; ++p) {
     const PixelResult& r = results[p];
     const bool known_pixel = r.exact || (passes >= 2 && r.known);
@@ -221,7 +255,22 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
         const double mu = w * r.bias[c] / denominator[c];
         const double sigma = std::sqrt(r.variance[c] * t_var + w * vb) / denominator[c];
         error_sum += expected_abs_error(mu, sigma) + r.sparse[c] / denominator[c];
-        pixel_error_sd += std::sqrt(abs_error_variance(mu, sigma));
+        const double v = abs_error_variance(mu, sigma);
+        pixel_error_sd += std::sqrt(v);
+        if (sigma > 0.0 && r.variance[c] > 0.0) {
+          // |mu + sigma Z| = m + g sigma He_1(Z) + sum_{k >= 2} c_k sigma He_k(Z) (Hermite),
+          // g = erf(mu / sigma sqrt 2): two pixels' |e| whose noises correlate by rho have the
+          // covariance sigma sigma' (g g' rho + sum_k k! c_k c_k' rho^k), and for 0 <= rho <= 1
+          // the sum is at most rho sqrt(r r') (Cauchy-Schwarz), r = v - g^2 sigma^2 the part of
+          // the variance beyond the linear term. The replica's z measures rho: the covariance is
+          // bounded by the cross products of g sigma z and sqrt(r) z, exactly so for identical
+          // errors (rho = 1), and by rho in place of rho^2 for the noise-dominated (the price of
+          // a bound whose every term a replica can measure without its distribution's shape).
+          const double g = std::erf(mu / (sigma * std::sqrt(2.0)));
+          const double z = r.replica[c] / std::sqrt(r.variance[c]);  // standardised replica
+          replica_linear[p] += g * sigma * z;
+          replica_rest[p] += std::sqrt(std::max(0.0, v - g * g * sigma * sigma)) * z;
+        }
       }
       // A pixel's three channels come from the same photons and paths: their errors are taken
       // as fully correlated (exactly so in a grey scene), so their sd add.
@@ -269,18 +318,26 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
   }
   if (sum.unknown_pixels == 0 && pixels > 0) {
     // The mean over every pixel-channel, as `compare` takes it (exact pixels add no error).
-    // Its variance: the pixels' own, summed as if each were fully correlated with the K pixels
-    // its disc's photons also reach (section 7), plus the model's: each sigma^2 comes from
-    // i - 1 passes, and their mean over the n / K independent groups has relative error
-    // 1 / sqrt(2 (i - 1) n / K), which moves the predicted mean by half that.
+    // Its variance (section 7): the pixels' own, plus the covariances of neighbours' |e|,
+    // bounded by the replicas' cross products over the window their discs can share (2R, plus
+    // the jitter); plus the model's: each sigma^2 comes from i - 1 passes, and their mean over
+    // the n / K independent groups has relative error 1 / sqrt(2 (i - 1) n / K), which moves
+    // the predicted mean by half that.
     const double n = 3.0 * double(pixels);
     double mean_r2 = 0.0;
     for (const PointState& st : states) mean_r2 += st.r2;
     mean_r2 /= double(std::max<size_t>(states.size(), 1));
-    const double k = correlated_pixels(std::sqrt(mean_r2), eye.footprint);
+    const double reach_pixels =
+        eye.footprint > 0.0 ? 2.0 * std::sqrt(mean_r2) / eye.footprint + 1.0 : 1.0;
+    const int reach =
+        int(std::ceil(std::min(reach_pixels, double(std::max(eye.width, eye.height)))));
+    const double cross = windowed_cross_sum(replica_linear, eye.width, eye.height, reach) +
+                         windowed_cross_sum(replica_rest, eye.width, eye.height, reach);
+    const double k = error_var_sum > 0.0 ? 1.0 + cross / error_var_sum : 1.0;
     const double m = error_sum / n;
     const double model = 0.5 * m / std::sqrt(2.0 * nu * std::max(1.0, n / k));
     const double var = k * error_var_sum / (n * n) + model * model;
+    sum.correlated_pixels = k;
     sum.predicted_error = m;
     sum.predicted_error_upper = m + normal_quantile(s.confidence) * std::sqrt(var);
   }

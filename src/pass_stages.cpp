@@ -18,7 +18,7 @@ namespace {
 
 // A checkpoint snapshot is written once and read later by another thread: non-temporal stores
 // skip reading the destination's cache lines first and leave the cache to the pass's own data.
-// PointState is 160 bytes (16-byte multiple) and the vector's storage is 16-byte aligned.
+// PointState is 192 bytes (16-byte multiple) and the vector's storage is 16-byte aligned.
 void stream_copy(PointState* dst, const PointState& src) {
 #if defined(__SSE2__)
   static_assert(sizeof(PointState) % 16 == 0 && alignof(std::max_align_t) >= 16);

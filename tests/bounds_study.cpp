@@ -352,13 +352,17 @@ void calibration_table(int seeds) {
   std::printf("### Mean-error prediction (%s, 32x32)\n\n",
               g_method == Method::PPM ? "PPM" : "SPPM");
   std::printf(
-      "| scene | passes | actual | predicted | actual sd | predicted sd "
-      "|\n|---|---|---|---|---|---|\n");
+      "| scene | passes | actual | predicted | actual sd | predicted sd | measured K "
+      "|\n|---|---|---|---|---|---|---|\n");
   const std::pair<const char*, DirectMode> scenes[] = {{"plane", DirectMode::Photons},
                                                        {"box", DirectMode::NextEvent}};
+  const char* only_scene = std::getenv("PB_STUDY_SCENE");
+  auto wanted = [&](const char* name) { return !only_scene || std::string(only_scene) == name; };
   for (const auto& [name, direct] : scenes)
     for (uint64_t passes : {16, 64, 256, 1024}) {
+      if (!wanted(name)) continue;
       std::vector<double> actual, predicted, sd;
+      double k = 0.0;
       for (int seed = 1; seed <= seeds; ++seed) {
         RenderOptions o = study_options(analytic::by_name(name).file, 32, passes);
         o.direct = direct;
@@ -378,6 +382,7 @@ void calibration_table(int seeds) {
         actual.push_back(e / double(n));
         predicted.push_back(sum.predicted_error);
         sd.push_back(sum.predicted_error_upper - sum.predicted_error);
+        k += sum.correlated_pixels / double(seeds);
       }
       auto mean = [](const std::vector<double>& v) {
         double m = 0.0;
@@ -393,19 +398,19 @@ void calibration_table(int seeds) {
         const double d = actual[k] - predicted[k] - dm;
         dvar += d * d;
       }
-      std::printf("| %s | %llu | %.5f | %.5f | %.5f | %.5f | diff sd %.5f |\n", name,
+      std::printf("| %s | %llu | %.5f | %.5f | %.5f | %.5f | %.1f | diff sd %.5f |\n", name,
                   (unsigned long long)passes, ma, mean(predicted),
-                  std::sqrt(var / double(actual.size() - 1)), mean(sd),
+                  std::sqrt(var / double(actual.size() - 1)), mean(sd), k,
                   std::sqrt(dvar / double(actual.size() - 1)));
       std::fflush(stdout);
     }
   // The Cornell box (SPPM only) against its reference, as in the rules table (64x64, 2500
   // photons per pass), at the pass counts its mean-error stops reached.
-  if (g_method == Method::SPPM) {
+  if (g_method == Method::SPPM && wanted("cornell")) {
     const reference::Truth truth =
         reference::load(std::string(PHOTONBOUND_REFERENCES) + "/cornell_64x64_sppm_reference.exr");
     for (uint64_t passes : {46, 198, 880}) {
-      double ma = 0.0, mp = 0.0, msd = 0.0, ss = 0.0;
+      double ma = 0.0, mp = 0.0, msd = 0.0, ss = 0.0, k = 0.0;
       std::vector<double> actual;
       for (int seed = 1; seed <= seeds; ++seed) {
         RenderOptions o = study_options("cornell.gltf", 64, passes);
@@ -422,11 +427,12 @@ void calibration_table(int seeds) {
         actual.push_back(e / double(img.radiance.size()));
         mp += sum.predicted_error / seeds;
         msd += (sum.predicted_error_upper - sum.predicted_error) / seeds;
+        k += sum.correlated_pixels / seeds;
       }
       for (double a : actual) ma += a / seeds;
       for (double a : actual) ss += (a - ma) * (a - ma);
-      std::printf("| cornell | %llu | %.5f | %.5f | %.5f | %.5f | |\n", (unsigned long long)passes,
-                  ma, mp, std::sqrt(ss / double(seeds - 1)), msd);
+      std::printf("| cornell | %llu | %.5f | %.5f | %.5f | %.5f | %.1f |\n",
+                  (unsigned long long)passes, ma, mp, std::sqrt(ss / double(seeds - 1)), msd, k);
       std::fflush(stdout);
     }
   }
@@ -447,7 +453,7 @@ void correlation_table() {
       while (r.passes() < passes) r.step();
       const std::vector<double> truth = analytic::pixel_truth(r, analytic::by_name(name).exact);
       FilmImage img;
-      r.develop(&img);
+      const double measured_k = r.develop(&img).correlated_pixels;
       const int w = r.eye().width, h = r.eye().height;
       std::vector<double> z(size_t(w * h)), a(size_t(w * h));
       double ma = 0.0;
@@ -475,10 +481,12 @@ void correlation_table() {
         }
       double mr2 = 0.0;
       for (const PointState& st : r.states()) mr2 += st.r2 / double(r.states().size());
-      std::printf("%s %llu passes: sum corr(e) %.1f, sum corr(|e|) %.1f, model K %.1f (R/f %.2f)\n",
-                  name, (unsigned long long)passes, sz / z0, sa / a0,
-                  correlated_pixels(std::sqrt(mr2), r.eye().median_footprint),
-                  std::sqrt(mr2) / r.eye().median_footprint);
+      std::printf(
+          "%s %llu passes: sum corr(e) %.1f, sum corr(|e|) %.1f, model K %.1f, measured K %.1f "
+          "(R/f %.2f)\n",
+          name, (unsigned long long)passes, sz / z0, sa / a0,
+          correlated_pixels(std::sqrt(mr2), r.eye().median_footprint), measured_k,
+          std::sqrt(mr2) / r.eye().median_footprint);
     }
 }
 

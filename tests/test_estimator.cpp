@@ -11,6 +11,8 @@
 
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -504,6 +506,68 @@ TEST(Estimator, RetroactiveCorrectionRemovesDeterministicDrift) {
   // Bias b mean(R_j^2) and bias-corrected radiance equal to L.
   EXPECT_NEAR(e.bias.x, b * s.mean_r2, 1e-12);
   EXPECT_NEAR(e.radiance.x - e.bias.x, L, 1e-12);
+  // The noise replica sees corrected samples that are all equal: 0, drift and constant gone.
+  EXPECT_LE(std::fabs(e.replica.x), 1e-6 * std::sqrt(raw_var_of_mean));
+}
+
+TEST(Estimator, NoiseReplicaCancelsDriftAndConstantAtOddAndEvenPassCounts) {
+  // The same exact drift as above, read after every pass count from 2 to 60: the alternating
+  // sum of the corrected samples less their mean is 0 at odd counts too (sum s_j = 1 there).
+  const double L = 2.0, b = 3.0, me = 500.0;
+  const double lap_true = b / (0.5 * kernel::kSecondMoment);
+  PointState s;
+  EstimatorParams p;
+  p.alpha = 0.6;
+  p.photons_per_pass = me;
+  s.r2 = 0.5;
+  for (uint64_t j = 1; j <= 60; ++j) {
+    const double r2 = s.r2;
+    PassGather g;
+    g.count = 25;
+    g.phi = dvec3(kPi_ * r2 * me * (L + b * r2));
+    g.phi_lap_r2 = dvec3(kPi_ * r2 * r2 * me * lap_true);
+    accumulate_pass(s, g, p, j);
+    if (j >= 2) EXPECT_LE(std::fabs(estimate(s, j, me).replica.x), 1e-9) << j << " passes";
+  }
+}
+
+TEST(Estimator, NoiseReplicaHasTheVarianceAndCovarianceOfTheNoise) {
+  // Pairs of points whose samples are 5 + c_j + own_j with a shared c_j ~ N(0, 1) and their own
+  // own_j ~ N(0, 1), 41 passes (odd): the replica D of each point must have E D = 0, E D^2 =
+  // Var(mean) = 2 / 41 (up to 1 / 41^2), E D_A D_B = Cov(mean_A, mean_B) = 1 / 41, and be
+  // uncorrelated with the point's own error mean - 5. Tolerances: over 4000 pairs the moments
+  // are known to 2.2% (E D^2: sqrt(2 / 4000)), 2.5% (E D_A D_B: sqrt(1.25 x 4) / sqrt(4000)
+  // relative to 1 / 41) and 0.016 (a correlation): 4 of those.
+  constexpr int kPairs = 4000;
+  constexpr uint64_t kPasses = 41;
+  std::mt19937_64 rng(7);
+  std::normal_distribution<double> z;
+  double d2 = 0.0, dd = 0.0, d = 0.0, de = 0.0, e2 = 0.0;
+  EstimatorParams params;
+  for (int k = 0; k < kPairs; ++k) {
+    PointState a, b;
+    a.r2 = b.r2 = 1.0;
+    for (uint64_t j = 1; j <= kPasses; ++j) {
+      const double c = z(rng);
+      PassGather ga, gb;
+      ga.direct = dvec3(5.0 + c + z(rng));
+      gb.direct = dvec3(5.0 + c + z(rng));
+      accumulate_pass(a, ga, params, j);
+      accumulate_pass(b, gb, params, j);
+    }
+    const PointEstimate ea = estimate(a, kPasses, 1.0), eb = estimate(b, kPasses, 1.0);
+    d += ea.replica.x / kPairs;
+    d2 += ea.replica.x * ea.replica.x / kPairs;
+    dd += ea.replica.x * eb.replica.x / kPairs;
+    const double err = ea.radiance.x - 5.0;
+    de += ea.replica.x * err / kPairs;
+    e2 += err * err / kPairs;
+  }
+  const double var_mean = 2.0 / double(kPasses);
+  EXPECT_NEAR(d / std::sqrt(var_mean), 0.0, 4.0 / std::sqrt(double(kPairs)));
+  EXPECT_NEAR(d2 / var_mean, 1.0, 4.0 * std::sqrt(2.0 / kPairs));
+  EXPECT_NEAR(dd / (0.5 * var_mean), 1.0, 4.0 * std::sqrt(5.0 / kPairs));
+  EXPECT_NEAR(de / std::sqrt(d2 * e2), 0.0, 4.0 / std::sqrt(double(kPairs)));
 }
 
 TEST(Estimator, StudentTQuantilesMatchTable) {

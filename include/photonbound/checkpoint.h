@@ -28,8 +28,9 @@ class StateError : public std::runtime_error {
 
 // 2: PointState without direct_sum (160 B); 3: options as key/value text from the option table;
 // 4: glTF's metallic-roughness materials (a version 3 state was rendered with other ones), the
-// sparse-photon bound's SPPM kernel masses, largest photon power and glossy caps.
-inline constexpr uint32_t kStateVersion = 4;
+// sparse-photon bound's SPPM kernel masses, largest photon power and glossy caps;
+// 5: PointState with the alternating sums of the noise replica (192 B).
+inline constexpr uint32_t kStateVersion = 5;
 
 struct SavedRender {
   RenderOptions options;    // as rendered (scene path, everything that shapes the image)

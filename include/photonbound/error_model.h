@@ -14,7 +14,10 @@ double abs_error_variance(double mu, double sigma);
 // Pixels whose errors are fully correlated, in effect, because their discs share photons:
 // sum over pixels j of the correlation of two kernel estimates a pixel apart, for discs of
 // radius R and pixels of footprint f: (integral kappa)^2 / integral kappa^2 (R / f)^2 =
-// 1.4449 (R / f)^2 (the quintic kernel; at least 1).
+// 1.4449 (R / f)^2 (the quintic kernel; at least 1). The photon-sharing model the mean-error
+// rule measures against (`bounds_study correlation`); the rule itself measures K from the
+// noise replicas (film.cpp, ESTIMATOR.md section 7), since next-event and jitter noise are
+// each pixel's own.
 double correlated_pixels(double radius, double footprint);
 
 // The one-sided normal quantile z_p (p in (0, 1)).

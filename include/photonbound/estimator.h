@@ -34,8 +34,13 @@ struct PointState {
   dvec3 c_xx{0.0};
   dvec3 c_xr{0.0};
   double c_rr = 0.0;
+  // Alternating sums sum_j s_j X_j and sum_j s_j R_j^2 (s_j = +1 on odd passes, -1 on even
+  // ones): with the means, a replica of the estimate's noise
+  // with the same covariance between points, free of the drift (ESTIMATOR.md section 7).
+  dvec3 alt_x{0.0};
+  double alt_r2 = 0.0;
 };
-static_assert(sizeof(PointState) == 160, "the per-point memory budget counts on 160 bytes");
+static_assert(sizeof(PointState) == 192, "the per-point memory budget counts on 192 bytes");
 
 // The smallest kernel mass a boundary correction divides by: a point whose disc is almost all
 // off its surface (the tip of a sliver) is not amplified beyond 1000x.
@@ -69,6 +74,9 @@ struct PointEstimate {
   dvec3 variance{0.0};  // S^2 / i: variance of the mean after the retroactive bias correction
   // Variance of the bias estimate B_i itself (section 6b): the Laplacian estimate is noisy.
   dvec3 bias_variance{0.0};
+  // A replica of the noise of L_i - B_i: sum_j (-1)^j X'_j / i, of the same variance and the
+  // same covariance with other points' replicas as the noise itself (section 7).
+  dvec3 replica{0.0};
   bool known = false;  // false until kMinPhotonsForBound photons and passes >= 2
 };
 

@@ -43,6 +43,9 @@ struct FilmSummary {
   // settings' confidence (ESTIMATOR.md section 7); +inf while a pixel is unknown.
   double predicted_error = INFINITY;
   double predicted_error_upper = INFINITY;
+  // The pixels whose errors move with a pixel's, in effect, measured from the noise replicas:
+  // the variance of the mean error is K times the independent pixels' (section 7).
+  double correlated_pixels = 1.0;
   // The settings' quantile (stop_fraction) of the pixels' bounds (largest channel, in the
   // metric): at most the target exactly when that share of the pixels is within it.
   double pixel_quantile_bound = INFINITY;
