@@ -473,62 +473,59 @@ TEST(Estimator, RetroactiveCorrectionMatchesDirectRecomputation) {
   }
 }
 
-TEST(Estimator, RetroactiveCorrectionRemovesDeterministicDrift) {
-  // Samples X_j = L + b R_j^2 exactly (no noise) with Laplacian samples chosen so that
-  // a = 0.5 k2 Lap = b: the corrected samples are all equal, so the variance must be ~0, while
-  // the uncorrected sample variance of X_j is large (the radius shrinks by ~3x over the run).
-  // Tolerance: 1e-9 of the uncorrected variance (the streaming cancellation error is ~1e-13).
-  const double L = 2.0, b = 3.0, me = 500.0;
-  const double lap_true = b / (0.5 * kernel::kSecondMoment);
+// Samples X_j = L + b R_j^2 exactly (no noise) with Laplacian samples chosen so that
+// a = 0.5 k2 Lap = b: the corrected samples X_j - a R_j^2 are all equal to L. Calls
+// after_pass(state, j, X_j) after each of `passes` passes.
+constexpr double kDriftL = 2.0, kDriftB = 3.0, kDriftPhotons = 500.0;
+
+template <class AfterPass>
+PointState exact_drift(uint64_t passes, AfterPass after_pass) {
+  const double lap_true = kDriftB / (0.5 * kernel::kSecondMoment);
   PointState s;
   EstimatorParams p;
   p.alpha = 0.6;
-  p.photons_per_pass = me;
+  p.photons_per_pass = kDriftPhotons;
   s.r2 = 0.5;
-  std::vector<double> xs;
-  for (uint64_t j = 1; j <= 100; ++j) {
+  for (uint64_t j = 1; j <= passes; ++j) {
     const double r2 = s.r2;
     PassGather g;
     g.count = 25;
-    g.phi = dvec3(kPi_ * r2 * me * (L + b * r2));
-    g.phi_lap_r2 = dvec3(kPi_ * r2 * r2 * me * lap_true);
-    xs.push_back(L + b * r2);
+    g.phi = dvec3(kPi_ * r2 * kDriftPhotons * (kDriftL + kDriftB * r2));
+    g.phi_lap_r2 = dvec3(kPi_ * r2 * r2 * kDriftPhotons * lap_true);
     accumulate_pass(s, g, p, j);
+    after_pass(s, j, kDriftL + kDriftB * r2);
   }
+  return s;
+}
+
+TEST(Estimator, RetroactiveCorrectionRemovesDeterministicDrift) {
+  // The corrected samples are all equal, so the variance must be ~0, while the uncorrected
+  // sample variance of X_j is large (the radius shrinks by ~3x over the run).
+  // Tolerance: 1e-9 of the uncorrected variance (the streaming cancellation error is ~1e-13).
+  std::vector<double> xs;
+  const PointState s =
+      exact_drift(100, [&](const PointState&, uint64_t, double x) { xs.push_back(x); });
   double m = 0.0, v = 0.0;
   for (double x : xs) m += x;
   m /= double(xs.size());
   for (double x : xs) v += (x - m) * (x - m);
   const double raw_var_of_mean = v / double(xs.size() - 1) / double(xs.size());
   ASSERT_GT(raw_var_of_mean, 1e-4);
-  const PointEstimate e = estimate(s, 100, me);
+  const PointEstimate e = estimate(s, 100, kDriftPhotons);
   EXPECT_LE(e.variance.x, 1e-9 * raw_var_of_mean);
   // Bias b mean(R_j^2) and bias-corrected radiance equal to L.
-  EXPECT_NEAR(e.bias.x, b * s.mean_r2, 1e-12);
-  EXPECT_NEAR(e.radiance.x - e.bias.x, L, 1e-12);
-  // The noise replica sees corrected samples that are all equal: 0, drift and constant gone.
-  EXPECT_LE(std::fabs(e.replica.x), 1e-6 * std::sqrt(raw_var_of_mean));
+  EXPECT_NEAR(e.bias.x, kDriftB * s.mean_r2, 1e-12);
+  EXPECT_NEAR(e.radiance.x - e.bias.x, kDriftL, 1e-12);
 }
 
 TEST(Estimator, NoiseReplicaCancelsDriftAndConstantAtOddAndEvenPassCounts) {
-  // The same exact drift as above, read after every pass count from 2 to 60: the alternating
-  // sum of the corrected samples less their mean is 0 at odd counts too (sum s_j = 1 there).
-  const double L = 2.0, b = 3.0, me = 500.0;
-  const double lap_true = b / (0.5 * kernel::kSecondMoment);
-  PointState s;
-  EstimatorParams p;
-  p.alpha = 0.6;
-  p.photons_per_pass = me;
-  s.r2 = 0.5;
-  for (uint64_t j = 1; j <= 60; ++j) {
-    const double r2 = s.r2;
-    PassGather g;
-    g.count = 25;
-    g.phi = dvec3(kPi_ * r2 * me * (L + b * r2));
-    g.phi_lap_r2 = dvec3(kPi_ * r2 * r2 * me * lap_true);
-    accumulate_pass(s, g, p, j);
-    if (j >= 2) EXPECT_LE(std::fabs(estimate(s, j, me).replica.x), 1e-9) << j << " passes";
-  }
+  // The same exact drift, read after every pass count from 2 to 60: the alternating sum of the
+  // corrected samples less their mean is 0 at odd counts too (sum s_j = 1 there), where the
+  // plain alternating sum would be L / i. Tolerance: the streaming cancellation error.
+  exact_drift(60, [](const PointState& s, uint64_t j, double) {
+    if (j >= 2)
+      EXPECT_LE(std::fabs(estimate(s, j, kDriftPhotons).replica.x), 1e-9) << j << " passes";
+  });
 }
 
 TEST(Estimator, NoiseReplicaHasTheVarianceAndCovarianceOfTheNoise) {
