@@ -82,25 +82,42 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
   return r;
 }
 
+// A summed-area table over the image: the sum of a per-pixel value over any box in O(1).
+template <class T>
+class SummedArea {
+ public:
+  template <class ValueAt>
+  SummedArea(int width, int height, ValueAt value_at)
+      : w1_(size_t(width) + 1), t_((size_t(height) + 1) * w1_, T(0.0)) {
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const size_t at = size_t(y + 1) * w1_ + size_t(x + 1), up = size_t(y) * w1_ + size_t(x + 1);
+        t_[at] = value_at(size_t(y) * size_t(width) + size_t(x)) + t_[at - 1] + t_[up] - t_[up - 1];
+      }
+  }
+  // Over pixels [xa, xb) x [ya, yb).
+  T box(size_t xa, size_t ya, size_t xb, size_t yb) const {
+    return t_[yb * w1_ + xb] - t_[ya * w1_ + xb] - t_[yb * w1_ + xa] + t_[ya * w1_ + xa];
+  }
+
+ private:
+  size_t w1_;
+  std::vector<T> t_;
+};
+
 // Empirical-Bayes prior of the bias (ESTIMATOR.md section 6b): per pixel and channel, the
 // variance tau^2 of the true bias around it, estimated over the (2W+1)^2 window of known
 // pixels as mean(B^2) - mean(Var B) (the estimates' own noise taken out), never below 0.
-// Summed-area tables keep it linear in the pixel count.
 constexpr int kPriorWindow = 4;
 
 std::vector<dvec3> bias_prior(const std::vector<PixelResult>& results, int width, int height) {
-  const size_t w1 = size_t(width) + 1;
-  std::vector<dvec3> b2((size_t(height) + 1) * w1, dvec3(0.0)), v(b2.size(), dvec3(0.0));
-  std::vector<double> n(b2.size(), 0.0);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const PixelResult& r = results[size_t(y) * size_t(width) + size_t(x)];
-      const size_t at = size_t(y + 1) * w1 + size_t(x + 1), up = size_t(y) * w1 + size_t(x + 1);
-      const bool use = r.known && !r.exact;
-      b2[at] = (use ? r.bias * r.bias : dvec3(0.0)) + b2[at - 1] + b2[up] - b2[up - 1];
-      v[at] = (use ? r.bias_variance : dvec3(0.0)) + v[at - 1] + v[up] - v[up - 1];
-      n[at] = (use ? 1.0 : 0.0) + n[at - 1] + n[up] - n[up - 1];
-    }
+  auto use = [&](size_t p) { return results[p].known && !results[p].exact; };
+  const SummedArea<dvec3> b2(width, height, [&](size_t p) {
+    return use(p) ? results[p].bias * results[p].bias : dvec3(0.0);
+  });
+  const SummedArea<dvec3> v(
+      width, height, [&](size_t p) { return use(p) ? results[p].bias_variance : dvec3(0.0); });
+  const SummedArea<double> n(width, height, [&](size_t p) { return use(p) ? 1.0 : 0.0; });
   std::vector<dvec3> tau2(size_t(width) * size_t(height), dvec3(0.0));
   parallel_for(size_t(height), 16, [&](size_t y0, size_t y1) {
     for (size_t y = y0; y < y1; ++y)
@@ -109,39 +126,29 @@ std::vector<dvec3> bias_prior(const std::vector<PixelResult>& results, int width
         const size_t ya = y >= kPriorWindow ? y - kPriorWindow : 0;
         const size_t xb = std::min(x + kPriorWindow + 1, size_t(width));
         const size_t yb = std::min(y + kPriorWindow + 1, size_t(height));
-        auto box = [&](const auto& t) {
-          return t[yb * w1 + xb] - t[ya * w1 + xb] - t[yb * w1 + xa] + t[ya * w1 + xa];
-        };
-        const double count = box(n);
+        const double count = n.box(xa, ya, xb, yb);
         if (count > 0.0)
-          tau2[y * size_t(width) + x] = glm::max(dvec3(0.0), (box(b2) - box(v)) / count);
+          tau2[y * size_t(width) + x] =
+              glm::max(dvec3(0.0), (b2.box(xa, ya, xb, yb) - v.box(xa, ya, xb, yb)) / count);
       }
   });
   return tau2;
 }
 
-// Sum over pixel pairs p, q within `reach` pixels of each other (both orders, q = p included)
-// of u_p u_q, by a summed-area table: the window estimate of Var(sum_p u_p) for a field u whose
-// correlation does not reach further (as in a Newey-West estimate of a correlated sum). Returns
-// the pairs q != p only, never below 0: a negative sum is the estimate's own noise.
+// Sum over pixel pairs p, q within `reach` pixels of each other (both orders) of u_p u_q, by a
+// summed-area table: the window estimate of Var(sum_p u_p) for a field u whose correlation does
+// not reach further (as in a Newey-West estimate of a correlated sum). Returns the pairs q != p
+// only, never below 0: a negative sum is the estimate's own noise.
 double windowed_cross_sum(const std::vector<double>& u, int width, int height, int reach) {
-  const size_t w1 = size_t(width) + 1;
-  std::vector<double> sat((size_t(height) + 1) * w1, 0.0);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const size_t at = size_t(y + 1) * w1 + size_t(x + 1), up = size_t(y) * w1 + size_t(x + 1);
-      sat[at] = u[size_t(y) * size_t(width) + size_t(x)] + sat[at - 1] + sat[up] - sat[up - 1];
-    }
+  const SummedArea<double> sat(width, height, [&](size_t p) { return u[p]; });
   double cross = 0.0;
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) {
       const double v = u[size_t(y) * size_t(width) + size_t(x)];
       if (v == 0.0) continue;
-      const size_t xa = size_t(std::max(0, x - reach)), ya = size_t(std::max(0, y - reach));
-      const size_t xb = size_t(std::min(width, x + reach + 1));
-      const size_t yb = size_t(std::min(height, y + reach + 1));
       const double box =
-          sat[yb * w1 + xb] - sat[ya * w1 + xb] - sat[yb * w1 + xa] + sat[ya * w1 + xa];
+          sat.box(size_t(std::max(0, x - reach)), size_t(std::max(0, y - reach)),
+                  size_t(std::min(width, x + reach + 1)), size_t(std::min(height, y + reach + 1)));
       cross += v * (box - v);
     }
   return std::max(0.0, cross);
