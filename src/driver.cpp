@@ -19,6 +19,8 @@ std::string stop_text(StopReason reason) {
       return "target-error";
     case StopReason::Unreachable:
       return "unreachable: the radius cannot shrink and the bias is above the target";
+    case StopReason::ModelRefuted:
+      return "unreachable: the bias model fails at this radius; start with a smaller --radius";
     case StopReason::Interrupted:
       return "interrupted";
   }
@@ -97,6 +99,11 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
     // or every radius at its floor): more passes only shrink the noise.
     if (check && report.summary.mean_bias_metric >= *o.target_error && renderer_.radii_fixed())
       report.stop = StopReason::Unreachable;
+    // Where the samples' drift with R^2 refutes the bias model (section 11b) every bound is
+    // unknown, and stays so for a long time: the disagreement grows with the passes, and the
+    // radius shrinks only as passes^-0.2 or so at the default alpha. Say so now rather than run
+    // to the budget.
+    if (check && report.summary.model_refuted) report.stop = StopReason::ModelRefuted;
     if (interrupt && interrupt->load()) report.stop = StopReason::Interrupted;
 
     if (report.stop != StopReason::None && !developed) {

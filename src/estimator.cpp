@@ -103,6 +103,17 @@ PointEstimate estimate(const PointState& s, uint64_t passes, double photons_per_
     // noise is part of the variance.
     const double shrink = s.mean_r2 / s.r2;
     e.bias_variance = kBiasNoiseRatio * shrink * shrink * e.variance;
+    // Section 11b: under the model E[X_j] = L + a R_j^2, the least-squares slope of the samples
+    // on R_j^2 estimates the same a as the Laplacian; a radius far above the scale on which the
+    // radiance varies bends E[X] in R^2, and the two part. The regression slope's variance is
+    // the residual variance over C_RR; the Laplacian's is Var(B) / mean(R^2)^2.
+    if (passes >= 3 && s.c_rr > 0.0 && s.mean_r2 > 0.0 && s.photons >= kMinPhotonsForBound)
+      for (int c = 0; c < 3; ++c) {
+        const double b = s.c_xr[c] / s.c_rr;
+        const double resid = std::max(0.0, s.c_xx[c] - s.c_xr[c] * b) / (i - 2.0);
+        const double var = resid / s.c_rr + e.bias_variance[c] / (s.mean_r2 * s.mean_r2);
+        if (var > 0.0 && std::isfinite(var)) e.slope_z[c] = (b - a[c]) / std::sqrt(var);
+      }
   }
   return e;
 }

@@ -17,10 +17,20 @@ struct PixelResult {
   dvec3 sparse{0.0};         // bound of the photon part of states with few photons (section 12)
   dvec3 replica{0.0};        // a replica of the noise (sum_k W_k of the states', section 7)
   double photons = 0.0;
+  uint32_t slope_tested = 0, slope_disagree = 0;  // state-channels of the model check (11b)
   float radius = 0.0f;
   bool exact = false;  // PPM: no point, so nothing random (background, exact emission)
   bool known = true;
 };
+
+// Counts a state's channels into the model check (ESTIMATOR.md section 11b).
+void count_slopes(PixelResult& r, const PointEstimate& e) {
+  for (int c = 0; c < 3; ++c) {
+    if (e.slope_z[c] == 0.0) continue;
+    ++r.slope_tested;
+    r.slope_disagree += std::fabs(e.slope_z[c]) > kSlopeZ;
+  }
+}
 
 // L_pix = Le_seen + sum_k W_k L_k; B_pix = sum_k W_k B_k; Var_pix = sum_k W_k^2 S_k^2 / i
 // (ESTIMATOR.md section 5). W_k is already inside each point's estimate (MeasurementPoint::f).
@@ -48,6 +58,7 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
     r.variance = e.variance;
     r.bias_variance = e.bias_variance;
     r.replica = e.replica;
+    count_slopes(r, e);
     r.photons = double(states[pixel].photons);
     r.radius = float(std::sqrt(states[pixel].r2));
     // A pixel that never had a visible point has no photon part to wait for: its samples are
@@ -71,6 +82,7 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
     r.variance += e.variance;
     r.bias_variance += e.bias_variance;
     r.replica += e.replica;
+    count_slopes(r, e);
     r.photons += double(states[k].photons);
     if (r.exact) r.radius = float(std::sqrt(states[k].r2));
     r.exact = false;
@@ -222,6 +234,16 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
     image->radius.assign(pixels, 0.0f);
   }
 
+  // The model check (section 11b): where the samples' drift with R^2 and the Laplacian disagree
+  // in more than kRefutedShare of the state-channels, no bound of this image can be trusted.
+  uint64_t slope_tested = 0, slope_disagree = 0;
+  for (const PixelResult& r : results) {
+    slope_tested += r.slope_tested;
+    slope_disagree += r.slope_disagree;
+  }
+  sum.slope_disagreement = slope_tested ? double(slope_disagree) / double(slope_tested) : 0.0;
+  sum.model_refuted = sum.slope_disagreement > kRefutedShare;
+
   const std::vector<dvec3> tau2 = bias_prior(results, eye.width, eye.height);
   double bound_sum = 0.0, noise_sum = 0.0, bias_sum = 0.0, bias_metric_sum = 0.0;
   double error_sum = 0.0, error_var_sum = 0.0;  // of the error model (section 7)
@@ -235,7 +257,7 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
   std::vector<double> replica_linear(pixels, 0.0), replica_rest(pixels, 0.0);
   for (size_t p = 0; p < pixels; ++p) {
     const PixelResult& r = results[p];
-    const bool known_pixel = r.exact || (passes >= 2 && r.known);
+    const bool known_pixel = r.exact || (passes >= 2 && r.known && !sum.model_refuted);
     dvec3 noise(0.0), bound(std::numeric_limits<double>::infinity());
     if (known_pixel) {
       // PPM pixels without points see only background or exact emission: bound 0.

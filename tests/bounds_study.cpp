@@ -551,6 +551,110 @@ void slope_experiment() {
   }
 }
 
+// The second-order model's own check (issue 14, large starting radii): per state and channel,
+// z = (b - a) / sd, b = C_XR / C_RR the samples' regression slope on R^2 and a the Laplacian's;
+// the share of |z| > 2 and > 3 and the mean of z^2 over the image, against the coverage at 90%.
+void modelcheck_experiment() {
+  std::printf(
+      "| scene | method | radius x default | passes | share z>2 | share z>3 | mean z^2 | error | "
+      "bound | coverage 90%% |\n|---|---|---|---|---|---|---|---|---|---|\n");
+  const std::pair<const char*, DirectMode> cases[] = {{"plane", DirectMode::Photons},
+                                                      {"box", DirectMode::NextEvent},
+                                                      {"block", DirectMode::NextEvent}};
+  const char* only = std::getenv("PB_STUDY_SCENE");
+  for (Method method : {Method::PPM, Method::SPPM})
+    for (const auto& [name, mode] : cases) {
+      if (only && std::string(only) != name) continue;
+      const analytic::Case sc = analytic::by_name(name);
+      for (double mult : {1.0, 3.0, 10.0, 30.0}) {
+        for (uint64_t passes : {16u, 64u, 256u}) {
+          double share2 = 0, share3 = 0, z2 = 0, cnt = 0, err = 0, bnd = 0, cov = 0;
+          for (int seed = 1; seed <= 2; ++seed) {
+            RenderOptions o = study_options(sc.file, 32, passes);
+            o.method = method;
+            o.direct = mode;
+            o.seed = uint64_t(seed) * 7919u;
+            const Scene scene = load_gltf(o.scene);
+            {
+              Renderer r0(scene, o);
+              o.radius = mult * r0.initial_radius();
+            }
+            Renderer r(scene, o);
+            while (r.passes() < passes) r.step();
+            const double i = double(r.passes());
+            for (const PointState& st : r.states()) {
+              if (!(st.c_rr > 0.0) || st.photons < kMinPhotonsForBound) continue;
+              const PointEstimate e = estimate(st, r.passes(), double(o.photons_per_pass));
+              for (int c = 0; c < 3; ++c) {
+                const double a = e.bias[c] / st.mean_r2;
+                const double b = st.c_xr[c] / st.c_rr;
+                const double resid =
+                    std::max(0.0, (st.c_xx[c] - st.c_xr[c] * st.c_xr[c] / st.c_rr) / (i - 2.0));
+                const double var = resid / st.c_rr + e.bias_variance[c] / (st.mean_r2 * st.mean_r2);
+                if (!(var > 0.0)) continue;
+                const double z = (b - a) / std::sqrt(var);
+                share2 += std::fabs(z) > 2.0;
+                share3 += std::fabs(z) > 3.0;
+                z2 += z * z;
+                cnt += 1;
+              }
+            }
+            const analytic::Accuracy acc = analytic::measure(r, sc.exact, 0.9);
+            err += acc.mean_abs_error / 2;
+            bnd += acc.mean_bound / 2;
+            cov += acc.coverage / 2;
+          }
+          std::printf("| %s | %s | %.0f | %llu | %.3f | %.3f | %.2f | %.4f | %.4f | %.3f |\n", name,
+                      method == Method::PPM ? "PPM" : "SPPM", mult, (unsigned long long)passes,
+                      share2 / cnt, share3 / cnt, z2 / cnt, err, bnd, cov);
+          std::fflush(stdout);
+        }
+      }
+    }
+}
+
+// The same statistic on the shipped scenes at their defaults (64x64): how often the model check
+// would fire where the radius is the default one.
+void modelnull_experiment() {
+  std::printf(
+      "| scene | method | passes | share z>2 | share z>3 | mean z^2 | max state z^2 share of sum "
+      "|\n|---|---|---|---|---|---|---|\n");
+  for (const char* file : {"cornell.gltf", "glass_slab.gltf", "spot.gltf", "glossy_plane.gltf",
+                           "sun.gltf", "unlit.gltf", "closed_block.gltf", "furnace.gltf"})
+    for (Method method : {Method::SPPM, Method::PPM}) {
+      RenderOptions o = study_options(file, 64, 256);
+      o.method = method;
+      Renderer r(load_gltf(o.scene), o);
+      for (uint64_t passes : {16u, 64u, 256u}) {
+        while (r.passes() < passes) r.step();
+        const double i = double(r.passes());
+        double share2 = 0, share3 = 0, z2 = 0, cnt = 0, zmax = 0;
+        for (const PointState& st : r.states()) {
+          if (!(st.c_rr > 0.0) || st.photons < kMinPhotonsForBound) continue;
+          const PointEstimate e = estimate(st, r.passes(), double(o.photons_per_pass));
+          for (int c = 0; c < 3; ++c) {
+            const double a = e.bias[c] / st.mean_r2;
+            const double b = st.c_xr[c] / st.c_rr;
+            const double resid =
+                std::max(0.0, (st.c_xx[c] - st.c_xr[c] * st.c_xr[c] / st.c_rr) / (i - 2.0));
+            const double var = resid / st.c_rr + e.bias_variance[c] / (st.mean_r2 * st.mean_r2);
+            if (!(var > 0.0)) continue;
+            const double z = (b - a) / std::sqrt(var);
+            share2 += std::fabs(z) > 2.0;
+            share3 += std::fabs(z) > 3.0;
+            z2 += z * z;
+            zmax = std::max(zmax, z * z);
+            cnt += 1;
+          }
+        }
+        std::printf("| %s | %s | %llu | %.3f | %.3f | %.2f | %.3f |\n", file,
+                    method == Method::PPM ? "PPM" : "SPPM", (unsigned long long)passes,
+                    share2 / cnt, share3 / cnt, z2 / cnt, zmax / z2);
+        std::fflush(stdout);
+      }
+    }
+}
+
 int main(int argc, char** argv) {
   const std::string which = argc > 1 ? argv[1] : "all";
   if (argc > 2 && std::string(argv[2]) == "sppm") g_method = Method::SPPM;
@@ -559,6 +663,8 @@ int main(int argc, char** argv) {
   if (which == "all" || which == "stopping") stopping_table();
   if (which == "correlation") correlation_table();
   if (which == "slope") slope_experiment();
+  if (which == "modelcheck") modelcheck_experiment();
+  if (which == "modelnull") modelnull_experiment();
   if (which == "all" || which == "edges") edges_table();
   if (which == "all" || which == "cornell") cornell_table(argc > 3 ? std::atoi(argv[3]) : 4);
   if (which == "calibration") calibration_table(argc > 3 ? std::atoi(argv[3]) : 20);

@@ -3,6 +3,7 @@
 // number of passes, every bound finite, and the actual error within the target.
 #include "analytic.h"
 #include "render_fixture.h"
+#include "scene_builder.h"
 
 #include <gtest/gtest.h>
 
@@ -72,6 +73,49 @@ TEST(Stop, SomePointsUnreachedDoNotStopEarly) {
     // The image is within the target, as the mean-error rule promises at 90%.
     EXPECT_LE(c.actual, 0.05) << int(m);
   }
+}
+
+// A light that no visible point sees: under the plane (the photons land on its back, which the
+// same-side test rejects, and next-event sees the light from behind), or shut in a closed box
+// beside it. The radiance is exactly 0; every pixel's bound is the sparse-photon bound of a
+// point that received nothing (ESTIMATOR.md section 12), which falls as 1 / passes, so the
+// target is met in a bounded number of passes with every bound finite. Bound: 0.002 needs
+// lambda_u cap <= 0.002 with lambda_u = ln(10) / k at 90%, a few hundred passes here.
+TEST(Stop, LightThatNoPointSeesStopsWithFiniteBounds) {
+  for (int where = 0; where < 2; ++where)
+    for (Method m : {Method::PPM, Method::SPPM}) {
+      SCOPED_TRACE(std::string(where ? "light in a box" : "light under the plane") + ", " +
+                   (m == Method::PPM ? "PPM" : "SPPM"));
+      test::SceneBuilder b;
+      const uint32_t grey = b.material(vec3(0.5f));
+      b.quad(vec3(0), vec3(5, 0, 0), vec3(0, 0, -5), grey);
+      if (where == 0) {
+        b.point_light(vec3(0, -1, 0), vec3(10.0f));
+      } else {
+        // Faces outward; the light at its centre lights only the inside (the back faces).
+        b.box(vec3(3.0f, 0.0f, -1.0f), vec3(4.0f, 1.0f, 0.0f), grey);
+        b.point_light(vec3(3.5f, 0.5f, -0.5f), vec3(10.0f));
+      }
+      b.camera(vec3(0, 3, 0), vec3(0), 0.6f, vec3(0, 0, -1));
+      RenderOptions o = test::quick_options("plane_point.gltf", 16, 1);
+      o.method = m;
+      o.passes = 100000;
+      o.target_error = 0.002;
+      o.photons_per_pass = 2000;
+      Renderer r(std::move(b.scene), o);
+      const RenderReport report = test::run_to_stop(r);
+      std::printf("stopped after %llu passes, mean bound %.4g\n",
+                  (unsigned long long)report.work.passes, report.summary.mean_bound);
+      EXPECT_EQ(stop_text(report.stop), "target-error");
+      EXPECT_LT(report.work.passes, 20000u);
+      EXPECT_EQ(report.summary.unknown_pixels, 0u);
+      FilmImage img;
+      r.develop(&img);
+      for (size_t k = 0; k < img.bound.size(); ++k) {
+        ASSERT_TRUE(std::isfinite(img.bound[k])) << "pixel-channel " << k;
+        ASSERT_EQ(img.radiance[k], 0.0f) << "pixel-channel " << k;
+      }
+    }
 }
 
 }  // namespace

@@ -15,7 +15,15 @@
 
 namespace pb {
 
-enum class StopReason : uint8_t { None, Passes, Time, TargetError, Unreachable, Interrupted };
+enum class StopReason : uint8_t {
+  None,
+  Passes,
+  Time,
+  TargetError,
+  Unreachable,   // the radii cannot shrink and the bias is above the target
+  ModelRefuted,  // the second-order bias model fails at this radius (ESTIMATOR.md 11b)
+  Interrupted
+};
 
 // As printed and stored in the EXR metadata ("passes", "time", "target-error", ...).
 std::string stop_text(StopReason reason);
