@@ -622,10 +622,14 @@ void modelnull_experiment() {
   for (const char* file : {"cornell.gltf", "glass_slab.gltf", "spot.gltf", "glossy_plane.gltf",
                            "sun.gltf", "unlit.gltf", "closed_block.gltf", "furnace.gltf"})
     for (Method method : {Method::SPPM, Method::PPM}) {
+      const char* only = std::getenv("PB_STUDY_SCENE");
+      if (only && std::string(only) != file) continue;
       RenderOptions o = study_options(file, 64, 256);
       o.method = method;
       Renderer r(load_gltf(o.scene), o);
-      for (uint64_t passes : {16u, 64u, 256u}) {
+      const char* longer = std::getenv("PB_STUDY_LONG");
+      for (uint64_t passes : {16u, 64u, 256u, 1024u, 4096u}) {
+        if (passes > 256u && !longer) break;
         while (r.passes() < passes) r.step();
         const double i = double(r.passes());
         double share2 = 0, share3 = 0, z2 = 0, cnt = 0, zmax = 0;

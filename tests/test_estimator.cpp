@@ -723,5 +723,89 @@ TEST(BoundQuantile, LiesBetweenOneAndTwoSidedBoundsAndGrowsWithBias) {
   EXPECT_EQ(q(0.7, 0.0), 0.7);  // no noise: the bias alone
 }
 
+// ---------------------------------------------------------------------------------------------
+// The model check (ESTIMATOR.md section 11b), on photons of a Poisson process whose density is a
+// Gaussian bump of width 1, gathered at a point 0.5 from its centre: 300 independent points, 64
+// PPM passes, about 300 photons in the starting disc per pass. With a starting radius of 0.1 the
+// bump is quadratic across the disc and the two slopes estimate the same a: the share of |z| > 3
+// is the normal tail's 0.3% if z is standard normal (its sd is an upper estimate where the
+// Laplacian's is, so fewer); 5% would be 3.5 times its binomial sd above 2% at 900
+// state-channels. With a starting radius of 5 the disc holds the whole bump, E[X] bends in R^2,
+// and the check must refute the model for the image (share above kRefutedShare; measured 1.0).
+struct ModelCheckRun {
+  double share = 0.0;  // of state-channels with |z| > kSlopeZ
+  double mean_z2 = 0.0;
+  double mean_abs_error = 0.0, mean_abs_bias = 0.0;
+};
+
+ModelCheckRun model_check_run(double r0) {
+  const double x0 = 0.5;  // the point's distance from the bump's centre
+  auto density = [](double x, double y) { return std::exp(-0.5 * (x * x + y * y)); };
+  // Photons per unit area at the density's peak, so that the starting disc holds about 300.
+  const double r_area = std::min(r0, 2.0);
+  const double me = 300.0 / (kPi_ * r_area * r_area * density(x0 + 0.5 * r_area, 0.0));
+  ModelCheckRun out;
+  size_t tested = 0, over = 0;
+  double z2 = 0.0;
+  const int points = 300;
+  for (int k = 0; k < points; ++k) {
+    PointState s;
+    s.r2 = r0 * r0;
+    EstimatorParams params;
+    params.photons_per_pass = me;
+    for (uint64_t j = 1; j <= 64; ++j) {
+      Rng rng(uint64_t(k), j, 0, Stream::Test);
+      const double r = std::sqrt(s.r2);
+      // Poisson process of intensity me over the square around the point, thinned by the
+      // density: arrival times of a unit-rate process up to the square's expected count.
+      const double lambda = me * 4.0 * r * r;
+      PassGather g;
+      for (double t = -std::log(1.0 - rng.next_double()); t < lambda;
+           t += -std::log(1.0 - rng.next_double())) {
+        const double dx = (2.0 * rng.next_double() - 1.0) * r,
+                     dy = (2.0 * rng.next_double() - 1.0) * r;
+        if (rng.next_double() >= density(x0 + dx, dy)) continue;
+        const double u = std::sqrt(dx * dx + dy * dy) / r;
+        if (u >= 1.0) continue;
+        g.phi += dvec3(kernel::weight(u));
+        g.phi_lap_r2 += dvec3(kernel::laplacian_weight_r2(u));
+        ++g.count;
+      }
+      accumulate_pass(s, g, params, j);
+    }
+    const PointEstimate e = estimate(s, 64, me);
+    out.mean_abs_error += std::fabs(e.radiance.x - density(x0, 0.0)) / points;
+    out.mean_abs_bias += std::fabs(e.bias.x) / points;
+    for (int c = 0; c < 3; ++c) {
+      if (e.slope_z[c] == 0.0) continue;
+      ++tested;
+      over += std::fabs(e.slope_z[c]) > kSlopeZ;
+      z2 += e.slope_z[c] * e.slope_z[c];
+    }
+  }
+  out.share = double(over) / double(std::max<size_t>(tested, 1));
+  out.mean_z2 = z2 / double(std::max<size_t>(tested, 1));
+  EXPECT_EQ(tested, size_t(3 * points));
+  return out;
+}
+
+TEST(ModelCheck, SlopesAgreeWhereTheRadianceIsSmoothAcrossTheDisc) {
+  const ModelCheckRun r = model_check_run(0.1);
+  std::printf("radius 0.1: share |z| > 3 %.4f, mean z^2 %.3f, error %.4g, |bias| %.4g\n", r.share,
+              r.mean_z2, r.mean_abs_error, r.mean_abs_bias);
+  EXPECT_LT(r.share, 0.05);
+  EXPECT_LT(r.mean_z2, 1.5);
+}
+
+TEST(ModelCheck, SlopesPartWhereTheDiscHoldsTheWholeBump) {
+  const ModelCheckRun r = model_check_run(5.0);
+  std::printf("radius 5: share |z| > 3 %.4f, mean z^2 %.3f, error %.4g, |bias| %.4g\n", r.share,
+              r.mean_z2, r.mean_abs_error, r.mean_abs_bias);
+  // The model is wrong here: the error is well beyond the bias it predicts (measured 0.32
+  // against 0.20; at a starting radius of 3 it is 0.16 against 0.13, and the slopes agree).
+  EXPECT_GT(r.mean_abs_error, 1.4 * r.mean_abs_bias);
+  EXPECT_GT(r.share, kRefutedShare);
+}
+
 }  // namespace
 }  // namespace pb

@@ -403,6 +403,46 @@ TEST(Extremes, HugeInitialRadius) {
   }
 }
 
+// A quarter of and the whole scene size (7 and 28 on a plane lit from a height of 1): the disc
+// holds most of the light's footprint, c stays near 1/2 or above, and the estimate is a blur of
+// the footprint whose bias the Laplacian at that radius cannot extrapolate (the error is 0.5
+// against a bound of 0.2 after 64 passes, README "Error bounds"). The model check (ESTIMATOR.md
+// section 11b) must refute the model for the image, so every bound is unknown and a target
+// render stops "unreachable" in a bounded number of passes instead of reporting a small bound;
+// with both methods. At the default radius the same render is not refuted.
+TEST(Extremes, RadiusOfTheSceneSizeIsRefutedByTheModelCheck) {
+  for (Method m : {Method::PPM, Method::SPPM})
+    for (double fraction : {0.25, 1.0}) {
+      SCOPED_TRACE(std::string(m == Method::PPM ? "PPM" : "SPPM") + " radius " +
+                   std::to_string(fraction) + " x scene");
+      RenderOptions o = extremes::options(test::scene_path("plane_point.gltf"), 16, 10000);
+      o.method = m;
+      o.radius = fraction * plane_scene_size();
+      o.passes = 5000;
+      o.target_error = 0.01;
+      Renderer r(load_gltf(o.scene), o);
+      const RenderReport report = test::run_to_stop(r);
+      std::printf("%s, radius %.2f x scene: stopped after %llu passes (%s), %.0f%% disagree\n",
+                  m == Method::PPM ? "PPM" : "SPPM", fraction,
+                  (unsigned long long)report.work.passes, stop_text(report.stop).c_str(),
+                  100.0 * report.summary.slope_disagreement);
+      EXPECT_EQ(report.stop, StopReason::ModelRefuted);
+      EXPECT_LT(report.work.passes, 500u);
+      EXPECT_TRUE(report.summary.model_refuted);
+      EXPECT_EQ(report.summary.unknown_pixels, 16u * 16u);
+      EXPECT_FALSE(std::isfinite(report.summary.predicted_error_upper));
+    }
+  RenderOptions o = extremes::options(test::scene_path("plane_point.gltf"), 16, 10000);
+  o.passes = 256;
+  Render run(o.scene, o);
+  run.passes(256);
+  FilmSummary summary;
+  check_film(*run.r, run.r->film_settings(), nullptr, &summary);
+  std::printf("default radius, 256 passes: %.2f%% disagree\n", 100.0 * summary.slope_disagreement);
+  EXPECT_FALSE(summary.model_refuted);
+  EXPECT_LT(summary.slope_disagreement, 0.05);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Scenes scaled by 1e-4 and 1e5.
 
