@@ -1,7 +1,7 @@
 // Prints the README's evidence for the error bounds: coverage against the exact answers of the
 // analytic scenes, and renders to halving target errors (specified vs actual error).
 // Run: build/tests/bounds_study [all|coverage|termination|stopping|edges|cornell|rules|
-// calibration|correlation|slope] [ppm|sppm] [seeds]
+// calibration|correlation|slope|modelcheck|modelnull] [ppm|sppm] [seeds]
 // (a few minutes on 2 cores)
 #include "analytic.h"
 #include "reference_truth.h"
@@ -551,6 +551,25 @@ void slope_experiment() {
   }
 }
 
+// The model check's statistics over a render's states (PointEstimate::slope_z).
+struct SlopeShares {
+  double share2 = 0, share3 = 0, z2 = 0, zmax = 0, count = 0;
+  void add(const Renderer& r) {
+    for (const PointState& st : r.states()) {
+      const PointEstimate e = estimate(st, r.passes(), double(r.options().photons_per_pass));
+      for (int c = 0; c < 3; ++c) {
+        const double z = e.slope_z[c];
+        if (z == 0.0) continue;
+        share2 += std::fabs(z) > 2.0;
+        share3 += std::fabs(z) > kSlopeZ;
+        z2 += z * z;
+        zmax = std::max(zmax, z * z);
+        count += 1;
+      }
+    }
+  }
+};
+
 // The second-order model's own check (issue 14, large starting radii): per state and channel,
 // z = (b - a) / sd, b = C_XR / C_RR the samples' regression slope on R^2 and a the Laplacian's;
 // the share of |z| > 2 and > 3 and the mean of z^2 over the image, against the coverage at 90%.
@@ -568,7 +587,8 @@ void modelcheck_experiment() {
       const analytic::Case sc = analytic::by_name(name);
       for (double mult : {1.0, 3.0, 10.0, 30.0}) {
         for (uint64_t passes : {16u, 64u, 256u}) {
-          double share2 = 0, share3 = 0, z2 = 0, cnt = 0, err = 0, bnd = 0, cov = 0;
+          SlopeShares shares;
+          double err = 0, bnd = 0, cov = 0;
           for (int seed = 1; seed <= 2; ++seed) {
             RenderOptions o = study_options(sc.file, 32, passes);
             o.method = method;
@@ -581,24 +601,7 @@ void modelcheck_experiment() {
             }
             Renderer r(scene, o);
             while (r.passes() < passes) r.step();
-            const double i = double(r.passes());
-            for (const PointState& st : r.states()) {
-              if (!(st.c_rr > 0.0) || st.photons < kMinPhotonsForBound) continue;
-              const PointEstimate e = estimate(st, r.passes(), double(o.photons_per_pass));
-              for (int c = 0; c < 3; ++c) {
-                const double a = e.bias[c] / st.mean_r2;
-                const double b = st.c_xr[c] / st.c_rr;
-                const double resid =
-                    std::max(0.0, (st.c_xx[c] - st.c_xr[c] * st.c_xr[c] / st.c_rr) / (i - 2.0));
-                const double var = resid / st.c_rr + e.bias_variance[c] / (st.mean_r2 * st.mean_r2);
-                if (!(var > 0.0)) continue;
-                const double z = (b - a) / std::sqrt(var);
-                share2 += std::fabs(z) > 2.0;
-                share3 += std::fabs(z) > 3.0;
-                z2 += z * z;
-                cnt += 1;
-              }
-            }
+            shares.add(r);
             const analytic::Accuracy acc = analytic::measure(r, sc.exact, 0.9);
             err += acc.mean_abs_error / 2;
             bnd += acc.mean_bound / 2;
@@ -606,7 +609,8 @@ void modelcheck_experiment() {
           }
           std::printf("| %s | %s | %.0f | %llu | %.3f | %.3f | %.2f | %.4f | %.4f | %.3f |\n", name,
                       method == Method::PPM ? "PPM" : "SPPM", mult, (unsigned long long)passes,
-                      share2 / cnt, share3 / cnt, z2 / cnt, err, bnd, cov);
+                      shares.share2 / shares.count, shares.share3 / shares.count,
+                      shares.z2 / shares.count, err, bnd, cov);
           std::fflush(stdout);
         }
       }
@@ -631,29 +635,11 @@ void modelnull_experiment() {
       for (uint64_t passes : {16u, 64u, 256u, 1024u, 4096u}) {
         if (passes > 256u && !longer) break;
         while (r.passes() < passes) r.step();
-        const double i = double(r.passes());
-        double share2 = 0, share3 = 0, z2 = 0, cnt = 0, zmax = 0;
-        for (const PointState& st : r.states()) {
-          if (!(st.c_rr > 0.0) || st.photons < kMinPhotonsForBound) continue;
-          const PointEstimate e = estimate(st, r.passes(), double(o.photons_per_pass));
-          for (int c = 0; c < 3; ++c) {
-            const double a = e.bias[c] / st.mean_r2;
-            const double b = st.c_xr[c] / st.c_rr;
-            const double resid =
-                std::max(0.0, (st.c_xx[c] - st.c_xr[c] * st.c_xr[c] / st.c_rr) / (i - 2.0));
-            const double var = resid / st.c_rr + e.bias_variance[c] / (st.mean_r2 * st.mean_r2);
-            if (!(var > 0.0)) continue;
-            const double z = (b - a) / std::sqrt(var);
-            share2 += std::fabs(z) > 2.0;
-            share3 += std::fabs(z) > 3.0;
-            z2 += z * z;
-            zmax = std::max(zmax, z * z);
-            cnt += 1;
-          }
-        }
+        SlopeShares sh;
+        sh.add(r);
         std::printf("| %s | %s | %llu | %.3f | %.3f | %.2f | %.3f |\n", file,
                     method == Method::PPM ? "PPM" : "SPPM", (unsigned long long)passes,
-                    share2 / cnt, share3 / cnt, z2 / cnt, zmax / z2);
+                    sh.share2 / sh.count, sh.share3 / sh.count, sh.z2 / sh.count, sh.zmax / sh.z2);
         std::fflush(stdout);
       }
     }
