@@ -141,7 +141,8 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
               << ": every error bound is unknown: the bias model fails at this radius (in "
               << std::setprecision(3) << 100.0 * report.summary.slope_disagreement
               << std::setprecision(6)
-              << "% of points the samples' drift with the radius disagrees with the Laplacian); "
+              << "% of the points' channels the samples' drift with the radius disagrees with the "
+                 "Laplacian); "
                  "start with a smaller --radius\n";
   if (keep_state || report.stop == pb::StopReason::Interrupted)
     pb::save_state(state_path, {options, scene_hash, renderer.snapshot(), driver.state()});

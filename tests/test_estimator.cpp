@@ -729,9 +729,10 @@ TEST(BoundQuantile, LiesBetweenOneAndTwoSidedBoundsAndGrowsWithBias) {
 // PPM passes, about 300 photons in the starting disc per pass. With a starting radius of 0.1 the
 // bump is quadratic across the disc and the two slopes estimate the same a: the share of |z| > 3
 // is the normal tail's 0.3% if z is standard normal (its sd is an upper estimate where the
-// Laplacian's is, so fewer); 5% would be 3.5 times its binomial sd above 2% at 900
-// state-channels. With a starting radius of 5 the disc holds the whole bump, E[X] bends in R^2,
-// and the check must refute the model for the image (share above kRefutedShare; measured 1.0).
+// Laplacian's is, so fewer); the three channels are equal, so 300 points decide, and 5% of them
+// (15) is 16 times the 0.9 the normal tail expects. With a starting radius of 5 the disc holds the
+// whole bump, E[X] bends in R^2, and the check must refute the model for the image (share above
+// kRefutedShare; measured 1.0).
 struct ModelCheckRun {
   double share = 0.0;  // of state-channels with |z| > kSlopeZ
   double mean_z2 = 0.0;

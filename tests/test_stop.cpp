@@ -80,7 +80,7 @@ TEST(Stop, SomePointsUnreachedDoNotStopEarly) {
 // beside it. The radiance is exactly 0; every pixel's bound is the sparse-photon bound of a
 // point that received nothing (ESTIMATOR.md section 12), which falls as 1 / passes, so the
 // target is met in a bounded number of passes with every bound finite. Bound: 0.002 needs
-// lambda_u cap <= 0.002 with lambda_u = ln(10) / k at 90%, a few hundred passes here.
+// lambda_u cap <= 0.002 with lambda_u = ln(10) / k at 90%, 60 passes here.
 TEST(Stop, LightThatNoPointSeesStopsWithFiniteBounds) {
   for (int where = 0; where < 2; ++where)
     for (Method m : {Method::PPM, Method::SPPM}) {
