@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <vector>
 
 namespace pb {
 
@@ -49,6 +50,20 @@ void accumulate_pass(PointState& s, const PassGather& g, const EstimatorParams& 
   // Per-pass sample X_j = D_j + phi_j / (pi R_j^2 M_e) (section 4), streamed into bivariate
   // Welford moments with R_j^2: C_xy += (x - mean_x_old)(y - mean_y_new).
   const dvec3 x = g.direct + phi * inv_area;
+  // Section 11c: the kernel at R_j / 2 over the same photons. Under E[X(R)] = L + a R^2 the
+  // difference of the two scales is 0.75 a R_j^2 (the direct part cancels), so Y_j below has
+  // mean 0; the R^4 terms the model leaves out give it a mean, with a noise of its own that the
+  // samples measure. Where the disc is cut by an edge the half disc's kernel mass would be
+  // needed too: those passes are left out.
+  if (g.disc.full) {
+    const dvec3 y3 =
+        (g.phi - 4.0 * g.phi_half - 0.375 * kernel::kSecondMoment * g.phi_lap_r2) * inv_area;
+    const double y = y3.x + y3.y + y3.z;
+    ++s.scale_passes;
+    const double dy = y - s.scale_mean;
+    s.scale_mean += dy / double(s.scale_passes);
+    s.scale_c2 += float(dy * (y - s.scale_mean));
+  }
   const double inv_i = 1.0 / double(pass);
   const dvec3 dx = x - s.mean_x;
   const double dr = r2_bias - s.mean_r2;
@@ -115,7 +130,25 @@ PointEstimate estimate(const PointState& s, uint64_t passes, double photons_per_
         if (var > 0.0 && std::isfinite(var)) e.slope_z[c] = (b - a[c]) / std::sqrt(var);
       }
   }
+  if (s.scale_passes >= 3 && s.scale_c2 > 0.0f && s.photons >= kMinPhotonsForBound) {
+    const double n = double(s.scale_passes);
+    const double t = s.scale_mean / std::sqrt(double(s.scale_c2) / ((n - 1.0) * n));
+    e.scale_z = t * (kSlopeZ / t_at_three_sd(s.scale_passes - 1));
+  }
   return e;
+}
+
+double t_at_three_sd(uint64_t nu) {
+  // The Student-t quantile at the normal's 3-sd point, Phi(3), by degrees of freedom; the
+  // table ends where it is within 0.1% of 3.
+  static constexpr uint64_t kTable = 1024;
+  static const std::vector<double> table = [] {
+    const double p = boost::math::cdf(boost::math::normal_distribution<double>(), kSlopeZ);
+    std::vector<double> t(kTable + 1, kSlopeZ);
+    for (uint64_t k = 1; k <= kTable; ++k) t[k] = student_t_quantile(double(k), p);
+    return t;
+  }();
+  return nu == 0 ? std::numeric_limits<double>::infinity() : table[std::min(nu, kTable)];
 }
 
 namespace {

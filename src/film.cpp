@@ -18,17 +18,23 @@ struct PixelResult {
   dvec3 replica{0.0};        // a replica of the noise (sum_k W_k of the states', section 7)
   double photons = 0.0;
   uint32_t slope_tested = 0, slope_disagree = 0;  // state-channels of the model check (11b)
+  uint32_t scale_tested = 0, scale_disagree = 0;  // states of the two-scale check (11c)
   float radius = 0.0f;
   bool exact = false;  // PPM: no point, so nothing random (background, exact emission)
   bool known = true;
 };
 
-// Counts a state's channels into the model check (ESTIMATOR.md section 11b).
+// Counts a state's channels into the model check (ESTIMATOR.md section 11b) and the state into
+// the two-scale check (section 11c).
 void count_slopes(PixelResult& r, const PointEstimate& e) {
   for (int c = 0; c < 3; ++c) {
     if (e.slope_z[c] == 0.0) continue;
     ++r.slope_tested;
     r.slope_disagree += std::fabs(e.slope_z[c]) > kSlopeZ;
+  }
+  if (e.scale_z != 0.0) {
+    ++r.scale_tested;
+    r.scale_disagree += std::fabs(e.scale_z) > kSlopeZ;
   }
 }
 
@@ -234,15 +240,20 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
     image->radius.assign(pixels, 0.0f);
   }
 
-  // The model check (section 11b): where the samples' drift with R^2 and the Laplacian disagree
-  // in more than kRefutedShare of the state-channels, no bound of this image can be trusted.
-  uint64_t slope_tested = 0, slope_disagree = 0;
+  // The model checks (sections 11b, 11c): where the samples' drift with R^2 and the Laplacian
+  // disagree in more than kRefutedShare of the state-channels, or the two scales in more than
+  // that share of the states, no bound of this image can be trusted.
+  uint64_t slope_tested = 0, slope_disagree = 0, scale_tested = 0, scale_disagree = 0;
   for (const PixelResult& r : results) {
     slope_tested += r.slope_tested;
     slope_disagree += r.slope_disagree;
+    scale_tested += r.scale_tested;
+    scale_disagree += r.scale_disagree;
   }
   sum.slope_disagreement = slope_tested ? double(slope_disagree) / double(slope_tested) : 0.0;
-  sum.model_refuted = sum.slope_disagreement > kRefutedShare;
+  sum.scale_disagreement = scale_tested ? double(scale_disagree) / double(scale_tested) : 0.0;
+  sum.model_refuted =
+      sum.slope_disagreement > kRefutedShare || sum.scale_disagreement > kRefutedShare;
 
   const std::vector<dvec3> tau2 = bias_prior(results, eye.width, eye.height);
   double bound_sum = 0.0, noise_sum = 0.0, bias_sum = 0.0, bias_metric_sum = 0.0;

@@ -140,10 +140,11 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
     std::cerr << "photonbound: warning: " << options.scene
               << ": every error bound is unknown: the bias model fails at this radius (in "
               << std::setprecision(3) << 100.0 * report.summary.slope_disagreement
-              << std::setprecision(6)
               << "% of the points' channels the samples' drift with the radius disagrees with the "
-                 "Laplacian); "
-                 "start with a smaller --radius\n";
+                 "Laplacian, in "
+              << 100.0 * report.summary.scale_disagreement << std::setprecision(6)
+              << "% of the points the kernel at half the radius does); start with a smaller "
+                 "--radius\n";
   if (keep_state || report.stop == pb::StopReason::Interrupted)
     pb::save_state(state_path, {options, scene_hash, renderer.snapshot(), driver.state()});
   if (options.progress != pb::ProgressMode::Never)

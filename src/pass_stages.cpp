@@ -18,7 +18,7 @@ namespace {
 
 // A checkpoint snapshot is written once and read later by another thread: non-temporal stores
 // skip reading the destination's cache lines first and leave the cache to the pass's own data.
-// PointState is 192 bytes (16-byte multiple) and the vector's storage is 16-byte aligned.
+// PointState is 208 bytes (16-byte multiple) and the vector's storage is 16-byte aligned.
 void stream_copy(PointState* dst, const PointState& src) {
 #if defined(__SSE2__)
   static_assert(sizeof(PointState) % 16 == 0 && alignof(std::max_align_t) >= 16);
@@ -58,7 +58,7 @@ void gather_kernel(const MeasurementPoint& point, double r2, const HashGrid& gri
                    const std::vector<PhotonHit>& hits, PhotonFlux&& photon_flux, PassGather& out) {
   const float radius = search_radius(r2);
   const double inv_r2 = 1.0 / r2;
-  dvec3 phi(0.0), lap(0.0);
+  dvec3 phi(0.0), lap(0.0), half(0.0);
   uint64_t count = 0;
   grid.query(point.position, radius, [&](uint32_t k, float dist2) {
     const PhotonHit& h = hits[k];
@@ -74,11 +74,17 @@ void gather_kernel(const MeasurementPoint& point, double r2, const HashGrid& gri
     const dvec3 flux = photon_flux(h) * double(cos_s / cos_g);
     const double t = std::min(1.0, std::sqrt(double(dist2) * inv_r2));
     phi += kernel::weight(t) * flux;
-    if constexpr (kLaplacian) lap += kernel::laplacian_weight_r2(t) * flux;
+    if constexpr (kLaplacian) {
+      lap += kernel::laplacian_weight_r2(t) * flux;
+      if (t < 0.5) half += kernel::weight(2.0 * t) * flux;
+    }
   });
   const dvec3 f(point.f);
   out.phi += f * phi;
-  if constexpr (kLaplacian) out.phi_lap_r2 += f * lap;
+  if constexpr (kLaplacian) {
+    out.phi_lap_r2 += f * lap;
+    out.phi_half += f * half;
+  }
   out.count += count;
 }
 

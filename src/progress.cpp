@@ -58,7 +58,8 @@ std::string ProgressPrinter::line(const PassInfo& info) {
     }
     line << " | " << s.unknown_pixels << " unknown";
     if (s.model_refuted)
-      line << " (bias model refuted: " << 100.0 * s.slope_disagreement << "% of slopes disagree)";
+      line << " (bias model refuted: " << 100.0 * s.slope_disagreement << "% of slopes, "
+           << 100.0 * s.scale_disagreement << "% of scales disagree)";
   }
   line << " | " << seconds << " s";
   // Time left: the smallest of what the stop conditions imply. The target's comes from the

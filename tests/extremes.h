@@ -199,7 +199,7 @@ struct FilmCounts {
 // Develops the render and asserts the channel contract of README "Output": radiance, bias,
 // photons and radius finite; bound and noise finite and >= 0 where known, +inf on all three
 // channels exactly before the second pass (from then on a point with few or no photons has the
-// sparse-photon bound of ESTIMATOR.md section 12); radius > 0
+// sparse-photon bound of ESTIMATOR.md section 12) and where the bias model is refuted; radius > 0
 // where the pixel has points. The Variance channel is float32: with allow_variance_overflow a
 // channel may be +inf where the double variance exceeds FLT_MAX (the noise channel stays finite).
 inline FilmCounts check_film(const Renderer& r, const FilmSettings& s, FilmImage* out = nullptr,
@@ -213,7 +213,9 @@ inline FilmCounts check_film(const Renderer& r, const FilmSettings& s, FilmImage
   c.pixels = size_t(eye.width) * size_t(eye.height);
   for (size_t p = 0; p < c.pixels; ++p) {
     const uint32_t b = eye.pixel_begin[p], e = eye.pixel_begin[p + 1];
-    bool unknown = b != e && r.passes() < 2;
+    // A refuted bias model (ESTIMATOR.md sections 11b, 11c) leaves every pixel with points
+    // unknown.
+    bool unknown = b != e && (r.passes() < 2 || summary.model_refuted);
     for (uint32_t k = b; k < e; ++k) unknown = unknown || layout.mass[k] < kValidKernelMass;
     c.with_points += b != e;
     c.unknown += unknown;

@@ -247,6 +247,21 @@ bool wait_for(const std::string& file) {
   return false;
 }
 
+// Waits until process pid catches `sig` (its handler is installed: the SigCgt mask of
+// /proc/PID/status), so that a signal sent then is the program's to handle, however slowly a
+// loaded machine starts it.
+bool wait_for_handler(pid_t pid, int sig) {
+  for (int k = 0; k < 600; ++k) {
+    std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+    for (std::string line; std::getline(status, line);)
+      if (line.rfind("SigCgt:", 0) == 0 &&
+          (std::stoull(line.substr(7), nullptr, 16) >> (sig - 1)) & 1u)
+        return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
 std::string meta(const ExrImage& img, const std::string& key) {
   for (const auto& [k, v] : img.metadata)
     if (k == key) return v;
@@ -301,6 +316,7 @@ TEST_F(Checkpoints, CtrlCWritesImageAndStateAndExitsZero) {
   const std::string out = path("i.exr"), state = path("i.pbstate");
   const pid_t pid = spawn(long_render(out, 0.0));
   ASSERT_GT(pid, 0);
+  ASSERT_TRUE(wait_for_handler(pid, SIGINT));
   std::this_thread::sleep_for(std::chrono::milliseconds(1500));
   kill(pid, SIGINT);
   int status = 0;

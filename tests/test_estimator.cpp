@@ -732,10 +732,16 @@ TEST(BoundQuantile, LiesBetweenOneAndTwoSidedBoundsAndGrowsWithBias) {
 // Laplacian's is, so fewer); the three channels are equal, so 300 points decide, and 5% of them
 // (15) is 16 times the 0.9 the normal tail expects. With a starting radius of 5 the disc holds the
 // whole bump, E[X] bends in R^2, and the check must refute the model for the image (share above
-// kRefutedShare; measured 1.0).
+// kRefutedShare; measured 1.0). The two-scale check (section 11c) on the same photons: 300
+// states decide, each once, so the same 5% bound applies, and its mean z^2 is 1 for a standard
+// normal z (measured 0.98; 1.5 is 7 sd of a mean of 300 chi-square(1) values above 1); at radius
+// 5 it must refute already after 4 passes (measured 0.81, and 1.0 after 64).
 struct ModelCheckRun {
   double share = 0.0;  // of state-channels with |z| > kSlopeZ
   double mean_z2 = 0.0;
+  // The two-scale check (section 11c): share of states with |scale_z| > kSlopeZ after 4 and 64
+  // passes, and the mean of scale_z^2 after 64.
+  double scale_share4 = 0.0, scale_share64 = 0.0, scale_z2 = 0.0;
   double mean_abs_error = 0.0, mean_abs_bias = 0.0;
 };
 
@@ -746,7 +752,7 @@ ModelCheckRun model_check_run(double r0) {
   const double r_area = std::min(r0, 2.0);
   const double me = 300.0 / (kPi_ * r_area * r_area * density(x0 + 0.5 * r_area, 0.0));
   ModelCheckRun out;
-  size_t tested = 0, over = 0;
+  size_t tested = 0, over = 0, scale_tested4 = 0, scale_tested = 0;
   double z2 = 0.0;
   const int points = 300;
   for (int k = 0; k < points; ++k) {
@@ -770,9 +776,15 @@ ModelCheckRun model_check_run(double r0) {
         if (u >= 1.0) continue;
         g.phi += dvec3(kernel::weight(u));
         g.phi_lap_r2 += dvec3(kernel::laplacian_weight_r2(u));
+        if (u < 0.5) g.phi_half += dvec3(kernel::weight(2.0 * u));
         ++g.count;
       }
       accumulate_pass(s, g, params, j);
+      if (j == 4) {
+        const double z = estimate(s, 4, me).scale_z;
+        scale_tested4 += z != 0.0;
+        out.scale_share4 += std::fabs(z) > kSlopeZ;
+      }
     }
     const PointEstimate e = estimate(s, 64, me);
     out.mean_abs_error += std::fabs(e.radiance.x - density(x0, 0.0)) / points;
@@ -783,7 +795,17 @@ ModelCheckRun model_check_run(double r0) {
       over += std::fabs(e.slope_z[c]) > kSlopeZ;
       z2 += e.slope_z[c] * e.slope_z[c];
     }
+    if (e.scale_z != 0.0) {
+      ++scale_tested;
+      out.scale_share64 += std::fabs(e.scale_z) > kSlopeZ;
+      out.scale_z2 += e.scale_z * e.scale_z;
+    }
   }
+  out.scale_share4 /= double(std::max<size_t>(scale_tested4, 1));
+  out.scale_share64 /= double(std::max<size_t>(scale_tested, 1));
+  out.scale_z2 /= double(std::max<size_t>(scale_tested, 1));
+  EXPECT_EQ(scale_tested4, size_t(points));
+  EXPECT_EQ(scale_tested, size_t(points));
   out.share = double(over) / double(std::max<size_t>(tested, 1));
   out.mean_z2 = z2 / double(std::max<size_t>(tested, 1));
   EXPECT_EQ(tested, size_t(3 * points));
@@ -796,6 +818,11 @@ TEST(ModelCheck, SlopesAgreeWhereTheRadianceIsSmoothAcrossTheDisc) {
               r.mean_z2, r.mean_abs_error, r.mean_abs_bias);
   EXPECT_LT(r.share, 0.05);
   EXPECT_LT(r.mean_z2, 1.5);
+  std::printf("two scales: share |z| > 3 %.4f after 4 passes, %.4f after 64, mean z^2 %.3f\n",
+              r.scale_share4, r.scale_share64, r.scale_z2);
+  EXPECT_LT(r.scale_share4, 0.05);
+  EXPECT_LT(r.scale_share64, 0.05);
+  EXPECT_LT(r.scale_z2, 1.5);
 }
 
 TEST(ModelCheck, SlopesPartWhereTheDiscHoldsTheWholeBump) {
@@ -806,6 +833,10 @@ TEST(ModelCheck, SlopesPartWhereTheDiscHoldsTheWholeBump) {
   // against 0.20; at a starting radius of 3 it is 0.16 against 0.13, and the slopes agree).
   EXPECT_GT(r.mean_abs_error, 1.4 * r.mean_abs_bias);
   EXPECT_GT(r.share, kRefutedShare);
+  std::printf("two scales: share |z| > 3 %.4f after 4 passes, %.4f after 64, mean z^2 %.3f\n",
+              r.scale_share4, r.scale_share64, r.scale_z2);
+  EXPECT_GT(r.scale_share4, kRefutedShare);
+  EXPECT_GT(r.scale_share64, kRefutedShare);
 }
 
 }  // namespace

@@ -29,8 +29,9 @@ class StateError : public std::runtime_error {
 // 2: PointState without direct_sum (160 B); 3: options as key/value text from the option table;
 // 4: glTF's metallic-roughness materials (a version 3 state was rendered with other ones), the
 // sparse-photon bound's SPPM kernel masses, largest photon power and glossy caps;
-// 5: PointState with the alternating sums of the noise replica (192 B).
-inline constexpr uint32_t kStateVersion = 5;
+// 5: PointState with the alternating sums of the noise replica (192 B); 6: with the two-scale
+// check's moments (208 B).
+inline constexpr uint32_t kStateVersion = 6;
 
 struct SavedRender {
   RenderOptions options;    // as rendered (scene path, everything that shapes the image)

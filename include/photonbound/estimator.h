@@ -14,6 +14,7 @@ namespace pb {
 struct PassGather {
   dvec3 phi{0.0};         // sum of w(t) f Phi
   dvec3 phi_lap_r2{0.0};  // sum of w_lap(t) R_j^2 f Phi (divided by R_j^2 in the update)
+  dvec3 phi_half{0.0};    // sum of w(2t) f Phi over t < 1/2: the same kernel at radius R_j / 2
   uint64_t count = 0;     // M_j: photons that landed within R_j on the point's side
   dvec3 direct{0.0};      // D_j: next-event estimate of direct light (0 with --direct photons)
   DiscMoments disc;       // the kernel's moments over the reachable part of the disc (section 11)
@@ -39,8 +40,14 @@ struct PointState {
   // with the same covariance between points, free of the drift (ESTIMATOR.md section 7).
   dvec3 alt_x{0.0};
   double alt_r2 = 0.0;
+  // The two-scale check (ESTIMATOR.md section 11c): Welford moments of
+  // Y_j = X_j(R_j) - X_j(R_j / 2) - 0.75 R_j^2 a_j summed over the channels, zero in expectation
+  // while the bias is a R^2; only passes whose whole disc lies on the surface are counted.
+  double scale_mean = 0.0;
+  float scale_c2 = 0.0f;  // a test statistic's spread: float keeps the state at 208 bytes
+  uint32_t scale_passes = 0;
 };
-static_assert(sizeof(PointState) == 192, "the per-point memory budget counts on 192 bytes");
+static_assert(sizeof(PointState) == 208, "the per-point memory budget counts on 208 bytes");
 
 // The smallest kernel mass a boundary correction divides by: a point whose disc is almost all
 // off its surface (the tip of a sliver) is not amplified beyond 1000x.
@@ -81,6 +88,11 @@ struct PointEstimate {
   // samples' regression slope on R^2, a the Laplacian's, sd of their difference; 0 where it
   // cannot be formed (fewer than 3 passes, a radius that never changed, a state without photons).
   dvec3 slope_z{0.0};
+  // The two-scale check (section 11c): the t statistic of mean Y over its standard error,
+  // rescaled so that kSlopeZ is its two-sided 0.27% point at its degrees of freedom (normal
+  // sds for many passes); 0 where fewer than 3 passes had a whole disc or a state has too few
+  // photons.
+  double scale_z = 0.0;
   bool known = false;  // false until kMinPhotonsForBound photons and passes >= 2
 };
 
@@ -93,6 +105,10 @@ PointEstimate estimate(const PointState& state, uint64_t passes, double photons_
 // where the radius is 10 or 30 times the default on the analytic plane, 39-100% from 64 passes on.
 inline constexpr double kSlopeZ = 3.0;
 inline constexpr double kRefutedShare = 0.2;
+// The two-scale check (section 11c) is pooled the same way, over states: where more than
+// kRefutedShare of the tested states have |scale_z| > kSlopeZ the model is refuted too. It has
+// power from the first passes, where the slope on R^2 has almost none: on the analytic plane at
+// 10x the default radius 60% of states disagree after 4 passes, at 30x all of them.
 
 // Variance of the kernel estimate's bias estimate against that of the estimate itself, for
 // photons of a Poisson process: (0.5 k2)^2 integral (lap kappa)^2 / integral kappa^2 over the
@@ -118,6 +134,10 @@ double sparse_photon_bound(uint64_t photons, uint64_t passes, double cap, double
 
 // The kernel's peak weight w(0) = 3.5: no photon weighs more in phi (ESTIMATOR.md section 2).
 inline constexpr double kPeakWeight = 3.5;
+
+// t_{nu, Phi(3)}: the Student-t point a t statistic with nu degrees of freedom exceeds as often
+// as a normal one exceeds 3 sd (infinite for nu = 0; 3 to within 0.1% from nu = 1024 on).
+double t_at_three_sd(uint64_t nu);
 
 // Student-t quantile t_{nu, p} (Boost.Math), ESTIMATOR.md section 6. nu >= 1.
 double student_t_quantile(double nu, double p);

@@ -49,10 +49,12 @@ struct FilmSummary {
   // The settings' quantile (stop_fraction) of the pixels' bounds (largest channel, in the
   // metric): at most the target exactly when that share of the pixels is within it.
   double pixel_quantile_bound = INFINITY;
-  // The model check (ESTIMATOR.md section 11b): the share of state-channels whose regression
-  // slope on R^2 and Laplacian slope disagree, and whether that share refutes the second-order
-  // bias model (every pixel with a random state is then unknown).
+  // The model checks (ESTIMATOR.md sections 11b, 11c): the share of state-channels whose
+  // regression slope on R^2 and Laplacian slope disagree, the share of states whose two kernel
+  // scales disagree, and whether either share refutes the second-order bias model (every pixel
+  // with a random state is then unknown).
   double slope_disagreement = 0.0;
+  double scale_disagreement = 0.0;
   bool model_refuted = false;
 };
 
