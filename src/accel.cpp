@@ -58,7 +58,10 @@ struct Accel::Impl {
 };
 
 Accel::Accel(const Scene& scene) : impl_(std::make_unique<Impl>()) {
-  impl_->device = rtcNewDevice(nullptr);
+  // Embree picks its kernels by the CPU, and its BVH (BVH4 up to AVX, BVH8 from AVX2 on, other
+  // kernels with AVX-512) decides every hit's rounding, so the same seed gave other bits on an
+  // AVX-512 machine. Capped at AVX2, images are bit-identical on every CPU with AVX2.
+  impl_->device = rtcNewDevice("max_isa=avx2");
   if (!impl_->device) throw std::runtime_error("embree: cannot create a device");
   rtcSetDeviceErrorFunction(impl_->device, on_embree_error, nullptr);
   impl_->scene = rtcNewScene(impl_->device);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -261,10 +262,17 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
   if (std::getenv("PB_BOUNDARY_DEBUG"))
     std::fprintf(stderr, "boundary: %zu segments with blockers\n", found.size());
   // 4. Each segment is listed for every triangle of its host's surface within max_radius.
+  // A radius far above the triangles' size over a mesh with many boundary segments (an unposed
+  // skinned character at a preview resolution) would list thousands of segments per triangle
+  // and take gigabytes: past kPairBudget pairs plus 16 per triangle the index is given up, every
+  // disc counts as whole, and the renderer warns (truncated()).
   segments_.resize(found.size());
   std::vector<std::vector<std::pair<uint32_t, uint32_t>>> near(found.size());
+  const size_t budget = kPairBudget + 16 * size_t(n);
+  std::atomic<size_t> listed{0};
   parallel_for(found.size(), 64, [&](size_t b, size_t e) {
     for (size_t i = b; i < e; ++i) {
+      if (listed.load(std::memory_order_relaxed) > budget) return;
       const Pending& f = found[i];
       Segment& s = segments_[i];
       s = f.s;
@@ -280,12 +288,18 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
         if (segment_distance2(triangle_centre(v), f.s.a, f.s.b) < reach * reach)
           near[i].emplace_back(t, uint32_t(i));
       });
+      listed.fetch_add(near[i].size(), std::memory_order_relaxed);
     }
   });
+  truncated_ = listed.load() > budget;
   std::vector<std::pair<uint32_t, uint32_t>> pairs;
   for (auto& v : near) {
-    pairs.insert(pairs.end(), v.begin(), v.end());
+    if (!truncated_) pairs.insert(pairs.end(), v.begin(), v.end());
     std::vector<std::pair<uint32_t, uint32_t>>().swap(v);
+  }
+  if (truncated_) {
+    segments_.clear();
+    segments_.shrink_to_fit();
   }
   if (std::getenv("PB_BOUNDARY_DEBUG")) std::fprintf(stderr, "boundary: %zu pairs\n", pairs.size());
   std::sort(pairs.begin(), pairs.end());

@@ -95,6 +95,11 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   // The bias term models the radiance as smooth (second order) within the radius. A radius of
   // the scene's size breaks that (the extremes suite measured a bound of 0.128 against an error
   // of ~1 at R = scene size), so say so rather than report a bound that cannot be trusted.
+  if (renderer.boundary().truncated())
+    std::cerr << "photonbound: warning: " << options.scene
+              << ": too many boundary segments within the radius for the boundary correction "
+                 "(ESTIMATOR.md section 11); every disc counts as whole, so bounds along edges "
+                 "may be too small (a higher --resolution or a smaller --radius avoids this)\n";
   if (options.radius && *options.radius > kRadiusWarnFraction * renderer.world().scene_size())
     std::cerr << "photonbound: warning: --radius " << *options.radius << " is "
               << std::setprecision(3) << 100.0 * *options.radius / renderer.world().scene_size()

@@ -638,7 +638,12 @@ void modelnull_experiment() {
     for (Method method : {Method::SPPM, Method::PPM}) {
       const char* only = std::getenv("PB_STUDY_SCENE");
       if (only && std::string(only) != file) continue;
-      RenderOptions o = study_options(file, 64, 256);
+      // PB_STUDY_SIZE and PB_STUDY_PHOTONS: sparse photons per state (a large image at few
+      // photons per pass), where each state's Y and slope rest on a handful of photons.
+      const char* size = std::getenv("PB_STUDY_SIZE");
+      RenderOptions o = study_options(file, size ? std::atoi(size) : 64, 256);
+      if (const char* photons = std::getenv("PB_STUDY_PHOTONS"))
+        o.photons_per_pass = uint64_t(std::atoll(photons));
       o.method = method;
       Renderer r(load_gltf(o.scene), o);
       const char* longer = std::getenv("PB_STUDY_LONG");

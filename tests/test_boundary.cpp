@@ -202,5 +202,50 @@ TEST(BoundaryClearance, IsTheDistanceToTheNearestEndWithinTheRadius) {
   EXPECT_GT(cut, checked / 4);  // the grid exercises both sides
 }
 
+// Tiles: 120 x 120 separate unit squares, each of two triangles with four border edges
+// (57,600 segments, 28,800 triangles). At a radius of the whole field every segment is within
+// reach of every triangle: 1.7e9 pairs, far past BoundaryIndex::kPairBudget, so the index must
+// give up (an unposed skinned character at a preview resolution hung here, growing past 6 GB)
+// and count every disc as whole. At a radius of a tenth of a tile it lists each tile's own
+// borders and cuts a disc on a border.
+Scene tiles() {
+  Scene s;
+  s.source = "tiles";
+  s.materials.emplace_back();
+  Mesh m;
+  m.name = "tiles";
+  for (int i = 0; i < 120; ++i)
+    for (int j = 0; j < 120; ++j) {
+      const float x = 2.0f * float(i), y = 2.0f * float(j);
+      const uint32_t b = uint32_t(m.positions.size());
+      m.positions.insert(m.positions.end(),
+                         {{x, y, 0}, {x + 1, y, 0}, {x + 1, y + 1, 0}, {x, y + 1, 0}});
+      m.indices.insert(m.indices.end(), {b, b + 1, b + 2, b, b + 2, b + 3});
+    }
+  s.meshes = {m};
+  PunctualLight light;
+  light.position = vec3(120, 120, 10);
+  light.intensity = vec3(1);
+  s.lights.push_back(light);
+  for (const vec3& p : s.meshes[0].positions) s.bounds.extend(p);
+  return s;
+}
+
+TEST(BoundaryIndexBudget, AFieldOfEdgesWithinAHugeRadiusGivesTheIndexUp) {
+  const World world(tiles());
+  const BoundaryIndex huge(world, 400.0f);
+  EXPECT_TRUE(huge.truncated());
+  EXPECT_EQ(huge.segment_count(), 0u);
+  const uint32_t t = world.triangle_index(0, 0);  // tile (0, 0), below its diagonal
+  EXPECT_TRUE(huge.moments(t, vec3(0.5f, 0.01f, 0.0f), vec3(0, 0, 1), 0.3f).full);
+  const BoundaryIndex small(world, 0.1f);
+  EXPECT_FALSE(small.truncated());
+  EXPECT_EQ(small.segment_count(), 4u * 120u * 120u);
+  const DiscMoments cut = small.moments(t, vec3(0.5f, 0.01f, 0.0f), vec3(0, 0, 1), 0.1f);
+  EXPECT_FALSE(cut.full);
+  EXPECT_GT(cut.mass, 0.5);  // the disc's centre is inside the tile, 0.01 from its border
+  EXPECT_LT(cut.mass, 1.0);
+}
+
 }  // namespace
 }  // namespace pb

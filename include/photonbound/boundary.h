@@ -50,6 +50,10 @@ class BoundaryIndex {
   float clearance(uint32_t triangle, const vec3& p, float r) const;
 
   size_t segment_count() const { return segments_.size(); }
+  // The index was given up (more than kPairBudget + 16 per triangle segment-triangle pairs
+  // within the radius): every disc counts as whole.
+  bool truncated() const { return truncated_; }
+  static constexpr size_t kPairBudget = size_t(1) << 24;
   size_t memory_bytes() const;
 
   // Directions of the polar quadrature.
@@ -83,6 +87,7 @@ class BoundaryIndex {
   template <class Skip, class Visit>
   void scan(uint32_t triangle, Skip&& skip, Visit&& visit) const;
   std::vector<vec3> centre_;  // of triangles with segments (zero elsewhere)
+  bool truncated_ = false;
 };
 
 // The radial integrals of moments(), in closed form (kernel.h's quintic), for 0 <= a <= 1:

@@ -85,7 +85,8 @@ struct PointEstimate {
   // same covariance with other points' replicas as the noise itself (section 7).
   dvec3 replica{0.0};
   // The second-order model's own check (section 11b): (b - a) / sd, b = C_XR / C_RR the
-  // samples' regression slope on R^2, a the Laplacian's, sd of their difference; 0 where it
+  // samples' regression slope on R^2, a the Laplacian's, sd of their difference, rescaled by
+  // 3 / t_{i-2, Phi(3)} so that few passes' heavy tails do not fire the check; 0 where it
   // cannot be formed (fewer than 3 passes, a radius that never changed, a state without photons).
   dvec3 slope_z{0.0};
   // The two-scale check (section 11c): the t statistic of mean Y over its standard error,
