@@ -113,9 +113,9 @@ std::optional<View> Loader::attribute(const tinygltf::Primitive& prim, const Dra
   return View{d->second.data(), element, a.count, a.componentType, a.normalized};
 }
 
-// Three per triangle, each below `vertices`: the Draco faces, the indices accessor, or
-// 0, 1, 2, ... when there is none. tinygltf never sees an indices accessor without bufferView
-// (gltf_prepass.h), so that one comes from the prepass.
+// Three per triangle (strips and fans unrolled), each below `vertices`: the Draco faces, the
+// indices accessor, or 0, 1, 2, ... when there is none. tinygltf never sees an indices accessor
+// without bufferView (gltf_prepass.h), so that one comes from the prepass.
 std::vector<uint32_t> Loader::indices(size_t mesh, size_t p, const DracoPrimitive* dp,
                                       size_t vertices, const std::string& where) {
   const tinygltf::Primitive& prim = m_.meshes[mesh].primitives[p];
@@ -140,7 +140,7 @@ std::vector<uint32_t> Loader::indices(size_t mesh, size_t p, const DracoPrimitiv
                : iv.component == TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT ? iv.get<uint16_t>(i, 0)
                                                                         : iv.get<uint32_t>(i, 0);
   } else {
-    if (vertices % 3 != 0)
+    if (prim.mode == TINYGLTF_MODE_TRIANGLES && vertices % 3 != 0)
       fail(where + " has " + std::to_string(vertices) + " vertices, not a multiple of 3, and " +
            "no indices");
     idx.resize(vertices);
@@ -151,9 +151,22 @@ std::vector<uint32_t> Loader::indices(size_t mesh, size_t p, const DracoPrimitiv
     if (idx[i] >= vertices)
       fail(from + ": index " + std::to_string(i) + " has value " + std::to_string(idx[i]) +
            ", out of range for " + std::to_string(vertices) + " vertices");
-  if (idx.size() % 3 != 0)
-    fail(where + " has " + std::to_string(idx.size()) + " indices, not a multiple of 3");
-  return idx;
+  if (prim.mode == TINYGLTF_MODE_TRIANGLES) {
+    if (idx.size() % 3 != 0)
+      fail(where + " has " + std::to_string(idx.size()) + " indices, not a multiple of 3");
+    return idx;
+  }
+  // Strips and fans as glTF 2.0 section 3.7.2.1 defines their triangles: a strip's p_i is
+  // (v_i, v_{i + 1 + i % 2}, v_{i + 2 - i % 2}), keeping every triangle's winding; a fan's is
+  // (v_{i + 1}, v_{i + 2}, v_0).
+  std::vector<uint32_t> tris;
+  const bool strip = prim.mode == TINYGLTF_MODE_TRIANGLE_STRIP;
+  for (size_t i = 0; i + 2 < idx.size(); ++i)
+    if (strip)
+      tris.insert(tris.end(), {idx[i], idx[i + 1 + i % 2], idx[i + 2 - i % 2]});
+    else
+      tris.insert(tris.end(), {idx[i + 1], idx[i + 2], idx[0]});
+  return tris;
 }
 
 void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
@@ -161,8 +174,16 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
   const tinygltf::Primitive& prim = gm.primitives[p];
   const std::string ml = label("mesh", gm.name, mesh_index);
   const std::string where = ml + " primitive " + std::to_string(p);
-  if (prim.mode != TINYGLTF_MODE_TRIANGLES)
-    fail(where + " uses mode " + mode_name(prim.mode) + "; only TRIANGLES is supported");
+  // Points and lines have no area: nothing of theirs reflects light. A file that mixes them with
+  // surfaces (a wireframe overlay, a point cloud beside a model) renders its surfaces.
+  if (prim.mode >= TINYGLTF_MODE_POINTS && prim.mode <= TINYGLTF_MODE_LINE_STRIP) {
+    warn(where + " uses mode " + mode_name(prim.mode) +
+         ": points and lines have no area and are not drawn");
+    return;
+  }
+  if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
+      prim.mode != TINYGLTF_MODE_TRIANGLE_FAN)
+    fail(where + " uses mode " + mode_name(prim.mode) + ", which glTF 2.0 does not define");
   if (!prim.targets.empty())
     warn(ml + ": morph targets are ignored; the mesh is drawn in its base shape");
   if (!prim.attributes.count("POSITION")) fail(where + " has no POSITION attribute");

@@ -222,7 +222,12 @@ void Loader::visit(const tinygltf::Node& n, const std::string& nl, const Xform& 
 void Loader::finish() {
   if (scene_.degenerate_triangles > 0)
     warn(std::to_string(scene_.degenerate_triangles) + " degenerate triangles skipped");
-  if (scene_.meshes.empty()) fail("no triangles");
+  // The nodes of the scene drew nothing: no mesh, or meshes of points, lines or degenerate
+  // triangles alone (a primitives member that is not an array also leaves none).
+  if (scene_.meshes.empty())
+    fail(
+        "no triangles to render: the scene's nodes reference no mesh with a non-degenerate "
+        "triangle");
   // No camera and no light are not errors: scene_setup.h frames the bounds and lights the scene
   // with the default sky, as glTF viewers do.
   for (const Mesh& m : scene_.meshes)

@@ -735,17 +735,70 @@ TEST_F(LoaderTest, WrongTypeForPosition) {
   expect_error(g, "POSITION accessor 0 has type VEC2; expected VEC3");
 }
 
-TEST_F(LoaderTest, PointsModeIsRejected) {
+TEST_F(LoaderTest, PointsBesideSurfacesAreSkippedWithAWarning) {
   Gltf g = basic();
   g.mesh("dots", 0, -1, 0, "", ",\"mode\":0");
   g.node("\"mesh\":1");
-  expect_error(g, "mesh 'dots' primitive 0 uses mode POINTS; only TRIANGLES is supported");
+  const Scene s = load(g);
+  ASSERT_EQ(s.meshes.size(), 1u);  // the triangle alone
+  EXPECT_EQ(s.meshes[0].indices.size(), 3u);
+  bool warned = false;
+  for (const std::string& w : s.warnings)
+    warned = warned || w.find(
+                           "mesh 'dots' primitive 0 uses mode POINTS: points and lines have "
+                           "no area and are not drawn") != std::string::npos;
+  EXPECT_TRUE(warned);
 }
 
-TEST_F(LoaderTest, LinesModeIsRejected) {
+TEST_F(LoaderTest, LinesAloneLeaveNoTriangles) {
   Gltf g = basic();
   g.meshes[0] = "{\"name\":\"tri\",\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":1}]}";
-  expect_error(g, "mesh 'tri' primitive 0 uses mode LINES; only TRIANGLES is supported");
+  expect_error(g, "no triangles");
+}
+
+TEST_F(LoaderTest, UndefinedModeIsRejected) {
+  Gltf g = basic();
+  g.meshes[0] = "{\"name\":\"tri\",\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":9}]}";
+  expect_error(g, "mesh 'tri' primitive 0 uses mode 9, which glTF 2.0 does not define");
+}
+
+// A strip and a fan over five vertices give the triangles glTF 2.0 section 3.7.2.1 defines, in
+// order and each with the winding of the first (all facing +z here).
+TEST_F(LoaderTest, StripsAndFansUnrollIntoTheirTriangles) {
+  struct Case {
+    int mode;
+    std::vector<float> xyz;
+    std::vector<uint32_t> order;     // the vertex order written to the file
+    std::vector<uint32_t> expected;  // the triangles, in file indices
+  };
+  // Strip 0 1 2 3 4 over a zigzag: (0 1 2) (1 3 2) (2 3 4). Fan 0 1 3 2 4 around vertex 0:
+  // (1 3 0) (3 2 0) (2 4 0).
+  const Case cases[] = {{5,
+                         {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 2, 0},
+                         {0, 1, 2, 3, 4},
+                         {0, 1, 2, 1, 3, 2, 2, 3, 4}},
+                        {6,
+                         {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, -1, 1, 0},
+                         {0, 1, 3, 2, 4},
+                         {1, 3, 0, 3, 2, 0, 2, 4, 0}}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE("mode " + std::to_string(c.mode));
+    Gltf g = basic();
+    const int pos = g.vec3s(c.xyz);
+    const int ind = g.indices(std::vector<uint16_t>(c.order.begin(), c.order.end()));
+    g.meshes[0] =
+        "{\"name\":\"m\",\"primitives\":[{\"attributes\":{\"POSITION\":" + std::to_string(pos) +
+        "},\"indices\":" + std::to_string(ind) + ",\"mode\":" + std::to_string(c.mode) + "}]}";
+    const Scene s = load(g);
+    ASSERT_EQ(s.meshes.size(), 1u);
+    EXPECT_EQ(s.meshes[0].indices, c.expected);
+    for (size_t t = 0; t < 3; ++t) {  // counter-clockwise seen from +z
+      const vec3 a = s.meshes[0].positions[c.expected[3 * t]],
+                 b = s.meshes[0].positions[c.expected[3 * t + 1]],
+                 d = s.meshes[0].positions[c.expected[3 * t + 2]];
+      EXPECT_GT(glm::cross(b - a, d - a).z, 0.0f) << "triangle " << t;
+    }
+  }
 }
 
 TEST_F(LoaderTest, SparseIndicesMustIncrease) {  // test_gltf_accessors.cpp: the valid cases
