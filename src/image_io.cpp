@@ -94,6 +94,13 @@ std::string format_name(const unsigned char* d, size_t n, const std::string& nam
 }  // namespace
 
 Image decode_image(const unsigned char* data, size_t size, const std::string& name) {
+  // KTX2 (KHR_texture_basisu's container) has no OpenImageIO reader; without this, OpenImageIO
+  // falls back to opening `name` as a path relative to the working directory and reports a
+  // missing file.
+  if (size >= 12 && std::memcmp(data, "\xabKTX 20\xbb\r\n\x1a\n", 12) == 0)
+    throw ImageError(name +
+                     ": cannot decode the image: it is KTX2 (Basis Universal), which "
+                     "photonbound does not read");
   OIIO::Filesystem::IOMemReader memory(data, size);
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);  // keep colour as stored, not premultiplied

@@ -297,6 +297,19 @@ TEST(DecodeImage, JpegFromMemoryAndBadBytes) {
     EXPECT_EQ(m.rfind("junk.png: ", 0), 0u) << m;
     EXPECT_EQ(m.find('\n'), std::string::npos) << m;
   }
+  // A KTX2 file (its 12-byte identifier, then anything) is named as such, not looked up as a
+  // file of that name in the working directory.
+  std::vector<unsigned char> ktx2 = {0xab, 'K',  'T',  'X',  ' ',  '2',
+                                     '0',  0xbb, '\r', '\n', 0x1a, '\n'};
+  ktx2.resize(64, 0);
+  try {
+    decode_image(ktx2.data(), ktx2.size(), "lamp.ktx2");
+    ADD_FAILURE() << "expected an ImageError";
+  } catch (const ImageError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "lamp.ktx2: cannot decode the image: it is KTX2 (Basis Universal), which "
+              "photonbound does not read");
+  }
 }
 
 }  // namespace
