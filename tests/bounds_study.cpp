@@ -290,6 +290,9 @@ void rules_table(int seeds, int other_seeds) {
       const int n_seeds = rule == StopRule::MeanError ? seeds : other_seeds;
       for (double confidence : {0.5, 0.9, 0.95})
         for (double target : sc.targets) {
+          // PB_STUDY_CONFIDENCE (0.5, 0.9 or 0.95) keeps one confidence's rows.
+          if (const char* c = std::getenv("PB_STUDY_CONFIDENCE"); c && std::atof(c) != confidence)
+            continue;
           int within = 0;
           double ratio = 0.0, passes = 0.0, seconds = 0.0, pixels_within = 0.0;
           for (int seed = 1; seed <= n_seeds; ++seed) {

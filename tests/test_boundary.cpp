@@ -22,10 +22,23 @@ double lap_kappa(double t) { return 105.0 / kPi * (-3 * t + 8 * t * t - 5 * t * 
 
 // A floor [-1, 1]^2 at z = 0 facing +z, and a wall on its edge x = 1 facing back over it (-x):
 // the floor's other three edges are borders, x = 1 a 90-degree crease.
-Scene floor_and_wall() {
+// A scene of `meshes` with one material and a point light (World needs one; the moments ignore
+// it), its bounds those of the meshes.
+Scene scene_of(const char* source, std::vector<Mesh> meshes) {
   Scene s;
-  s.source = "floor_and_wall";
+  s.source = source;
   s.materials.emplace_back();
+  s.meshes = std::move(meshes);
+  PunctualLight light;
+  light.position = vec3(0, 0, 1);
+  light.intensity = vec3(1);
+  s.lights.push_back(light);
+  for (const Mesh& m : s.meshes)
+    for (const vec3& p : m.positions) s.bounds.extend(p);
+  return s;
+}
+
+Scene floor_and_wall() {
   Mesh floor;
   floor.name = "floor";
   floor.positions = {{-1, -1, 0}, {1, -1, 0}, {1, 1, 0}, {-1, 1, 0}};
@@ -34,14 +47,7 @@ Scene floor_and_wall() {
   wall.name = "wall";
   wall.positions = {{1, -1, 0}, {1, 1, 0}, {1, 1, 2}, {1, -1, 2}};
   wall.indices = {0, 2, 1, 0, 3, 2};  // (0, 2, 2) x (0, 2, 0) points along -x
-  s.meshes = {floor, wall};
-  PunctualLight light;  // World needs a light; the moments ignore it
-  light.position = vec3(0, 0, 1);
-  light.intensity = vec3(1);
-  s.lights.push_back(light);
-  for (const Mesh& m : s.meshes)
-    for (const vec3& p : m.positions) s.bounds.extend(p);
-  return s;
+  return scene_of("floor_and_wall", {floor, wall});
 }
 
 // Moments over the part of the disc about (px, py) on the floor (x < 1, y in [-1, 1]), by a
@@ -209,9 +215,6 @@ TEST(BoundaryClearance, IsTheDistanceToTheNearestEndWithinTheRadius) {
 // and count every disc as whole. At a radius of a tenth of a tile it lists each tile's own
 // borders and cuts a disc on a border.
 Scene tiles() {
-  Scene s;
-  s.source = "tiles";
-  s.materials.emplace_back();
   Mesh m;
   m.name = "tiles";
   for (int i = 0; i < 120; ++i)
@@ -222,13 +225,7 @@ Scene tiles() {
                          {{x, y, 0}, {x + 1, y, 0}, {x + 1, y + 1, 0}, {x, y + 1, 0}});
       m.indices.insert(m.indices.end(), {b, b + 1, b + 2, b, b + 2, b + 3});
     }
-  s.meshes = {m};
-  PunctualLight light;
-  light.position = vec3(120, 120, 10);
-  light.intensity = vec3(1);
-  s.lights.push_back(light);
-  for (const vec3& p : s.meshes[0].positions) s.bounds.extend(p);
-  return s;
+  return scene_of("tiles", {m});
 }
 
 TEST(BoundaryIndexBudget, AFieldOfEdgesWithinAHugeRadiusGivesTheIndexUp) {

@@ -750,14 +750,11 @@ TEST_F(LoaderTest, PointsBesideSurfacesAreSkippedWithAWarning) {
   EXPECT_TRUE(warned);
 }
 
-TEST_F(LoaderTest, LinesAloneLeaveNoTriangles) {
+// Lines alone leave the file nothing to draw; a mode glTF does not define is refused.
+TEST_F(LoaderTest, LinesAloneLeaveNoTrianglesAndUndefinedModesAreRefused) {
   Gltf g = basic();
   g.meshes[0] = "{\"name\":\"tri\",\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":1}]}";
   expect_error(g, "no triangles");
-}
-
-TEST_F(LoaderTest, UndefinedModeIsRejected) {
-  Gltf g = basic();
   g.meshes[0] = "{\"name\":\"tri\",\"primitives\":[{\"attributes\":{\"POSITION\":0},\"mode\":9}]}";
   expect_error(g, "mesh 'tri' primitive 0 uses mode 9, which glTF 2.0 does not define");
 }
