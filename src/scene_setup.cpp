@@ -86,6 +86,37 @@ std::vector<std::string> complete_scene(Scene& scene, const RenderOptions& o) {
   return notes;
 }
 
+// Lit only by the emission of its materials, with no punctual light and no environment: a model
+// made to be shown under a viewer's environment (glTF sample models with emissive details, the
+// DamagedHelmet among them) then renders as a few glowing parts on black, and the image's mean
+// can stay above kDarkRadiance. Emission is light, so the default sky is not added (an enclosed
+// or emitter-lit scene must not gain light its author did not put there); the warning says what
+// the user can add instead.
+namespace {
+
+std::optional<std::string> mostly_dark_warning(const ExrImage& image, const int rgb[3],
+                                               const Scene& scene) {
+  if (scene.environment) return std::nullopt;
+  for (const PunctualLight& l : scene.lights)
+    if (max_component(l.intensity) > 0.0f) return std::nullopt;
+  const size_t pixels = size_t(image.width) * size_t(image.height), nc = image.channels.size();
+  size_t dark = 0;
+  for (size_t p = 0; p < pixels; ++p) {
+    float brightest = 0.0f;
+    for (int c = 0; c < 3; ++c)
+      brightest = std::max(brightest, image.pixels[p * nc + size_t(rgb[c])]);
+    dark += double(brightest) < kDarkRadiance;
+  }
+  const double share = pixels ? double(dark) / double(pixels) : 0.0;
+  if (share <= kMostlyDarkShare) return std::nullopt;
+  return "the image is mostly black (" + number(std::round(100.0 * share)) +
+         "% of the pixels): its only light is the emission of its materials, with no punctual "
+         "light and no environment; a model meant to be seen lit from around, as glTF viewers "
+         "show it, needs --environment (--environment 1 is the default sky)";
+}
+
+}  // namespace
+
 std::optional<std::string> dark_image_warning(const ExrImage& image, const Scene& scene) {
   int rgb[3];
   for (int c = 0; c < 3; ++c) rgb[c] = image.channel_index(channel_name(Channel::Radiance, c));
@@ -95,7 +126,7 @@ std::optional<std::string> dark_image_warning(const ExrImage& image, const Scene
   for (size_t p = 0; p < pixels; ++p)
     for (int c = 0; c < 3; ++c) sum += double(image.pixels[p * nc + size_t(rgb[c])]);
   const double mean = pixels ? sum / double(3 * pixels) : 0.0;
-  if (mean >= kDarkRadiance) return std::nullopt;
+  if (mean >= kDarkRadiance) return mostly_dark_warning(image, rgb, scene);
   std::string w = std::string(mean > 0.0 ? "the image is nearly black" : "the image is black") +
                   " (mean radiance " + number(mean) + "): no light reaches what the camera sees";
   w += scene.environment ? "" : " and the scene has no environment (--environment)";

@@ -4,6 +4,8 @@
 #include "process_fixture.h"
 
 #include "photonbound/image_io.h"
+#include "photonbound/scene_setup.h"
+#include "scene_builder.h"
 
 #include <filesystem>
 #include <fstream>
@@ -83,6 +85,45 @@ TEST_F(CliDefaults, BlackImagesAreWarnedAbout) {
   EXPECT_NE(r.err.find("photonbound preview --exposure"), std::string::npos) << r.err;
   r = run("render " + quote(scene("plane_point.gltf")) + quick() + sky + " --environment 0.5");
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+}
+
+// Lit only by its materials' emission, an image can be bright on average and black almost
+// everywhere (a sample model with emissive details and no light of its own): over 75% of the
+// pixels below the preview's black level is called mostly black, and --environment is named;
+// with a punctual light or an environment the darkness is what the author lit, and nothing is
+// said.
+TEST(DarkImageWarning, AnImageLitOnlyByEmissionAndMostlyBlackNamesTheEnvironment) {
+  pb::test::SceneBuilder b;
+  b.quad(pb::vec3(0), pb::vec3(1, 0, 0), pb::vec3(0, 1, 0),
+         b.material(pb::vec3(0.5f), pb::vec3(1.0f)));
+  auto image = [](int bright) {  // 4 x 4, `bright` pixels at radiance 1, the rest 0
+    pb::ExrImage im;
+    im.width = im.height = 4;
+    im.channels = {"R", "G", "B"};
+    im.pixels.assign(48, 0.0f);
+    for (int p = 0; p < bright; ++p) im.pixels[size_t(3 * p + 1)] = 1.0f;
+    return im;
+  };
+  // 15 of 16 dark: the mean, 1/48, is far above the black level (1.5e-4).
+  const auto w = pb::dark_image_warning(image(1), b.scene);
+  ASSERT_TRUE(w.has_value());
+  EXPECT_NE(w->find("the image is mostly black (94% of the pixels): its only light is the "
+                    "emission of its materials"),
+            std::string::npos)
+      << *w;
+  EXPECT_NE(w->find("--environment 1 is the default sky"), std::string::npos) << *w;
+  EXPECT_FALSE(pb::dark_image_warning(image(4), b.scene).has_value());  // 75%: not over
+  pb::Scene lit = b.scene;
+  lit.lights.push_back(
+      {"lamp", pb::PunctualKind::Point, pb::vec3(0, 0, 1), pb::vec3(0, 0, -1), pb::vec3(1.0f)});
+  EXPECT_FALSE(pb::dark_image_warning(image(1), lit).has_value());
+  pb::Scene sky = b.scene;
+  sky.environment = pb::Environment{"--environment 0.5", 1, 1, {pb::vec3(0.5f)}};
+  EXPECT_FALSE(pb::dark_image_warning(image(1), sky).has_value());
+  // A wholly black image keeps the black-image warning.
+  const auto black = pb::dark_image_warning(image(0), b.scene);
+  ASSERT_TRUE(black.has_value());
+  EXPECT_EQ(black->find("the image is black (mean radiance 0)"), 0u) << *black;
 }
 
 TEST_F(CliDefaults, EnvironmentErrorsNameTheFile) {

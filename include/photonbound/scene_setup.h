@@ -31,8 +31,14 @@ std::vector<std::string> complete_scene(Scene& scene, const RenderOptions& optio
 // (12.92 x 1.5e-4 x 255 < 0.5).
 inline constexpr double kDarkRadiance = 1.5e-4;
 
+// The share of pixels below kDarkRadiance (every channel) above which an image lit only by its
+// materials' emission is called mostly black.
+inline constexpr double kMostlyDarkShare = 0.75;
+
 // A warning for a finished image that is black or nearly so (mean radiance over pixels and RGB
-// below kDarkRadiance), saying what might be missing; none otherwise.
+// below kDarkRadiance), or, lit only by emissive materials (no punctual light, no environment),
+// mostly black (more than kMostlyDarkShare of its pixels below kDarkRadiance), saying what might
+// be missing; none otherwise.
 std::optional<std::string> dark_image_warning(const ExrImage& image, const Scene& scene);
 
 }  // namespace pb
