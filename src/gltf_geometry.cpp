@@ -105,12 +105,15 @@ std::optional<View> Loader::attribute(const tinygltf::Primitive& prim, const Dra
     return accessor(it->second, ctx, kAttributeComponents, type);
   std::string al;
   const tinygltf::Accessor& a = header(it->second, ctx, kAttributeComponents, type, al);
-  if (a.count != dp->points)
-    fail(al + " has count " + std::to_string(a.count) + ", but the Draco data has " +
-         std::to_string(dp->points) + " points");
+  // The Draco faces index the decoded points, so those are what the primitive is. Exporters
+  // (COLLADA2GLTF's CesiumMilkTruck: 1856 against 1886) write the uncompressed count, which
+  // differs where the encoder split points at seams; three.js and Cesium read the decoded data.
+  if (a.count != dp->points && draco_counts_differ_++ == 0)
+    first_draco_count_ = al + " has count " + std::to_string(a.count) + ", the Draco data " +
+                         std::to_string(dp->points) + " points";
   const size_t element = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType)) *
                                 tinygltf::GetNumComponentsInType(uint32_t(a.type)));
-  return View{d->second.data(), element, a.count, a.componentType, a.normalized};
+  return View{d->second.data(), element, dp->points, a.componentType, a.normalized};
 }
 
 // Three per triangle (strips and fans unrolled), each below `vertices`: the Draco faces, the
@@ -127,9 +130,9 @@ std::vector<uint32_t> Loader::indices(size_t mesh, size_t p, const DracoPrimitiv
     if (index >= 0) {
       std::string al;
       const tinygltf::Accessor& a = header(index, il, kIndexComponents, TINYGLTF_TYPE_SCALAR, al);
-      if (a.count != dp->indices.size())
-        fail(al + " has count " + std::to_string(a.count) + ", but the Draco data has " +
-             std::to_string(dp->indices.size()) + " indices");
+      if (a.count != dp->indices.size() && draco_counts_differ_++ == 0)
+        first_draco_count_ = al + " has count " + std::to_string(a.count) + ", the Draco data " +
+                             std::to_string(dp->indices.size()) + " indices";
     }
     idx = dp->indices;
   } else if (index >= 0) {
@@ -179,6 +182,7 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
   if (prim.mode >= TINYGLTF_MODE_POINTS && prim.mode <= TINYGLTF_MODE_LINE_STRIP) {
     warn(where + " uses mode " + mode_name(prim.mode) +
          ": points and lines have no area and are not drawn");
+    ++skipped_points_lines_;
     return;
   }
   if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&

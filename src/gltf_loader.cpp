@@ -25,6 +25,7 @@
 #include "photonbound/lights.h"
 
 #include <algorithm>
+#include <cctype>
 #include <climits>
 #include <cstring>
 #include <filesystem>
@@ -49,12 +50,18 @@ bool spurious(const std::string& line) {
   return line == "'inverseBindMatrices' property is missing in Skin.";
 }
 
-// .glb by extension, otherwise glTF JSON, rewritten first where tinygltf needs it
+// GLB by its magic, otherwise glTF JSON, rewritten first where tinygltf needs it
 // (gltf_prepass.h). Every error tinygltf reports is fatal, even when it returns true (2.7 drops
 // e.g. a baseColorFactor of the wrong length with only a message), but the spurious ones.
 tinygltf::Model parse(const std::string& path, const std::vector<unsigned char>& bytes,
                       std::vector<std::string>& warnings, Prepass& pre) {
-  const bool glb = std::filesystem::path(path).extension() == ".glb";
+  // By the magic bytes, whatever the name: a .glb saved as .gltf is still binary. A name ending
+  // in .glb (any case: BOX.GLB) without the magic is a broken GLB, and check_glb says so.
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return std::tolower(c); });
+  const bool glb =
+      (bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0) || ext == ".glb";
   uint32_t size = glb ? check_glb(path, bytes) : uint32_t(bytes.size());
   const unsigned char* data = bytes.data();
   std::string json;
@@ -224,10 +231,19 @@ void Loader::finish() {
     warn(std::to_string(scene_.degenerate_triangles) + " degenerate triangles skipped");
   // The nodes of the scene drew nothing: no mesh, or meshes of points, lines or degenerate
   // triangles alone (a primitives member that is not an array also leaves none).
+  if (draco_counts_differ_ > 0)
+    warn(std::to_string(draco_counts_differ_) + " Draco-compressed accessor" +
+         (draco_counts_differ_ == 1 ? "'s count differs" : "s' counts differ") +
+         " from the decoded data (" + first_draco_count_ +
+         "): the decoded data is used, as the faces index it");
   if (scene_.meshes.empty())
     fail(
         "no triangles to render: the scene's nodes reference no mesh with a non-degenerate "
-        "triangle");
+        "triangle" +
+        (skipped_points_lines_ > 0 ? " (" + std::to_string(skipped_points_lines_) + " primitive" +
+                                         (skipped_points_lines_ == 1 ? " is" : "s are") +
+                                         " points or lines, which have no area)"
+                                   : std::string()));
   // No camera and no light are not errors: scene_setup.h frames the bounds and lights the scene
   // with the default sky, as glTF viewers do.
   for (const Mesh& m : scene_.meshes)

@@ -115,6 +115,9 @@ class Loader {
   std::vector<int64_t> material_slot_;  // glTF material -> Scene::materials index, -1 unused
   std::vector<int64_t> image_slot_;     // glTF image -> Scene::images index, -1 not decoded
   int64_t default_material_ = -1;
+  size_t skipped_points_lines_ = 0;  // primitives of mode POINTS or LINES*, not drawn
+  size_t draco_counts_differ_ = 0;   // Draco accessors whose count is not the decoded data's
+  std::string first_draco_count_;    // the first of them, for the one warning
 };
 
 }  // namespace pb::gltf

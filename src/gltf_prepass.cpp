@@ -15,7 +15,8 @@ using nlohmann::json;
 constexpr size_t kMaxNesting = 512;  // nlohmann's dump() recurses once per level
 
 bool needs_prepass(std::string_view text) {
-  for (const char* key : {"EXT_meshopt_compression", "KHR_draco_mesh_compression", "\"sparse\""})
+  for (const char* key : {"EXT_meshopt_compression", "KHR_draco_mesh_compression", "\"sparse\"",
+                          "KHR_animation_pointer"})
     if (text.find(key) != std::string_view::npos) return true;
   return false;
 }
@@ -95,6 +96,33 @@ bool detach_indices(json& doc, Prepass& out) {
   return changed;
 }
 
+// Drops every animation channel whose target has no "node": KHR_animation_pointer's channels
+// name their target by a JSON pointer instead, and tinygltf 2.7 fails the whole file with
+// "'node' property is missing". Animations are ignored anyway (with a warning); a channel
+// left without its node would only be ignored too.
+bool drop_pointer_channels(json& doc) {
+  const auto animations = doc.find("animations");
+  if (animations == doc.end() || !animations->is_array()) return false;
+  bool changed = false;
+  for (json& a : *animations) {
+    if (!a.is_object()) continue;
+    const auto channels = a.find("channels");
+    if (channels == a.end() || !channels->is_array()) continue;
+    json kept = json::array();
+    for (json& c : *channels) {
+      const auto target = c.is_object() ? c.find("target") : c.end();
+      const bool nodeless =
+          c.is_object() && target != c.end() && target->is_object() && !target->contains("node");
+      if (nodeless)
+        changed = true;
+      else
+        kept.push_back(std::move(c));
+    }
+    *channels = std::move(kept);
+  }
+  return changed;
+}
+
 }  // namespace
 
 bool prepass(std::string_view text, bool glb, Prepass& out, std::string& rewritten) {
@@ -103,7 +131,8 @@ bool prepass(std::string_view text, bool glb, Prepass& out, std::string& rewritt
   if (doc.is_discarded() || !doc.is_object()) return false;
   const bool buffers = rewrite_buffers(doc, glb, out);
   const bool indices = detach_indices(doc, out);
-  if (!buffers && !indices) return false;
+  const bool channels = drop_pointer_channels(doc);
+  if (!buffers && !indices && !channels) return false;
   rewritten = doc.dump();
   return true;
 }

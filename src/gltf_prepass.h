@@ -8,8 +8,11 @@
 //  - a primitive whose indices accessor has no bufferView (every KHR_draco_mesh_compression
 //    primitive): tinygltf fails with "accessor[N] invalid bufferView". Its "indices" member is
 //    taken out here and handed to the loader beside the model.
-// Only files that name EXT_meshopt_compression, KHR_draco_mesh_compression or a "sparse"
-// accessor are parsed twice; nlohmann::json (the parser tinygltf uses) is seen only here.
+//  - KHR_animation_pointer channels, whose target has no "node": tinygltf fails with "'node'
+//    property is missing". They are dropped (animations are ignored anyway).
+// Only files that name EXT_meshopt_compression, KHR_draco_mesh_compression,
+// KHR_animation_pointer or a "sparse" accessor are parsed twice; nlohmann::json (the parser
+// tinygltf uses) is seen only here.
 #pragma once
 
 #include <cstddef>

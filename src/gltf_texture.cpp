@@ -56,13 +56,18 @@ int32_t Loader::image(int index, const std::string& where) {
   Bytes bytes{gi.image.data(), gi.image.size()};
   if (gi.bufferView >= 0) bytes = view_bytes(gi.bufferView, il);  // validated range
   if (bytes.size == 0) fail(il + " has no data (a missing file, or an empty bufferView)");
+  // The uri's extension tells OpenImageIO the format where the signature does not.
+  const std::string name = gi.uri.empty() ? il : one_line(gi.uri);
   try {
-    Image decoded = decode_image(bytes.data, bytes.size, gi.uri.empty() ? il : one_line(gi.uri));
+    Image decoded = decode_image(bytes.data, bytes.size, name);
     decoded.name = il;
     slot = int64_t(scene_.images.size());
     scene_.images.push_back(std::move(decoded));
   } catch (const ImageError& e) {
-    fail(il + ": " + e.what());
+    // decode_image names the image itself; il is said once.
+    std::string what = e.what();
+    if (what.rfind(name + ": ", 0) == 0) what.erase(0, name.size() + 2);
+    fail(il + ": " + what);
   }
   return int32_t(slot);
 }

@@ -1,6 +1,7 @@
 // The power formulas of every kind of light (lights.h): what the photon tracer divides among
 // its photons, the loader's range check and the sparse-photon bound all use these.
 #include "photonbound/lights.h"
+#include "photonbound/texture.h"
 
 #include <algorithm>
 
@@ -53,11 +54,36 @@ double total_emitted_power(const Scene& scene) {
   return power;
 }
 
+namespace {
+
+// A material emits somewhere: a positive factor, and, with an emissive texture, one texel whose
+// channel under a positive factor channel is positive (an exporter writes emissiveFactor 1 over
+// an all-black texture for "no emission": such a file has no light, and gets the default sky).
+bool emits_anywhere(const Scene& scene, const Material& m) {
+  if (!m.emits()) return false;
+  const TextureRef& t = m.emissive_texture;
+  if (!t.present() || t.image < 0 || size_t(t.image) >= scene.images.size()) return true;
+  const Image& im = scene.images[size_t(t.image)];
+  for (int y = 0; y < im.height; ++y)
+    for (int x = 0; x < im.width; ++x) {
+      const glm::vec4 c = texel(im, x, y, true);
+      for (int k = 0; k < 3; ++k)
+        if (c[k] * m.emission[k] > 0.0f) return true;
+    }
+  return false;
+}
+
+}  // namespace
+
 bool has_light(const Scene& scene) {
   for (const PunctualLight& l : scene.lights)
     if (max_component(l.intensity) > 0.0f) return true;
-  for (const Mesh& m : scene.meshes)
-    if (scene.materials[m.material].emits()) return true;
+  std::vector<char> checked(scene.materials.size(), 0);
+  for (const Mesh& m : scene.meshes) {
+    if (checked[m.material]) continue;
+    checked[m.material] = 1;
+    if (emits_anywhere(scene, scene.materials[m.material])) return true;
+  }
   return scene.environment && max_component(EnvironmentLight(*scene.environment).integral()) > 0.0f;
 }
 
