@@ -204,7 +204,7 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
     if (!(std::max({std::abs(w.x), std::abs(w.y), std::abs(w.z)}) <= kMaxCoordinate))
       fail(ml + " has a vertex coordinate beyond the limit of 1e10 in world space (vertex " +
            std::to_string(i) + ")");
-    out.positions[i] = vec3(w);
+    out.positions[i] = vec3(w - scene_.origin);
   }
   if (const std::optional<View> nor = attribute(prim, dp, "NORMAL", where)) {
     if (nor->count != pos.count)

@@ -116,17 +116,27 @@ Scene Loader::run(const std::vector<std::string>& parse_warnings) {
   const int s = m_.defaultScene;
   if (s != -1 && (s < 0 || size_t(s) >= m_.scenes.size()))
     fail("\"scene\" refers to " + absent("scene", s, m_.scenes.size()));
-  if (!m_.scenes.empty()) {
-    const size_t si = s >= 0 ? size_t(s) : 0;
-    for (int r : m_.scenes[si].nodes) walk(r, label("scene", m_.scenes[si].name, si));
-  } else {
-    std::vector<char> child(m_.nodes.size(), 0);
-    for (const tinygltf::Node& n : m_.nodes)
-      for (int c : n.children)
-        if (c >= 0 && size_t(c) < child.size()) child[size_t(c)] = 1;
-    for (size_t i = 0; i < child.size(); ++i)
-      if (!child[i]) walk(int(i), "the file");
-  }
+  auto traverse = [&] {
+    visited_.assign(m_.nodes.size(), 0);
+    if (!m_.scenes.empty()) {
+      const size_t si = s >= 0 ? size_t(s) : 0;
+      for (int r : m_.scenes[si].nodes) walk(r, label("scene", m_.scenes[si].name, si));
+    } else {
+      std::vector<char> child(m_.nodes.size(), 0);
+      for (const tinygltf::Node& n : m_.nodes)
+        for (int c : n.children)
+          if (c >= 0 && size_t(c) < child.size()) child[size_t(c)] = 1;
+      for (size_t i = 0; i < child.size(); ++i)
+        if (!child[i]) walk(int(i), "the file");
+    }
+  };
+  // Twice: the accessors' bounds first, to choose the origin the positions are stored about,
+  // then the scene itself (the hierarchy's errors come from the first walk, unchanged).
+  measuring_ = true;
+  traverse();
+  measuring_ = false;
+  choose_origin();
+  traverse();
   finish();
   return std::move(scene_);
 }
@@ -210,8 +220,43 @@ void Loader::walk(int root, const std::string& root_from) {
   }
 }
 
+// The world box of the node's mesh from its POSITION accessors' min and max (glTF requires
+// them; a primitive without them, or of a kind the loader skips, is left out).
+void Loader::measure(const tinygltf::Node& n, const Xform& xf) {
+  if (n.mesh < 0 || size_t(n.mesh) >= m_.meshes.size()) return;
+  for (const tinygltf::Primitive& p : m_.meshes[size_t(n.mesh)].primitives) {
+    const auto it = p.attributes.find("POSITION");
+    if (it == p.attributes.end() || it->second < 0 || size_t(it->second) >= m_.accessors.size())
+      continue;
+    const tinygltf::Accessor& a = m_.accessors[size_t(it->second)];
+    if (a.minValues.size() != 3 || a.maxValues.size() != 3) continue;
+    for (int k = 0; k < 8; ++k) {
+      const dvec3 corner(k & 1 ? a.maxValues[0] : a.minValues[0],
+                         k & 2 ? a.maxValues[1] : a.minValues[1],
+                         k & 4 ? a.maxValues[2] : a.minValues[2]);
+      const dvec3 w = xf.point(corner);
+      if (!is_finite(vec3(w))) continue;
+      measured_lo_ = glm::min(measured_lo_, w);
+      measured_hi_ = glm::max(measured_hi_, w);
+    }
+  }
+}
+
+// Positions are stored in float: at a distance c from the origin its step is c 2^-24, so a model
+// of size D far from the origin (geo-referenced tiles sit at 4e6 m) loses its shape (a 10 m house
+// at 6e6 m: 169 of its triangles degenerate). Past c > 64 D (a step above 4e-6 D) the model is
+// centred in double first; near the origin nothing moves, so ordinary files keep their bits.
+void Loader::choose_origin() {
+  if (!(measured_lo_.x <= measured_hi_.x)) return;
+  const dvec3 centre = 0.5 * (measured_lo_ + measured_hi_);
+  const double size = glm::length(measured_hi_ - measured_lo_);
+  const double far = std::max({std::abs(centre.x), std::abs(centre.y), std::abs(centre.z)});
+  if (far > kRecentreRatio * std::max(size, 1e-30) && far <= kMaxCoordinate) scene_.origin = centre;
+}
+
 // A node's own content: mesh instances, camera, light.
 void Loader::visit(const tinygltf::Node& n, const std::string& nl, const Xform& xf) {
+  if (measuring_) return measure(n, xf);
   if (n.skin != -1) warn(nl + ": skins are ignored; the mesh is drawn unposed");
   if (n.mesh != -1) {
     if (n.mesh < 0 || size_t(n.mesh) >= m_.meshes.size())

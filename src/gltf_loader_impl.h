@@ -27,6 +27,7 @@ using glm::dmat3;
 using glm::dmat4;
 
 inline constexpr double kMaxCoordinate = 1e10;  // |world coordinate| limit
+inline constexpr double kRecentreRatio = 64.0;  // distance / size past which a model is centred
 inline constexpr int kMaxDepth = 1000;          // node hierarchy depth limit
 
 inline bool fits_float(double v) {
@@ -102,6 +103,8 @@ class Loader {
   void add_camera(int index, const std::string& nl, const Xform& xf);
   vec3 origin(const Xform& xf, const std::string& nl) const;
   void finish();
+  void measure(const tinygltf::Node& n, const Xform& xf);
+  void choose_origin();
 
   const std::string& file_;
   const tinygltf::Model& m_;
@@ -115,6 +118,9 @@ class Loader {
   std::vector<int64_t> material_slot_;  // glTF material -> Scene::materials index, -1 unused
   std::vector<int64_t> image_slot_;     // glTF image -> Scene::images index, -1 not decoded
   int64_t default_material_ = -1;
+  // Recentring (Loader::choose_origin): the world bounds of the POSITION accessors' min/max.
+  dvec3 measured_lo_{INFINITY}, measured_hi_{-INFINITY};
+  bool measuring_ = false;
   size_t skipped_points_lines_ = 0;  // primitives of mode POINTS or LINES*, not drawn
   size_t draco_counts_differ_ = 0;   // Draco accessors whose count is not the decoded data's
   std::string first_draco_count_;    // the first of them, for the one warning

@@ -235,7 +235,7 @@ vec3 Loader::origin(const Xform& xf, const std::string& nl) const {
   const dvec3 p = xf.point(dvec3(0.0));
   if (!(std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)}) <= kMaxCoordinate))
     fail(nl + " is placed beyond the limit of 1e10 in world space");
-  return vec3(p);
+  return vec3(p - scene_.origin);
 }
 
 }  // namespace pb::gltf

@@ -82,15 +82,20 @@ PinholeCamera choose_camera(const Scene& scene, const RenderOptions& o) {
   const double yfov = o.fov  ? radians(*o.fov)
                       : file ? double(file->yfov)
                              : radians(kDefaultFovDegrees);
+  // --look-from and --look-at are points of the file's world; the scene may be stored about
+  // another origin (Scene::origin).
+  auto point = [&](const std::array<double, 3>& v) {
+    return vec3(dvec3(v[0], v[1], v[2]) - scene.origin);
+  };
   const vec3 centre = 0.5f * (scene.bounds.lo + scene.bounds.hi);
   Camera c = file ? *file
                   : default_view(scene.bounds, double(w) / double(h), yfov,
-                                 o.look_at ? to_vec3(*o.look_at) : centre);
+                                 o.look_at ? point(*o.look_at) : centre);
   c.yfov = float(yfov);
-  if (o.look_from) c.position = to_vec3(*o.look_from);
+  if (o.look_from) c.position = point(*o.look_from);
   dvec3 forward(c.forward);
   if (o.look_at)
-    forward = dvec3(to_vec3(*o.look_at)) - dvec3(c.position);
+    forward = dvec3(point(*o.look_at)) - dvec3(c.position);
   else if (o.look_from)
     forward = dvec3(centre) - dvec3(c.position);
   if (!(glm::length(forward) > 0.0))

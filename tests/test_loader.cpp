@@ -687,6 +687,54 @@ TEST_F(LoaderTest, AnimationPointerChannelsDoNotRefuseTheFile) {
   EXPECT_TRUE(has_warning(s, "1 animation is ignored"));
 }
 
+// Geo-referenced content lies millions of units from the origin (3D Tiles in ECEF: 4e6 m) where a
+// float's step is 0.25-0.5: a 0.1-unit triangle there collapses. The loader centres such a model
+// in double precision (Scene::origin), cameras, lights and --look-from / --look-at with it.
+TEST_F(LoaderTest, AModelFarFromTheOriginIsCentredBeforeItIsRoundedToFloat) {
+  // basic() with a 0.1-unit triangle (and the min / max glTF requires of POSITION) under a parent
+  // node translated by t.
+  auto placed = [](const glm::dvec3& t) {
+    Gltf g = basic();
+    g.accessors[0] = "{\"bufferView\":" +
+                     std::to_string(g.view(std::vector<float>{0, 0, 0, 0.1f, 0, 0, 0, 0.1f, 0})) +
+                     ",\"componentType\":5126,\"count\":3,\"type\":\"VEC3\","
+                     "\"min\":[0,0,0],\"max\":[0.1,0.1,0]}";
+    char node[128];
+    std::snprintf(node, sizeof node, "\"translation\":[%.3f,%.3f,%.3f],\"children\":[0,1,2]", t.x,
+                  t.y, t.z);
+    g.node(node);
+    g.roots = std::vector<int>{3};
+    return g;
+  };
+  const glm::dvec3 shift(4e6, 3e6, 3.5e6);
+  const Scene s = load(placed(shift));
+  ASSERT_EQ(s.triangle_count(), 1u);  // in float about 4e6 it would be degenerate
+  EXPECT_EQ(s.degenerate_triangles, 0u);
+  // The origin is the box centre, (0.05, 0.05, 0) + shift; stored = file - origin.
+  EXPECT_LT(glm::length(s.origin - (shift + glm::dvec3(0.05, 0.05, 0))), 1e-6);
+  const glm::dvec3 corner[3] = {{0, 0, 0}, {0.1, 0, 0}, {0, 0.1, 0}};
+  for (int k = 0; k < 3; ++k) {
+    const glm::dvec3 stored(s.meshes[0].positions[s.meshes[0].indices[size_t(k)]]);
+    EXPECT_LT(glm::length(stored + s.origin - (shift + corner[k])), 1e-7) << k;
+  }
+  // The camera (0, 0, 5) and the lamp (0, 2, 0) under the same parent move with it.
+  EXPECT_LT(
+      glm::length(glm::dvec3(s.cameras[0].position) + s.origin - (shift + glm::dvec3(0, 0, 5))),
+      1e-6);
+  EXPECT_LT(
+      glm::length(glm::dvec3(s.lights[0].position) + s.origin - (shift + glm::dvec3(0, 2, 0))),
+      1e-6);
+  // --look-from and --look-at are the file's coordinates.
+  pb::RenderOptions o;
+  o.look_from = std::array<double, 3>{shift.x, shift.y, shift.z + 3};
+  o.look_at = std::array<double, 3>{shift.x + 0.05, shift.y + 0.05, shift.z};
+  const pb::PinholeCamera cam = pb::choose_camera(s, o);
+  EXPECT_LT(glm::length(glm::dvec3(cam.origin()) + s.origin - (shift + glm::dvec3(0, 0, 3))), 1e-6);
+  expect_vec(cam.camera().forward, vec3(0.05f, 0.05f, -3.0f) / std::sqrt(9.005f), 1e-6f);
+  // At 64 sizes from the origin or closer nothing moves: ordinary files keep their coordinates.
+  EXPECT_EQ(load(placed(glm::dvec3(5, 2, 0))).origin, glm::dvec3(0.0));
+}
+
 TEST_F(LoaderTest, DegenerateTrianglesAreSkippedAndCounted) {
   Gltf g = basic();
   const int pos = g.vec3s({0, 0, 0, 1, 0, 0, 0, 1, 0, 2, 0, 0, 1e-20f, 1e-20f, 0});
