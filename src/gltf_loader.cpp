@@ -152,13 +152,19 @@ void Loader::check_extensions() {
   // Unknown extensions, even required ones, are rendered without (README "Scenes"): a material
   // extension then falls back to the core factors; data an unknown extension holds is missing,
   // and the accessors that lack it are refused with their own message.
+  // What rendering without it means, where that is not only a material falling back.
+  auto without = [](const std::string& e) -> std::string {
+    if (e == "EXT_mesh_gpu_instancing") return ": each instanced mesh is drawn once, at its node";
+    return "";
+  };
   for (const std::string& e : m_.extensionsRequired)
     if (!known.count(e))
-      warn("extension '" + e + "' is required but not implemented; rendered without it");
+      warn("extension '" + e + "' is required but not implemented; rendered without it" +
+           without(e));
   for (const std::string& e : m_.extensionsUsed)
     if (!known.count(e) &&
         !std::count(m_.extensionsRequired.begin(), m_.extensionsRequired.end(), e))
-      warn("extension '" + e + "' is ignored");
+      warn("extension '" + e + "' is ignored" + without(e));
   if (!m_.animations.empty())
     warn(std::to_string(m_.animations.size()) +
          (m_.animations.size() == 1 ? " animation is" : " animations are") +
@@ -257,7 +263,7 @@ void Loader::choose_origin() {
 // A node's own content: mesh instances, camera, light.
 void Loader::visit(const tinygltf::Node& n, const std::string& nl, const Xform& xf) {
   if (measuring_) return measure(n, xf);
-  if (n.skin != -1) warn(nl + ": skins are ignored; the mesh is drawn unposed");
+  if (n.skin != -1 && skinned_nodes_++ == 0) first_skinned_ = nl;
   if (n.mesh != -1) {
     if (n.mesh < 0 || size_t(n.mesh) >= m_.meshes.size())
       fail(nl + " refers to " + absent("mesh", n.mesh, m_.meshes.size()));
@@ -276,6 +282,11 @@ void Loader::finish() {
     warn(std::to_string(scene_.degenerate_triangles) + " degenerate triangles skipped");
   // The nodes of the scene drew nothing: no mesh, or meshes of points, lines or degenerate
   // triangles alone (a primitives member that is not an array also leaves none).
+  // One line for every skinned node (a character rig has dozens).
+  if (skinned_nodes_ == 1) warn(first_skinned_ + ": skins are ignored; the mesh is drawn unposed");
+  if (skinned_nodes_ > 1)
+    warn(std::to_string(skinned_nodes_) + " nodes have skins (" + first_skinned_ +
+         " the first): skins are ignored; the meshes are drawn unposed");
   if (draco_counts_differ_ > 0)
     warn(std::to_string(draco_counts_differ_) + " Draco-compressed accessor" +
          (draco_counts_differ_ == 1 ? "'s count differs" : "s' counts differ") +

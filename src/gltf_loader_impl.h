@@ -121,6 +121,8 @@ class Loader {
   // Recentring (Loader::choose_origin): the world bounds of the POSITION accessors' min/max.
   dvec3 measured_lo_{INFINITY}, measured_hi_{-INFINITY};
   bool measuring_ = false;
+  size_t skinned_nodes_ = 0;  // skins are ignored: one warning for all
+  std::string first_skinned_;
   size_t skipped_points_lines_ = 0;  // primitives of mode POINTS or LINES*, not drawn
   size_t draco_counts_differ_ = 0;   // Draco accessors whose count is not the decoded data's
   std::string first_draco_count_;    // the first of them, for the one warning

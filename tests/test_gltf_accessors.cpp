@@ -206,4 +206,25 @@ TEST_F(DecodeTest, SkinWithoutInverseBindMatricesLoadsWithOnlyTheSkinWarning) {
   EXPECT_EQ(only_mesh(s).indices.size(), 6u);
 }
 
+// A rig skins dozens of nodes (SharpGLTF's InfiniteSkinnedTentacle: 85): one line for all of them.
+TEST_F(DecodeTest, ManySkinnedNodesGiveOneWarning) {
+  Doc d;
+  quad_file(d, json{{"bufferView", d.view(kQuad)}}, path("unused.gltf"));
+  json node = d.j["nodes"].back();
+  node["skin"] = 0;
+  d.j["nodes"].back() = node;
+  for (int k = 0; k < 3; ++k) {
+    node["name"] = "copy " + std::to_string(k);
+    node["translation"] = json::array({2.0 * (k + 1), 0.0, 0.0});
+    d.j["nodes"].push_back(node);
+    d.j["scenes"][0]["nodes"].push_back(d.j["nodes"].size() - 1);
+  }
+  d.j["skins"] = json::array({json{{"joints", json::array({0})}}});
+  const Scene s = pb::load_gltf(d.write(path("skins.gltf")));
+  EXPECT_EQ(s.warnings,
+            std::vector<std::string>{"4 nodes have skins (node 'grid node' the first): skins are "
+                                     "ignored; the meshes are drawn unposed"});
+  EXPECT_EQ(s.meshes.size(), 4u);
+}
+
 }  // namespace
