@@ -63,14 +63,17 @@ tinygltf::Model parse(const std::string& path, const std::vector<unsigned char>&
   const bool glb =
       (bytes.size() >= 4 && std::memcmp(bytes.data(), "glTF", 4) == 0) || ext == ".glb";
   uint32_t size = glb ? check_glb(path, bytes) : uint32_t(bytes.size());
-  const unsigned char* data = bytes.data();
+  std::optional<std::vector<unsigned char>> aligned;
+  if (glb && (aligned = align_glb(bytes, size))) size = uint32_t(aligned->size());
+  const std::vector<unsigned char>& in = aligned ? *aligned : bytes;
+  const unsigned char* data = in.data();
   std::string json;
   std::vector<unsigned char> rewritten_glb;
   const std::string_view text =
-      glb ? glb_json(bytes) : std::string_view(reinterpret_cast<const char*>(data), size);
+      glb ? glb_json(in) : std::string_view(reinterpret_cast<const char*>(data), size);
   if (prepass(text, glb, pre, json)) {
     if (glb) {
-      rewritten_glb = replace_glb_json(bytes, size, json);
+      rewritten_glb = replace_glb_json(in, size, json);
       data = rewritten_glb.data();
       size = uint32_t(rewritten_glb.size());
     } else {

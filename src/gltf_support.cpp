@@ -116,6 +116,30 @@ std::vector<unsigned char> replace_glb_json(const std::vector<unsigned char>& gl
   return out;
 }
 
+std::optional<std::vector<unsigned char>> align_glb(const std::vector<unsigned char>& glb,
+                                                    uint32_t length) {
+  const uint64_t json = le32(glb, 12), bin_at = 20 + json;
+  const bool has_bin = bin_at + 8 <= length;
+  const uint64_t bin = has_bin ? le32(glb, bin_at) : 0;
+  if (json % 4 == 0 && bin % 4 == 0) return std::nullopt;
+  std::vector<unsigned char> out(glb.begin(), glb.begin() + 20);
+  auto put32 = [&](size_t at, uint64_t v) {
+    for (int k = 0; k < 4; ++k) out[at + size_t(k)] = uint8_t(v >> (8 * k));
+  };
+  out.insert(out.end(), glb.begin() + 20, glb.begin() + int64_t(bin_at));
+  while (out.size() % 4) out.push_back(' ');  // JSON is padded with spaces
+  put32(12, out.size() - 20);
+  if (has_bin) {
+    const size_t at = out.size();
+    out.insert(out.end(), glb.begin() + int64_t(bin_at), glb.begin() + int64_t(bin_at + 8 + bin));
+    while (out.size() % 4) out.push_back(0);  // BIN with zeros
+    put32(at, out.size() - at - 8);
+    out.insert(out.end(), glb.begin() + int64_t(bin_at + 8 + bin), glb.begin() + int64_t(length));
+  }
+  put32(8, out.size());
+  return out;
+}
+
 Xform::Xform(const glm::dmat4& world)
     : m(world), linear(world), det(glm::determinant(glm::dmat3(world))) {}
 

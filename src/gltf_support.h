@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -65,6 +66,13 @@ std::vector<unsigned char> read_file(const std::string& path);
 // Checks the GLB header and chunk bounds (tinygltf 2.7 lets the BIN chunk run up to 8 bytes
 // past the declared length) and returns the declared length. Throws SceneError.
 uint32_t check_glb(const std::string& path, const std::vector<unsigned char>& data);
+
+// A GLB that check_glb accepted with its JSON and BIN chunks padded to 4 bytes, as glTF requires
+// and tinygltf 2.7 insists ("BIN Chunk end does not aligned"; real exporters, FME 2018 among
+// them, leave the last chunk unpadded); none when both already are. The buffer's byteLength is
+// unchanged: a chunk may be up to 3 bytes longer than its buffer.
+std::optional<std::vector<unsigned char>> align_glb(const std::vector<unsigned char>& glb,
+                                                    uint32_t length);
 
 // The JSON chunk of a GLB that check_glb accepted, and the same GLB (its first `length` bytes)
 // with that chunk replaced by `json`.

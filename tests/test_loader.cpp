@@ -668,6 +668,25 @@ TEST_F(LoaderTest, AGlbIsKnownByItsMagicNotItsName) {
   }
 }
 
+// glTF pads every GLB chunk to 4 bytes and tinygltf 2.7 refuses a BIN chunk that is not ("BIN
+// Chunk end does not aligned"); FME 2018 wrote one. The loader pads it: the same triangle loads.
+TEST_F(LoaderTest, AnUnpaddedBinChunkIsPadded) {
+  Gltf g = basic();
+  ASSERT_NE(g.bin.size() % 4, 0u);  // 3 uint16 indices end the buffer two bytes past a boundary
+  std::vector<unsigned char> glb = g.glb();
+  const uint32_t json = uint32_t(glb[12]) | uint32_t(glb[13]) << 8 | uint32_t(glb[14]) << 16 |
+                        uint32_t(glb[15]) << 24;
+  const size_t bin_at = 20 + json, unpadded = g.bin.size();
+  glb.resize(bin_at + 8 + unpadded);
+  for (int k = 0; k < 4; ++k) {
+    glb[bin_at + size_t(k)] = uint8_t(unpadded >> (8 * k));
+    glb[8 + size_t(k)] = uint8_t(glb.size() >> (8 * k));
+  }
+  const Scene s = load_gltf(write("unpadded.glb", glb));
+  EXPECT_EQ(s.triangle_count(), 1u);
+  expect_vec(s.meshes[0].positions[1], vec3(1, 0, 0));
+}
+
 // KHR_animation_pointer's channels target a JSON pointer, not a node; tinygltf 2.7 refused the
 // whole file ("'node' property is missing"). Animations are ignored, with their warning.
 TEST_F(LoaderTest, AnimationPointerChannelsDoNotRefuseTheFile) {
