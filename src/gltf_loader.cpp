@@ -97,9 +97,14 @@ tinygltf::Model parse(const std::string& path, const std::vector<unsigned char>&
   }
   std::vector<std::string> errors = nonempty_lines(err);
   const std::vector<std::string> notes = nonempty_lines(warn);
+  const std::vector<std::string> all_errors = errors;
   errors.erase(std::remove_if(errors.begin(), errors.end(), spurious), errors.end());
   if (!ok || !errors.empty()) {
-    std::string first = !errors.empty() ? errors[0] : !notes.empty() ? notes[0] : "unknown error";
+    // A failure whose only words were a spurious line still says them, not "unknown error".
+    std::string first = !errors.empty()       ? errors[0]
+                        : !all_errors.empty() ? all_errors[0]
+                        : !notes.empty()      ? notes[0]
+                                              : "tinygltf could not read it and gave no reason";
     if (first.size() > 160) first = first.substr(0, 160) + "...";  // it may quote a data URI
     throw SceneError(path + ": malformed glTF: " + first);
   }
