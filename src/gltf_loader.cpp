@@ -256,10 +256,13 @@ void Loader::measure(const tinygltf::Node& n, const Xform& xf) {
   }
 }
 
-// Positions are stored in float: at a distance c from the origin its step is c 2^-24, so a model
-// of size D far from the origin (geo-referenced tiles sit at 4e6 m) loses its shape (a 10 m house
-// at 6e6 m: 169 of its triangles degenerate). Past c > 64 D (a step above 4e-6 D) the model is
-// centred in double first; near the origin nothing moves, so ordinary files keep their bits.
+// Positions are stored in float: at a distance c from the origin its step is c 2^-24 to
+// c 2^-23, so a model of size D far from the origin (geo-referenced tiles sit at 4e6 m) loses its
+// shape (a 10 m house at 6e6 m: 169 of its triangles degenerate, 21 in the file). Past c > 64 D
+// (a step above 4e-6 D) the model is centred in double first; near the origin nothing moves, so
+// ordinary files keep their bits. Quantised POSITION (KHR_mesh_quantization) has min / max in
+// its stored units, so the box can be off by the dequantisation scale: that only moves the
+// threshold, as centring any model is exact up to float rounding of its centred positions.
 void Loader::choose_origin() {
   if (!(measured_lo_.x <= measured_hi_.x)) return;
   const dvec3 centre = 0.5 * (measured_lo_ + measured_hi_);

@@ -164,8 +164,8 @@ struct Scene {
   // Where the file's world origin lies in the coordinates stored here: positions (vertices,
   // cameras, lights) are the file's minus `origin`. Zero unless the model lies far from the
   // origin for its size (geo-referenced content at 4e6 m, where float steps are 0.5 m): the
-  // loader then centres it in double precision (gltf_loader.h), and view.cpp shifts --look-from
-  // and --look-at, which are given in the file's coordinates, the same way.
+  // loader then centres it in double precision (Loader::choose_origin), and view.cpp shifts
+  // --look-from and --look-at, which are given in the file's coordinates, the same way.
   dvec3 origin{0.0};
   uint64_t degenerate_triangles = 0;  // skipped at load time
   std::vector<std::string> warnings;  // each once, for the user
