@@ -122,13 +122,18 @@ struct Frame {
 vec3 Bsdf::eval_local(const vec3& wo, const vec3& wi, float* pdf) const {
   if (pdf) *pdf = 0.0f;
   if (wo.z <= 0.0f || wi.z <= 0.0f) return vec3(0.0f);
-  if (!smooth_) {
+  if (!smooth_ && part_ == Part::All) {
     if (pdf) *pdf = brdf_.pdf(wo, wi);
     return reflect_ * brdf_.eval(wo, wi);
   }
+  if (part_ == Part::Lobe) {
+    if (pdf) *pdf = ggx_reflection_pdf(wo, wi, ggx_alpha(brdf_.roughness));
+    return reflect_ * brdf_.eval_specular(wo, wi);
+  }
   // The mirror limit of appendix B's dielectric: the GGX layer is a delta branch, the diffuse
   // base keeps its weight 1 - max F(v.h) at this pair's half vector (v.h averaged over both
-  // directions, so that f stays reciprocal bit for bit).
+  // directions, so that f stays reciprocal bit for bit). base_part() is the same term of a
+  // rough lobe (MetalRoughBrdf::eval_diffuse computes it the same way).
   const vec3 h = glm::normalize(wo + wi);
   const float v_h = 0.5f * (glm::dot(wo, h) + glm::dot(wi, h));
   const vec3 f0 = brdf_.dielectric_f0();
@@ -184,7 +189,7 @@ vec3 Bsdf::max_f(const vec3& wo) const {
   if (kind_ == Kind::Delta) return vec3(0.0f);
   const float mu = brdf_.metallic;
   const vec3 diffuse = (1.0f - mu) / kPi * brdf_.base_color;  // 1 - max F <= 1
-  if (smooth_) return reflect_ * diffuse;
+  if (smooth_ || part_ == Part::Base) return reflect_ * diffuse;
   const float zo = std::max(std::fabs(glm::dot(wo, ns_)), kMinCosine);
   const vec3 f0 = brdf_.dielectric_f0();
   const float f90 = brdf_.dielectric_f90();
@@ -193,7 +198,7 @@ vec3 Bsdf::max_f(const vec3& wo) const {
     return (1.0f - mu) * max_component(f0 + (vec3(f90) - f0) * w) +
            mu * max_component(schlick_fresnel(brdf_.base_color, v_h));
   });
-  return reflect_ * (diffuse + vec3(spec));
+  return reflect_ * ((part_ == Part::Lobe ? vec3(0.0f) : diffuse) + vec3(spec));
 }
 
 float Bsdf::pdf(const vec3& wo, const vec3& wi) const {
@@ -205,7 +210,7 @@ float Bsdf::pdf(const vec3& wo, const vec3& wi) const {
   const Frame f(ns);
   float p = 0.0f;
   eval_local(f.local(wo), f.local(wi), &p);
-  return has_delta_ ? (1.0f - delta_probability(wo)) * p : p;
+  return has_delta_ && part_ == Part::All ? (1.0f - delta_probability(wo)) * p : p;
 }
 
 float Bsdf::non_delta_albedo(float cos_o) const {
@@ -214,8 +219,8 @@ float Bsdf::non_delta_albedo(float cos_o) const {
   // keeps the part's probability above 0 wherever it may reflect.
   const float mu = brdf_.metallic, f0 = max_component(brdf_.dielectric_f0());
   const float diffuse = (1.0f - mu) * (1.0f - f0) * max_component(brdf_.base_color);
-  float a = diffuse;
-  if (!smooth_)
+  float a = part_ == Part::Lobe ? 0.0f : diffuse;
+  if (!smooth_ && part_ != Part::Base)
     a += (1.0f - mu) * (f0 + (brdf_.dielectric_f90() - f0) * schlick_weight(cos_o)) +
          mu * max_component(schlick_fresnel(brdf_.base_color, cos_o));
   return reflect_ * std::max(a, 0.01f);
@@ -249,6 +254,7 @@ bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) con
     return true;
   }
   if (kind_ == Kind::Delta) return sample_delta(wo, rng, mode, out);
+  if (part_ != Part::All) return sample_non_delta(wo, rng, out);  // one term, no delta part
   const float pd = delta_probability(wo);
   if (pd > 0.0f) {
     const float u = rng.next_float();  // which part, then that part's numbers
@@ -270,7 +276,15 @@ bool Bsdf::sample_non_delta(const vec3& wo, Rng& rng, BsdfSample& out) const {
   const Frame f(front ? ns_ : -ns_);
   const vec3 wo_l = f.local(wo);
   if (wo_l.z <= 0.0f) return false;  // seen from below the shading hemisphere
-  if (!smooth_) {
+  if (part_ == Part::Lobe) {
+    const float u1 = rng.next_float(), u2 = rng.next_float();
+    vec3 wi_l, w;
+    float p = 0.0f;
+    if (!brdf_.sample_specular(wo_l, u1, u2, wi_l, w, p)) return false;
+    out.wi = f.world(wi_l);
+    out.weight = reflect_ * w;
+    out.pdf = p;
+  } else if (!smooth_ && part_ == Part::All) {
     const float u_lobe = rng.next_float(), u1 = rng.next_float(), u2 = rng.next_float();
     vec3 wi_l, w;
     float p = 0.0f;
@@ -360,6 +374,29 @@ int Bsdf::delta_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) 
   const float scale = mode == Transport::Radiance ? 1.0f / (eta * eta) : 1.0f;
   out[1] = {wt, glass_ * brdf_.base_color * ((1.0f - f) * scale)};
   return 2;
+}
+
+bool Bsdf::has_lobe_below(float below) const {
+  if (kind_ != Kind::Layered || smooth_ || part_ != Part::All || !(brdf_.roughness < below))
+    return false;
+  return brdf_.metallic > 0.0f || brdf_.specular > 0.0f;
+}
+
+float Bsdf::lobe_probability(const vec3& wo) const {
+  // specular_probability reads only the cosine of wo with the shading normal.
+  return brdf_.specular_probability(vec3(0.0f, 0.0f, std::fabs(glm::dot(wo, ns_))));
+}
+
+Bsdf Bsdf::base_part() const {
+  Bsdf b = *this;
+  b.part_ = Part::Base;
+  return b;
+}
+
+Bsdf Bsdf::lobe_part() const {
+  Bsdf b = *this;
+  b.part_ = Part::Lobe;
+  return b;
 }
 
 }  // namespace pb

@@ -1,6 +1,7 @@
 #include "photonbound/camera_paths.h"
 
 #include "photonbound/bsdf.h"
+#include "photonbound/pass_stages.h"
 #include "photonbound/rng.h"
 
 namespace pb {
@@ -21,19 +22,23 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first,
     vec3 weight(1.0f);
     dvec3 emission(0.0);
     MeasurementPoint point;  // f = 0: none
+    // The ray leaves a followed GGX lobe: the light it finds directly (an emitter, the
+    // environment) is that vertex's direct light, which its next-event sample has counted.
+    bool after_lobe = false;
     for (int depth = 0;; ++depth) {
       Hit hit;
       const bool found = depth == 0 ? in.world.accel().intersect(origin, dir, 0.0f, INFINITY, hit)
                                     : in.world.trace(origin, origin_normal, origin_error, dir, hit);
       if (!found) {  // the environment (black without one), seen along the path
-        emission += dvec3(weight * in.world.lights().environment_radiance(dir));
+        if (!after_lobe) emission += dvec3(weight * in.world.lights().environment_radiance(dir));
         break;
       }
       const Surface s = in.world.surface(hit);
       const vec3 wo = -dir;
       const bool front = glm::dot(wo, s.ng) > 0.0f;
       weight *= in.world.transmittance(s, wo, origin);  // inside an absorbing volume
-      if (s.material->emits()) emission += dvec3(weight * in.world.emitted(s, wo));
+      if (s.material->emits() && !after_lobe) emission += dvec3(weight * in.world.emitted(s, wo));
+      after_lobe = false;
       // Stop here (the non-delta part) or follow a delta branch: 1 - p_delta and p_delta.
       const float p_delta = s.bsdf.delta_probability(wo);
       bool stop = p_delta < 1.0f;
@@ -42,17 +47,44 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first,
         stop = u >= p_delta;
       }
       if (stop) {
-        const vec3 w = p_delta > 0.0f ? weight / (1.0f - p_delta) : weight;
+        vec3 w = p_delta > 0.0f ? weight / (1.0f - p_delta) : weight;
         point.position = in.world.spawn(s, wo);  // lifted off the surface: shadow rays start here
         point.normal = front ? s.ng : -s.ng;
         point.shading = front ? s.ns : -s.ns;
-        const bool lambertian = s.bsdf.is_lambertian();
-        point.f = lambertian ? w * s.bsdf.diffuse_f() : w;
+        Bsdf bsdf = s.bsdf;
+        if (depth < in.max_depth && s.bsdf.has_lobe_below(in.follow_roughness)) {
+          // This vertex's direct light with its whole Bsdf (so the choice below adds no noise
+          // to it), then follow the GGX lobe with p_lobe or gather photons at the diffuse base
+          // with 1 - p_lobe, each divided by its probability (ESTIMATOR.md section 10).
+          const GlossyPoint whole{0, wo, s.bsdf};
+          point.f = w;
+          emission += direct_light(in.world, point, &whole, rng);
+          const float p_lobe = s.bsdf.lobe_probability(wo);
+          if (p_lobe >= 1.0f || (p_lobe > 0.0f && rng.next_float() < p_lobe)) {
+            const GlossyPoint lobe{0, wo, s.bsdf.lobe_part()};
+            weight = w / p_lobe;
+            point = MeasurementPoint{};  // no visible point here
+            BsdfSample b;
+            if (!lobe.bsdf.sample(wo, rng, Transport::Radiance, b)) break;
+            weight *= b.weight;
+            if (!(max_component(weight) > 0.0f)) break;
+            origin = s.position;
+            origin_normal = s.ng;
+            origin_error = s.error;
+            dir = b.wi;
+            after_lobe = true;
+            continue;
+          }
+          w /= 1.0f - p_lobe;
+          bsdf = s.bsdf.base_part();  // its direct light is counted: next_event_pass skips it
+        }
+        const bool lambertian = bsdf.is_lambertian();
+        point.f = lambertian ? w * bsdf.diffuse_f() : w;
         point.triangle = in.world.triangle_index(hit);
         if (!(max_component(point.f) > 0.0f)) {
           point.f = vec3(0.0f);
         } else if (!lambertian) {
-          glossy[glossy_count++] = {uint32_t(k), wo, s.bsdf};
+          glossy[glossy_count++] = {uint32_t(k), wo, bsdf};
         }
         break;
       }

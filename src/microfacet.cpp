@@ -123,9 +123,13 @@ float dielectric_f0(float ior) {
 
 namespace {
 
-// f(wo, wi) and, when pdf is given, the sampling density, sharing the half vector.
-vec3 eval_and_pdf(const MetalRoughBrdf& m, const vec3& wo, const vec3& wi, float* pdf) {
+// f(wo, wi) and, when pdf is given, the sampling density, sharing the half vector. With
+// `parts`, also the two terms f is the sum of: parts[0] the diffuse base, parts[1] the GGX
+// lobe (both layers' specular terms), each already weighted by (1 - metallic) and metallic.
+vec3 eval_and_pdf(const MetalRoughBrdf& m, const vec3& wo, const vec3& wi, float* pdf,
+                  vec3* parts = nullptr) {
   if (pdf) *pdf = 0.0f;
+  if (parts) parts[0] = parts[1] = vec3(0.0f);
   if (wo.z <= 0.0f || wi.z <= 0.0f) return vec3(0.0f);
   const float a = ggx_alpha(m.roughness);
   // Float addition commutes, so h, v.h (averaged over both directions) and V are the same for
@@ -147,6 +151,10 @@ vec3 eval_and_pdf(const MetalRoughBrdf& m, const vec3& wo, const vec3& wi, float
     const float spec_pdf = d / (2.0f * (wo.z + smith_root(wo, a)));
     *pdf = ps * spec_pdf + (1.0f - ps) * wi.z / kPi;
   }
+  if (parts) {
+    parts[0] = (1.0f - m.metallic) * ((1.0f - max_component(fr)) * m.base_color / kPi);
+    parts[1] = (1.0f - m.metallic) * (fr * specular) + m.metallic * metal;
+  }
   return (1.0f - m.metallic) * dielectric + m.metallic * metal;
 }
 
@@ -154,6 +162,31 @@ vec3 eval_and_pdf(const MetalRoughBrdf& m, const vec3& wo, const vec3& wi, float
 
 vec3 MetalRoughBrdf::eval(const vec3& wo, const vec3& wi) const {
   return eval_and_pdf(*this, wo, wi, nullptr);
+}
+
+vec3 MetalRoughBrdf::eval_diffuse(const vec3& wo, const vec3& wi) const {
+  vec3 parts[2];
+  eval_and_pdf(*this, wo, wi, nullptr, parts);
+  return parts[0];
+}
+
+vec3 MetalRoughBrdf::eval_specular(const vec3& wo, const vec3& wi) const {
+  vec3 parts[2];
+  eval_and_pdf(*this, wo, wi, nullptr, parts);
+  return parts[1];
+}
+
+bool MetalRoughBrdf::sample_specular(const vec3& wo, float u1, float u2, vec3& wi, vec3& weight,
+                                     float& pdf_out) const {
+  if (wo.z <= 0.0f) return false;
+  const float a = ggx_alpha(roughness);
+  const vec3 h = sample_ggx_vndf(wo, a, u1, u2);
+  wi = glm::normalize(2.0f * glm::dot(wo, h) * h - wo);
+  if (wi.z <= 0.0f) return false;
+  pdf_out = ggx_reflection_pdf(wo, wi, a);
+  if (!(pdf_out > 0.0f)) return false;
+  weight = eval_specular(wo, wi) * (wi.z / pdf_out);
+  return true;
 }
 
 float MetalRoughBrdf::pdf(const vec3& wo, const vec3& wi) const {

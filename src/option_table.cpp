@@ -141,6 +141,10 @@ std::vector<OptionSpec> make_table() {
                         "GGX lobes with a glTF roughness below R are rendered as perfect mirrors"),
                    &RenderOptions::mirror_roughness,
                    {kMinMirrorRoughness, 1, false, false, "", ""}));
+  t.push_back(real(base("--follow-roughness", "follow_roughness", "R", render, K::Image,
+                        "SPPM with next-event direct light: camera paths follow GGX lobes with a "
+                        "roughness below R, and gather photons at their diffuse base; 0: never"),
+                   &RenderOptions::follow_roughness, {0, 1, false, false, "", ""}));
   t.push_back(resolution());
   t.push_back(text(base("--camera", "camera", "NAME", render, K::Image,
                         "glTF camera name, \"camera N\" when unnamed"),

@@ -170,8 +170,10 @@ void next_event_pass(const World& world, std::span<const MeasurementPoint> point
   GlossyCursor cursor(glossy, points.size());
   for (size_t k = 0; k < points.size(); ++k) {
     if (!(max_component(points[k].f) > 0.0f)) continue;
+    const GlossyPoint* g = cursor.at(k);
+    if (g && g->bsdf.is_base_part()) continue;  // its camera path counted its direct light
     Rng rng(seed, pass, first + k, Stream::DirectLight);
-    out[k].direct += direct_light(world, points[k], cursor.at(k), rng);
+    out[k].direct += direct_light(world, points[k], g, rng);
   }
 }
 

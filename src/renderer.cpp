@@ -148,7 +148,9 @@ void Renderer::step(std::vector<PointState>* copy) {
   if (options_.method == Method::PPM) {
     gather_and_fold(in, eye_.points, states_, radii_, sums_, out);
   } else {
-    const CameraPathInputs cam{world_, camera_, options_.max_depth, options_.seed, pass};
+    // A followed lobe's direct light is its next-event sample (camera_paths.h).
+    const float follow = nee ? float(options_.follow_roughness) : 0.0f;
+    const CameraPathInputs cam{world_, camera_, options_.max_depth, follow, options_.seed, pass};
     sppm_gather_and_fold(in, cam, states_, radii_, visible_, min_mass_, glossy_f_, visible_points_,
                          visible_glossy_, sums_, out);
   }

@@ -56,15 +56,22 @@ auto integrate_hemisphere(double b, int nphi, Fn&& fn) {
 // Directional albedo of the BRDF at wo: the integral over wi of f(wo, wi) wi.z, computed over
 // the microfacet normals h (wi = reflect(wo, h), d omega_i = 4 (wo.h) d omega_h), so that the
 // specular peak is resolved at any roughness.
-inline dvec3 albedo(const MetalRoughBrdf& brdf, const vec3& wo, int nphi = 128) {
+// The same for any f(wo, wi) (returning vec3) whose peak is a GGX lobe of the given alpha.
+template <class Eval>
+dvec3 albedo_of(float alpha, const vec3& wo, Eval&& f, int nphi = 128) {
   const dvec3 o(wo);
-  return integrate_hemisphere(ggx_alpha(brdf.roughness), nphi, [&](const vec3& h) {
+  return integrate_hemisphere(alpha, nphi, [&](const vec3& h) {
     const double o_h = glm::dot(o, dvec3(h));
     if (o_h <= 0.0) return dvec3(0.0);
     const dvec3 wi = 2.0 * o_h * dvec3(h) - o;
     if (wi.z <= 0.0) return dvec3(0.0);
-    return dvec3(brdf.eval(wo, glm::normalize(vec3(wi)))) * (wi.z * 4.0 * o_h);
+    return dvec3(f(wo, glm::normalize(vec3(wi)))) * (wi.z * 4.0 * o_h);
   });
+}
+inline dvec3 albedo(const MetalRoughBrdf& brdf, const vec3& wo, int nphi = 128) {
+  return albedo_of(
+      ggx_alpha(brdf.roughness), wo, [&](const vec3& o, const vec3& i) { return brdf.eval(o, i); },
+      nphi);
 }
 
 // Unit direction at polar angle theta (radians) in the xz-plane, x >= 0.

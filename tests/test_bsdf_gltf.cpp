@@ -220,6 +220,18 @@ std::vector<Case> cases() {
           {"lambertian", params(vec3(0.5f), 0.0f, 1.0f, 0.0f, true, 0.0f)}};
 }
 
+// A continuous draw must agree with the density and value the BSDF reports
+// for the same direction: weight = f |cos| / pdf (pbrt-v4's sampling contract).
+void expect_sample_matches_eval(const Bsdf& bsdf, const vec3& wo, const BsdfSample& s,
+                                const vec3& ns, const char* name) {
+  const float pdf = bsdf.pdf(wo, s.wi);
+  const vec3 f = bsdf.eval(wo, s.wi);
+  const float cos = std::fabs(glm::dot(s.wi, ns));
+  EXPECT_NEAR(s.pdf, pdf, 2e-3f * pdf) << name;
+  for (int ch = 0; ch < 3; ++ch)
+    EXPECT_NEAR(s.weight[ch], f[ch] * cos / pdf, 2e-3f * s.weight[ch] + 1e-6f) << name;
+}
+
 TEST(GltfBsdf, SampleWeightIsEvalCosOverPdfAndDeltaDrawsAreBranches) {
   // Continuous draws: weight = eval |wi.ns| / pdf and pdf = pdf(wo, wi) (relative 2e-3: the
   // sampled direction is rounded through the shading frame); delta draws leave along a branch.
@@ -246,12 +258,7 @@ TEST(GltfBsdf, SampleWeightIsEvalCosOverPdfAndDeltaDrawsAreBranches) {
         ++delta;
         continue;
       }
-      const float pdf = bsdf.pdf(wo, s.wi);
-      const vec3 f = bsdf.eval(wo, s.wi);
-      const float cos = std::fabs(glm::dot(s.wi, ns));
-      EXPECT_NEAR(s.pdf, pdf, 2e-3f * pdf) << c.name;
-      for (int ch = 0; ch < 3; ++ch)
-        EXPECT_NEAR(s.weight[ch], f[ch] * cos / pdf, 2e-3f * s.weight[ch] + 1e-6f) << c.name;
+      expect_sample_matches_eval(bsdf, wo, s, ns, c.name);
       ++continuous;
     }
     EXPECT_GT(continuous, 1000) << c.name;
@@ -334,6 +341,95 @@ ChiSquare chi_square(const Bsdf& bsdf, const vec3& wo, const vec3& ns_wo, int n,
   return r;
 }
 
+// The mean red weight of n draws of sample() (absorbed draws 0) and its standard error.
+struct SampledAlbedo {
+  double mean, se;
+};
+SampledAlbedo sampled_albedo(const Bsdf& bsdf, const vec3& wo, Rng& rng, int n = 200000) {
+  double sum = 0.0, sum2 = 0.0;
+  for (int i = 0; i < n; ++i) {
+    BsdfSample s;
+    const double w = bsdf.sample(wo, rng, Transport::Radiance, s) ? double(s.weight.x) : 0.0;
+    sum += w;
+    sum2 += w * w;
+  }
+  const double mean = sum / n;
+  return {mean, std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n)};
+}
+
+TEST(GltfBsdf, BaseAndLobeSumToTheWholeAndEachSamplesItself) {
+  // SPPM's camera paths split a rough lobe off (camera_paths.h): base_part() + lobe_part() must
+  // be eval() (relative 1e-5: the two sums round differently), each part's max_f must bound it,
+  // and each part's sample() must draw from that part alone (weight = part eval cos / part pdf,
+  // never a delta branch; relative 2e-3 as above). Which cases have a lobe is fixed.
+  Rng rng(311, 0, 0, Stream::Test);
+  int with_lobe = 0;
+  for (const Case& c : cases()) {
+    const Bsdf probe(c.p, vec3(0, 0, 1), vec3(0, 0, 1));
+    const bool lobe = probe.has_lobe_below(1.0f);
+    EXPECT_EQ(lobe, c.p.roughness >= kDefaultMirrorRoughness &&
+                        !(c.p.metallic == 0.0f && c.p.specular == 0.0f))
+        << c.name;
+    EXPECT_FALSE(probe.has_lobe_below(c.p.roughness)) << c.name;  // strictly below
+    if (!lobe) continue;
+    ++with_lobe;
+    int drawn[2] = {0, 0};
+    for (int k = 0; k < 4000; ++k) {
+      vec3 ng, ns;
+      random_normals(rng, ng, ns);
+      const Bsdf bsdf(c.p, ng, ns);
+      const Bsdf parts[2] = {bsdf.base_part(), bsdf.lobe_part()};
+      const vec3 wo = random_unit(rng), wi = random_unit(rng);
+      const vec3 n = glm::dot(wo, ng) > 0.0f ? ns : -ns;
+      if (glm::dot(wo, n) < 0.02f) continue;
+      const vec3 whole = bsdf.eval(wo, wi), sum = parts[0].eval(wo, wi) + parts[1].eval(wo, wi);
+      for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(sum[ch], whole[ch], 1e-5f * whole[ch]) << c.name;
+      const float p_lobe = bsdf.lobe_probability(wo);
+      EXPECT_TRUE(p_lobe > 0.0f && p_lobe <= 1.0f) << c.name;
+      if (c.p.metallic == 1.0f) EXPECT_EQ(p_lobe, 1.0f) << c.name;  // no base to gather at
+      for (int part = 0; part < 2; ++part) {
+        const Bsdf& b = parts[part];
+        const vec3 bound = b.max_f(wo), value = b.eval(wo, wi);
+        for (int ch = 0; ch < 3; ++ch) EXPECT_LE(value[ch], bound[ch]) << c.name;
+        BsdfSample s;
+        if (!b.sample(wo, rng, Transport::Radiance, s)) continue;
+        ASSERT_FALSE(s.delta) << c.name;
+        expect_sample_matches_eval(b, wo, s, ns, c.name);
+        ++drawn[part];
+      }
+    }
+    if (c.p.metallic < 1.0f) EXPECT_GT(drawn[0], 1000) << c.name;
+    EXPECT_GT(drawn[1], 1000) << c.name;
+  }
+  EXPECT_EQ(with_lobe, 5);
+}
+
+TEST(GltfBsdf, LobeAlbedoByItsSamplerEqualsItsQuadrature) {
+  // The lobe alone (metal and dielectric layer): the mean weight of lobe_part().sample() (2e5
+  // draws, absorbed draws 0) equals the quadrature of MetalRoughBrdf::eval_specular within 4
+  // standard errors (+2e-4 quadrature), so following the lobe in a camera path reflects what
+  // the lobe reflects, no more, no less.
+  const vec3 ng = glm::normalize(vec3(0.2f, -0.3f, 1.0f));
+  const Basis f(ng);
+  for (const BsdfParams& p : {params(vec3(0.9f, 0.6f, 0.5f), 1.0f, 0.15f),
+                              params(vec3(0.6f), 0.0f, 0.3f), params(vec3(0.6f), 0.5f, 0.45f)}) {
+    const Bsdf lobe = Bsdf(p, ng, ng).lobe_part();
+    MetalRoughBrdf only = brdf_of(p);
+    for (double mu : {0.9, 0.5, 0.2}) {
+      const vec3 wo = f.world(std::acos(mu), 1.1);
+      const vec3 wo_l = quad::at_cos(mu);
+      const double quad =
+          quad::albedo_of(ggx_alpha(p.roughness), wo_l, [&](const vec3& o, const vec3& i) {
+            return only.eval_specular(o, i);
+          }).x;
+      Rng rng(312, uint64_t(p.roughness * 100), uint64_t(mu * 10), Stream::Test);
+      const auto [mean, se] = sampled_albedo(lobe, wo, rng);
+      EXPECT_NEAR(mean, quad, 4.0 * se + 2e-4) << "roughness " << p.roughness << " mu " << mu;
+      EXPECT_GT(quad, 0.01);
+    }
+  }
+}
+
 TEST(GltfBsdf, ChiSquareSampledDirectionsFollowThePdf) {
   // 4e5 draws per case from a fixed seed; the 7 cases x 2 geometries each must keep p > 1e-3
   // (all together a false alarm below 1.4%). Geometry: ng tilted, ns 0.25 rad from ng, wo at 30
@@ -370,15 +466,7 @@ TEST(GltfBsdf, WhiteFurnacePerRoughness) {
     for (double mu : {1.0, 0.7, 0.4, 0.2}) {
       const vec3 wo = f.world(std::acos(mu), 0.4);
       Rng rng(305, uint64_t(r * 100), uint64_t(mu * 10), Stream::Test);
-      double sum = 0.0, sum2 = 0.0;
-      const int n = 200000;
-      for (int i = 0; i < n; ++i) {
-        BsdfSample s;
-        const double w = bsdf.sample(wo, rng, Transport::Radiance, s) ? double(s.weight.x) : 0.0;
-        sum += w;
-        sum2 += w * w;
-      }
-      const double mean = sum / n, se = std::sqrt(std::max(0.0, sum2 / n - mean * mean) / n);
+      const auto [mean, se] = sampled_albedo(bsdf, wo, rng);
       const bool mirror = r < kDefaultMirrorRoughness;
       const double quad =
           mirror ? 1.0 : quad::albedo(brdf_of(params(vec3(1.0f), 1.0f, r)), quad::at_cos(mu)).x;

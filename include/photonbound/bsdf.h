@@ -124,8 +124,30 @@ class Bsdf {
   // eta = 1/ior) or straight through (thin-walled). Returns the count (0, 1 or 2).
   int delta_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) const;
 
+  // The split SPPM's camera paths make at a rough GGX lobe (camera_paths.h, ESTIMATOR.md
+  // section 10): the non-delta part is the diffuse base plus the lobe (MetalRoughBrdf's
+  // eval_diffuse and eval_specular), and a path may follow the lobe by sampling it and gather
+  // photons at the base alone.
+  // True when the non-delta part has a GGX lobe that is not a mirror, of roughness below
+  // `below`, that can reflect something (metal, or a dielectric layer with specular > 0).
+  bool has_lobe_below(float below) const;
+  // The probability of following the lobe instead of gathering at the base: the lobe's share
+  // of the two parts' albedo estimates (MetalRoughBrdf::specular_probability); 1 where the
+  // base is black (metal).
+  float lobe_probability(const vec3& wo) const;
+  // This Bsdf with its non-delta part restricted to the base (base_part) or the lobe
+  // (lobe_part): eval, max_f and pdf of that term alone, and sample() draws from it alone
+  // (never a delta branch; delta_branches() is unchanged).
+  // Only for a Bsdf with has_lobe_below(1) (any lobe).
+  Bsdf base_part() const;
+  Bsdf lobe_part() const;
+  // A visible point on base_part() is where a camera path chose not to follow the lobe after
+  // it had counted the vertex's direct light with the whole Bsdf: the next-event stage skips it.
+  bool is_base_part() const { return part_ == Part::Base; }
+
  private:
   enum class Kind : uint8_t { Lambertian, Layered, Delta };
+  enum class Part : uint8_t { All, Base, Lobe };
   // eval and pdf of the non-delta part in the shading frame of wo's side (both above it).
   vec3 eval_local(const vec3& wo, const vec3& wi, float* pdf) const;
   float non_delta_albedo(float cos_o) const;
@@ -135,6 +157,7 @@ class Bsdf {
   bool smooth_ = false;     // GGX lobes below the mirror roughness: delta branches
   bool has_delta_ = false;  // Layered with a delta part too
   bool thin_ = true;
+  Part part_ = Part::All;  // base_part() and lobe_part()
   // The reflecting parts as one MetalRoughBrdf whose metallic is m / (m + o), scaled by
   // reflect_ = m + o; the Lambertian kind keeps its reflectance in brdf_.base_color.
   MetalRoughBrdf brdf_;

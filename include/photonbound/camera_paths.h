@@ -4,7 +4,14 @@
 // along one branch, chosen in proportion to its throughput and divided by that probability;
 // the visible point is the first non-delta hit. Where a surface has both (a smooth coat over a
 // diffuse base) the path stops there with Bsdf::delta_probability's complement, and both
-// choices are divided by their probability.
+// choices are divided by their probability. At a GGX lobe of roughness below
+// follow_roughness (Bsdf::has_lobe_below) the path chooses, with Bsdf::lobe_probability, to
+// follow the lobe (one next-event sample there with the lobe's f, then a direction drawn from
+// the lobe; the emitters and environment the next ray finds directly are not counted again)
+// or to stop with the diffuse base alone: a sharp lobe gathers almost no photons in its cone,
+// so a visible point there has a noise and a sparse-photon bound (section 12) that fall
+// slowly, while the surfaces it reflects are seen through it as through a mirror (pbrt-v4's
+// SPPM follows glossy surfaces the same way).
 #pragma once
 
 #include "photonbound/camera.h"
@@ -20,7 +27,10 @@ namespace pb {
 struct CameraPathInputs {
   const World& world;
   const PinholeCamera& camera;
-  int max_depth = 8;  // delta bounces a path may take
+  int max_depth = 8;  // delta bounces (and followed lobes) a path may take
+  // GGX lobes below this roughness are followed (--follow-roughness); 0: none. Needs the
+  // next-event direct light, which counts the followed vertex's direct light.
+  float follow_roughness = 0.0f;
   uint64_t seed = 0, pass = 0;
 };
 

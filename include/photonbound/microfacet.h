@@ -120,6 +120,19 @@ struct MetalRoughBrdf {
   // contracts a*b + c*d into a fused multiply-add, which costs one rounding).
   vec3 eval(const vec3& wo, const vec3& wi) const;
 
+  // The two terms eval() is the sum of (up to float rounding): the diffuse base
+  // (1 - metallic) (1 - max F) base_color / pi, and the GGX lobe, (1 - metallic) F V D +
+  // metallic F_metal V D. SPPM's camera paths follow the lobe and gather at the base
+  // (camera_paths.h).
+  vec3 eval_diffuse(const vec3& wo, const vec3& wi) const;
+  vec3 eval_specular(const vec3& wo, const vec3& wi) const;
+  // The GGX lobe alone: wi = reflect(wo, h), h by its visible normals, pdf =
+  // ggx_reflection_pdf, weight = eval_specular(wo, wi) wi.z / pdf. False when wo.z <= 0 or wi
+  // falls below the surface. A failed draw counts as 0: weight divides by the density over the
+  // upper hemisphere, so E[weight g(wi)] = integral of f_lobe cos g for every g.
+  bool sample_specular(const vec3& wo, float u1, float u2, vec3& wi, vec3& weight,
+                       float& pdf) const;
+
   // Density per solid angle of wi that sample() draws from wo: the mixture
   // p_spec * ggx_reflection_pdf + (1 - p_spec) * wi.z / pi, p_spec = specular_probability(wo).
   // Zero unless wo.z > 0 and wi.z > 0. Its integral over the hemisphere is below 1 by the

@@ -45,6 +45,9 @@ struct RenderOptions {
   std::optional<double> radius;  // world units; default from the pixel footprint
   int max_depth = 8;
   double mirror_roughness = kDefaultMirrorRoughness;
+  // SPPM with next-event direct light: camera paths follow GGX lobes below this roughness
+  // (camera_paths.h); 0 gathers photons at every glossy surface.
+  double follow_roughness = 0.7;
   std::optional<int> width, height;
   std::string camera;  // empty = first perspective camera
   // The view (view.h): each replaces the camera's own, or the default view's when the file has

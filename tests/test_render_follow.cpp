@@ -1,0 +1,157 @@
+// SPPM's camera paths through rough GGX lobes (--follow-roughness, camera_paths.h): a followed
+// lobe must estimate the same image as photons gathered at the lobe, count its direct light
+// once, and turn the sparse-photon bound of a sharp lobe (ESTIMATOR.md section 12) into the
+// bound of the diffuse surfaces it reflects.
+#include "photonbound/renderer.h"
+
+#include "analytic.h"
+#include "render_fixture.h"
+#include "scene_builder.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+namespace pb {
+namespace {
+
+// A closed room [-1, 1]^3 seen from inside, walls of reflectance 0.6 (the left one reddish),
+// a floor of the given material, a point light and an emitting panel under the ceiling: the
+// floor reflects the lit walls and the panel.
+Scene room(const Material& floor, bool panel = true) {
+  test::SceneBuilder b;
+  const uint32_t wall = b.material(vec3(0.6f)), red = b.material(vec3(0.7f, 0.2f, 0.2f));
+  Material f = floor;
+  f.name = "floor";
+  b.scene.materials.push_back(f);
+  const uint32_t fl = uint32_t(b.scene.materials.size() - 1);
+  // quad(c, u, v): front side u x v, here toward the inside.
+  b.quad(vec3(0, -1, 0), vec3(0, 0, 1), vec3(1, 0, 0), fl);     // floor, +y
+  b.quad(vec3(0, 1, 0), vec3(1, 0, 0), vec3(0, 0, 1), wall);    // ceiling, -y
+  b.quad(vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, 0, 1), red);    // left, +x
+  b.quad(vec3(1, 0, 0), vec3(0, 0, 1), vec3(0, 1, 0), wall);    // right, -x
+  b.quad(vec3(0, 0, -1), vec3(1, 0, 0), vec3(0, 1, 0), wall);   // back, +z
+  b.quad(vec3(0, 0, 1), vec3(0, 1, 0), vec3(1, 0, 0), wall);    // front, -z
+  // An emitting panel just under the ceiling, facing down: the floor's lobe reflects it.
+  if (panel) {
+    const uint32_t lamp = b.material(vec3(0.0f), vec3(4.0f));
+    b.quad(vec3(-0.3f, 0.98f, -0.4f), vec3(0.25f, 0, 0), vec3(0, 0, 0.25f), lamp);
+  }
+  b.point_light(vec3(0.3f, 0.7f, -0.2f), vec3(2.0f));
+  b.camera(vec3(0, 0.2f, 0.95f), vec3(0, -1, -0.4f), 1.0f);
+  return b.scene;
+}
+
+RenderOptions sppm(double follow, uint64_t passes) {
+  RenderOptions o;
+  o.method = Method::SPPM;
+  o.width = o.height = 40;
+  o.passes = passes;
+  o.photons_per_pass = 20000;
+  o.follow_roughness = follow;
+  o.progress = ProgressMode::Never;
+  return o;
+}
+
+struct Result {
+  double mean = 0.0;       // over pixels and channels
+  double mean_bias = 0.0;  // the mean of the signed bias estimates, the same way
+  double mean_var = 0.0;   // variance of `mean` from the pixels' own variances
+  FilmSummary summary;
+  double max_bound = 0.0;
+};
+
+// Two estimates of one image: the difference of their bias-corrected image means over its
+// standard deviation. Each image mean's variance is the sum of its pixels' variances of the
+// mean times the correlated pixels K (FilmSummary): that is what the renderer predicts for it.
+double agreement_z(const Result& a, const Result& b) {
+  return ((a.mean - a.mean_bias) - (b.mean - b.mean_bias)) / std::sqrt(a.mean_var + b.mean_var);
+}
+
+Result render(const Scene& scene, const RenderOptions& o) {
+  Renderer r(scene, o);
+  test::run_to_stop(r);
+  FilmImage img;
+  Result out;
+  out.summary = r.develop(&img);
+  const double n = double(img.radiance.size());
+  for (float v : img.radiance) out.mean += v / n;
+  for (float v : img.bias) out.mean_bias += v / n;
+  for (float v : img.variance) out.mean_var += v / (n * n);
+  // Neighbouring pixels share photons: K of them move together (FilmSummary).
+  out.mean_var *= out.summary.correlated_pixels;
+  for (float v : img.bound) out.max_bound = std::max(out.max_bound, double(v));
+  return out;
+}
+
+TEST(FollowLobe, FollowedAndGatheredLobesEstimateTheSameImage) {
+  // A rough metal floor (roughness 0.45) and a glossy dielectric one (0.35), where photons
+  // gathered at the lobe still converge, rendered both ways after 96 passes: the two image
+  // means agree within 4 standard deviations of their difference (agreement_z). Measured z =
+  // -0.01 and -0.31. Counting the light a followed lobe's ray finds directly on top of its
+  // next-event sample (the panel's reflection twice) gave z = 37 and 5.7.
+  for (const Material& floor :
+       {Material::metal(vec3(0.9f, 0.8f, 0.6f), 0.45f), [] {
+          Material m = Material::metal(vec3(0.5f, 0.6f, 0.7f), 0.35f);
+          m.metallic = 0.0f;  // a glossy dielectric: the base is gathered, the lobe followed
+          return m;
+        }()}) {
+    const Scene scene = room(floor);
+    const Result gathered = render(scene, sppm(0.0, 96)), followed = render(scene, sppm(0.5, 96));
+    const double z = agreement_z(followed, gathered);
+    std::printf("metallic %.0f: image mean %.5f gathered, %.5f followed, sd of the difference "
+                "%.5f, z %.2f\n",
+                floor.metallic, gathered.mean, followed.mean,
+                std::sqrt(gathered.mean_var + followed.mean_var), z);
+    EXPECT_LT(std::fabs(z), 4.0) << "metallic " << floor.metallic;
+    EXPECT_EQ(followed.summary.unknown_pixels, 0u);
+  }
+}
+
+TEST(FollowLobe, ASharpLobeIsBoundedByWhatItReflects) {
+  // A polished metal floor (roughness 0.12, alpha 0.014: the lobe's peak f is about 20x a
+  // white Lambertian's at normal incidence, and far more toward grazing): gathered at the lobe,
+  // few of the photons in its disc arrive inside its cone and the bound falls slowly; followed,
+  // the floor's pixels see the lit walls through the lobe and take the walls' bound. Measured
+  // after 48 passes: mean bound 0.148 gathered, 0.030 followed (5.0x); the assertion asks for
+  // 3x, and for the same image as above (|z| < 4).
+  // Without the panel: its reflection in the lobe is next-event light through a peaked f
+  // either way (with the panel the ratio is 2.5x).
+  const Scene scene = room(Material::metal(vec3(0.4f, 0.5f, 0.6f), 0.12f), false);
+  const Result gathered = render(scene, sppm(0.0, 48)), followed = render(scene, sppm(0.5, 48));
+  std::printf("mean bound %.4g gathered, %.4g followed; image mean %.5f and %.5f, z %.2f\n",
+              gathered.summary.mean_bound, followed.summary.mean_bound, gathered.mean,
+              followed.mean, agreement_z(followed, gathered));
+  EXPECT_LT(3.0 * followed.summary.mean_bound, gathered.summary.mean_bound);
+  EXPECT_LT(std::fabs(agreement_z(followed, gathered)), 4.0);
+  EXPECT_EQ(followed.summary.unknown_pixels, 0u);
+}
+
+TEST(FollowLobe, GlossyPlaneUnderNextEventLightKeepsItsCoverage) {
+  // glossy_plane.gltf (roughness 0.4, metallic 0.5) under a point light with next-event direct
+  // light, against its exact answer analytic::glossy_plane: every pixel's path follows the lobe
+  // or stops at the base each pass, after the vertex's next-event sample with the whole Bsdf.
+  // Only direct light exists, so a wrong weight or a direct light counted at the base point as
+  // well shows as bias the bound does not cover (a first version that kept a Lambertian point
+  // where the lobe's draw failed had mean error 0.14 and 50% coverage 0.08 after 256 passes).
+  // Next-event bounds over-cover this scene with or without following (measured 0.80 / 0.99
+  // and 0.71 / 0.98 at 50% / 90% after 16 and 64 passes: the point light's sample has no
+  // noise), so the criterion is one-sided: at least nominal minus 3 points (4096 pixels).
+  RenderOptions o = test::quick_options("glossy_plane.gltf", 64, 64);
+  o.method = Method::SPPM;
+  o.direct = DirectMode::NextEvent;
+  o.follow_roughness = 0.5;
+  for (const auto& r : analytic::coverage_run("glossy", o, {16, 64}, {0.5, 0.9})) {
+    std::printf("%3llu passes, %.0f%%: coverage %.3f, mean error %.5f, mean bound %.5f\n",
+                (unsigned long long)r.passes, 100.0 * r.confidence, r.accuracy.coverage,
+                r.accuracy.mean_abs_error, r.accuracy.mean_bound);
+    EXPECT_GE(r.accuracy.coverage, r.confidence - 0.03)
+        << "after " << r.passes << " passes at " << r.confidence;
+    EXPECT_LT(r.accuracy.mean_abs_error, 0.01) << "after " << r.passes;  // measured 0.0067, 0.0033
+    EXPECT_GT(r.accuracy.samples, 4000u);
+  }
+}
+
+}  // namespace
+}  // namespace pb
