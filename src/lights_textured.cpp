@@ -45,6 +45,19 @@ void Lights::add_textured(const Mesh& mesh, const Material& mat, uint32_t tri,
                           double(im.width) * double(im.height);
     if (std::isfinite(texels))
       n = int(std::clamp(std::ceil(2.0 * std::sqrt(texels)), 1.0, double(kMaxSplit)));
+    // A triangle whose texels are all black emits nowhere: one bound over its texture box
+    // spares cutting it into n^2 dark pieces (most triangles of a model whose emissive map
+    // lights a few details, such as glTF's DamagedHelmet). Read only when that box is not
+    // much larger than the texels the pieces would read: a sliver across the image would
+    // read all of it.
+    if (coloured) {
+      const vec2 lo = glm::min(s0, glm::min(s1, s2)), hi = glm::max(s0, glm::max(s1, s2));
+      const double box =
+          (double(hi.x - lo.x) * im.width + 2.0) * (double(hi.y - lo.y) * im.height + 2.0);
+      if (std::isfinite(texels) && box <= 16.0 * texels + 64.0 &&
+          max_texel(im, ref, lo, hi, true) == 0.0f)
+        return;
+    }
   }
   const float step = 1.0f / float(n);
   // Piece with vertex 0 at barycentrics b0 and edges d1, d2 (as oriented as the triangle).
@@ -54,6 +67,17 @@ void Lights::add_textured(const Mesh& mesh, const Material& mat, uint32_t tri,
     t.e1 = d1.x * whole.e1 + d1.y * whole.e2;
     t.e2 = d2.x * whole.e1 + d2.y * whole.e2;
     t.area = whole.area / float(n * n);
+    // A bound that is positive wherever the piece may emit: its brightest texel (filters
+    // included), or the factor when the texture only cuts out. Where it is 0 the piece never
+    // emits, and its mean below is not worth the lookups.
+    float bound = max_component(mat.emission);
+    if (coloured) {
+      const vec2 p[3] = {st_at(b0), st_at(b0 + d1), st_at(b0 + d2)};
+      const vec2 lo = glm::min(p[0], glm::min(p[1], p[2]));
+      const vec2 hi = glm::max(p[0], glm::max(p[1], p[2]));
+      bound *= max_texel(images_[size_t(ref.image)], ref, lo, hi, true);
+      if (!(bound > 0.0f)) return;
+    }
     t.source = int32_t(sources_.size());
     sources_.push_back({&mesh, &mat, tri, b0, d1, d2});
     // Mean radiance: the midpoint rule on the piece's four halves (centroids below).
@@ -61,15 +85,6 @@ void Lights::add_textured(const Mesh& mesh, const Material& mat, uint32_t tri,
         {1 / 6.0f, 1 / 6.0f}, {2 / 3.0f, 1 / 6.0f}, {1 / 6.0f, 2 / 3.0f}, {1 / 3.0f, 1 / 3.0f}};
     vec3 mean(0.0f);
     for (const vec2& m : mid) mean += 0.25f * radiance_at(t, m.x, m.y);
-    // A bound that is positive wherever the piece may emit: its brightest texel (filters
-    // included), or the factor when the texture only cuts out.
-    float bound = max_component(mat.emission);
-    if (coloured) {
-      const vec2 p[3] = {st_at(b0), st_at(b0 + d1), st_at(b0 + d2)};
-      const vec2 lo = glm::min(p[0], glm::min(p[1], p[2]));
-      const vec2 hi = glm::max(p[0], glm::max(p[1], p[2]));
-      bound *= max_texel(images_[size_t(ref.image)], ref, lo, hi, true);
-    }
     t.radiance = mean;
     t.select = std::max(average(mean), 0.1f * bound);
     t.peak = bound;

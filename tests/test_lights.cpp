@@ -150,6 +150,52 @@ TEST(TexturedEmitter, PhotonPowerIsTheIntegralOfTheTexturedRadiance) {
   }
 }
 
+TEST(TexturedEmitter, DarkTrianglesAreSkippedButNoneABrightTexelReaches) {
+  // A 1 x 1 m grid of 8 x 8 quads (128 triangles) under a 16 x 16 texture, black but for texel
+  // (7, 8), bilinear: its hat spans +-1 texel about its centre (7.5/16, 8.5/16), across the
+  // grid lines s = t = 1/2, so 8 triangles see it, some only through the filter's reach and
+  // the rest not at all (skipped whole). The hat integrates to 1/256 of the square, so the
+  // power is pi x 3 / 256 per channel (to 2%, the pieces' midpoint rule); a triangle dropped
+  // while the filter still reads the texel loses at least 1/8 of it. The photons' mean flux
+  // agrees (4 standard errors), and a photon carries flux only from inside the hat.
+  Image im{"dot", 16, 16, 3, std::vector<uint8_t>(16 * 16 * 3, 0), {}};
+  for (int k = 0; k < 3; ++k) im.u8[size_t((8 * 16 + 7) * 3 + k)] = 255;
+  Material mat = Material::lambertian(vec3(0.0f));
+  mat.emission = vec3(3.0f);
+  mat.emissive_texture.image = 0;
+  Scene scene;
+  Mesh m;
+  const int n = 8;
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const float x = float(i) / n, y = float(j) / n;
+      m.positions.push_back(vec3(x, 1.0f - y, 0.0f));  // v = t down the image, y up
+      m.texcoords[0].push_back(vec2(x, y));
+    }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const uint32_t a = uint32_t(j * (n + 1) + i), b = a + 1, c = a + uint32_t(n + 1), d = c + 1;
+      m.indices.insert(m.indices.end(), {a, c, b, b, c, d});  // counter-clockwise from +z
+    }
+  scene.meshes.push_back(m);
+  scene.materials.push_back(mat);
+  scene.images = {im};
+  const Lights lights(scene);
+  const double want = kPiD * 3.0 / 256.0;
+  Mean flux;
+  for (int i = 0; i < 200000; ++i) {
+    Rng rng(13, 0, uint64_t(i), Stream::Test);
+    const EmittedPhoton p = lights.sample_photon(rng);
+    ASSERT_GT(glm::dot(p.dir, vec3(0, 0, 1)), 0.0f);
+    const bool in = std::fabs(p.origin.x - 7.5f / 16) < 1.0f / 16 &&
+                    std::fabs((1.0f - p.origin.y) - 8.5f / 16) < 1.0f / 16;
+    if (!in) EXPECT_EQ(p.flux, vec3(0.0f)) << p.origin.x << " " << p.origin.y;
+    flux.add(p.flux.x);
+  }
+  EXPECT_NEAR(flux.mean(), want, 4.0 * flux.se());
+  for (int c = 0; c < 3; ++c) EXPECT_NEAR(lights.total_power()[c], want, 0.02 * want) << c;
+}
+
 TEST(TexturedEmitter, PhotonsLeaveWhereTheTextureIsBright) {
   // An 8 x 1 texture, bright in its first two texels (u < 1/4) and black elsewhere, NEAREST:
   // uniform sampling would start 25% of the photons in the bright quarter; choosing pieces by

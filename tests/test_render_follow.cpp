@@ -27,12 +27,12 @@ Scene room(const Material& floor, bool panel = true) {
   b.scene.materials.push_back(f);
   const uint32_t fl = uint32_t(b.scene.materials.size() - 1);
   // quad(c, u, v): front side u x v, here toward the inside.
-  b.quad(vec3(0, -1, 0), vec3(0, 0, 1), vec3(1, 0, 0), fl);     // floor, +y
-  b.quad(vec3(0, 1, 0), vec3(1, 0, 0), vec3(0, 0, 1), wall);    // ceiling, -y
-  b.quad(vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, 0, 1), red);    // left, +x
-  b.quad(vec3(1, 0, 0), vec3(0, 0, 1), vec3(0, 1, 0), wall);    // right, -x
-  b.quad(vec3(0, 0, -1), vec3(1, 0, 0), vec3(0, 1, 0), wall);   // back, +z
-  b.quad(vec3(0, 0, 1), vec3(0, 1, 0), vec3(1, 0, 0), wall);    // front, -z
+  b.quad(vec3(0, -1, 0), vec3(0, 0, 1), vec3(1, 0, 0), fl);    // floor, +y
+  b.quad(vec3(0, 1, 0), vec3(1, 0, 0), vec3(0, 0, 1), wall);   // ceiling, -y
+  b.quad(vec3(-1, 0, 0), vec3(0, 1, 0), vec3(0, 0, 1), red);   // left, +x
+  b.quad(vec3(1, 0, 0), vec3(0, 0, 1), vec3(0, 1, 0), wall);   // right, -x
+  b.quad(vec3(0, 0, -1), vec3(1, 0, 0), vec3(0, 1, 0), wall);  // back, +z
+  b.quad(vec3(0, 0, 1), vec3(0, 1, 0), vec3(1, 0, 0), wall);   // front, -z
   // An emitting panel just under the ceiling, facing down: the floor's lobe reflects it.
   if (panel) {
     const uint32_t lamp = b.material(vec3(0.0f), vec3(4.0f));
@@ -100,10 +100,11 @@ TEST(FollowLobe, FollowedAndGatheredLobesEstimateTheSameImage) {
     const Scene scene = room(floor);
     const Result gathered = render(scene, sppm(0.0, 96)), followed = render(scene, sppm(0.5, 96));
     const double z = agreement_z(followed, gathered);
-    std::printf("metallic %.0f: image mean %.5f gathered, %.5f followed, sd of the difference "
-                "%.5f, z %.2f\n",
-                floor.metallic, gathered.mean, followed.mean,
-                std::sqrt(gathered.mean_var + followed.mean_var), z);
+    std::printf(
+        "metallic %.0f: image mean %.5f gathered, %.5f followed, sd of the difference "
+        "%.5f, z %.2f\n",
+        floor.metallic, gathered.mean, followed.mean,
+        std::sqrt(gathered.mean_var + followed.mean_var), z);
     EXPECT_LT(std::fabs(z), 4.0) << "metallic " << floor.metallic;
     EXPECT_EQ(followed.summary.unknown_pixels, 0u);
   }
