@@ -47,7 +47,7 @@ struct RenderOptions {
   double mirror_roughness = kDefaultMirrorRoughness;
   // SPPM with next-event direct light: camera paths follow GGX lobes below this roughness
   // (camera_paths.h); 0 gathers photons at every glossy surface.
-  double follow_roughness = 0.7;
+  double follow_roughness = 0.0;
   std::optional<int> width, height;
   std::string camera;  // empty = first perspective camera
   // The view (view.h): each replaces the camera's own, or the default view's when the file has
