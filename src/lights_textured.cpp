@@ -36,6 +36,11 @@ void Lights::add_textured(const Mesh& mesh, const Material& mat, uint32_t tri,
     const vec2 uv[2] = {mesh_uv(mesh, tri, 0, b.x, b.y), mesh_uv(mesh, tri, 1, b.x, b.y)};
     return texture_coords(ref, uv);
   };
+  // The brightest texel a lookup inside the texture-space triangle (p0, p1, p2) may read.
+  auto brightest = [&](vec2 p0, vec2 p1, vec2 p2) {
+    const vec2 lo = glm::min(p0, glm::min(p1, p2)), hi = glm::max(p0, glm::max(p1, p2));
+    return max_texel(images_[size_t(ref.image)], ref, lo, hi, true);
+  };
   int n = 1;
   if (ref.present()) {
     const Image& im = images_[size_t(ref.image)];
@@ -54,8 +59,7 @@ void Lights::add_textured(const Mesh& mesh, const Material& mat, uint32_t tri,
       const vec2 lo = glm::min(s0, glm::min(s1, s2)), hi = glm::max(s0, glm::max(s1, s2));
       const double box =
           (double(hi.x - lo.x) * im.width + 2.0) * (double(hi.y - lo.y) * im.height + 2.0);
-      if (std::isfinite(texels) && box <= 16.0 * texels + 64.0 &&
-          max_texel(im, ref, lo, hi, true) == 0.0f)
+      if (std::isfinite(texels) && box <= 16.0 * texels + 64.0 && brightest(s0, s1, s2) == 0.0f)
         return;
     }
   }
@@ -72,10 +76,7 @@ void Lights::add_textured(const Mesh& mesh, const Material& mat, uint32_t tri,
     // emits, and its mean below is not worth the lookups.
     float bound = max_component(mat.emission);
     if (coloured) {
-      const vec2 p[3] = {st_at(b0), st_at(b0 + d1), st_at(b0 + d2)};
-      const vec2 lo = glm::min(p[0], glm::min(p[1], p[2]));
-      const vec2 hi = glm::max(p[0], glm::max(p[1], p[2]));
-      bound *= max_texel(images_[size_t(ref.image)], ref, lo, hi, true);
+      bound *= brightest(st_at(b0), st_at(b0 + d1), st_at(b0 + d2));
       if (!(bound > 0.0f)) return;
     }
     t.source = int32_t(sources_.size());

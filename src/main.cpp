@@ -85,6 +85,10 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
     std::cerr << "photonbound: warning: --alpha " << options.alpha
               << " is at or below 2/3: the Laplacian (bias) estimate does not converge and the "
                  "error bounds are unreliable\n";
+  if (options.follow_roughness > 0.0 &&
+      (options.method == pb::Method::PPM || options.direct != pb::DirectMode::NextEvent))
+    std::cerr << "photonbound: warning: --follow-roughness does nothing here: it needs "
+                 "--method sppm with next-event direct light\n";
   pb::ThreadLimit threads(options.threads);
   pb::Renderer renderer(std::move(scene), options);
   if (saved) renderer.restore(saved->render);
