@@ -270,6 +270,12 @@ bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) con
   return true;
 }
 
+bool Bsdf::sample_non_delta_part(const vec3& wo, Rng& rng, BsdfSample& out) const {
+  if (kind_ == Kind::Lambertian) return sample(wo, rng, Transport::Radiance, out);
+  if (kind_ == Kind::Delta) return false;
+  return sample_non_delta(wo, rng, out);
+}
+
 bool Bsdf::sample_non_delta(const vec3& wo, Rng& rng, BsdfSample& out) const {
   const bool front = glm::dot(wo, ng_) > 0.0f;
   const vec3 ng = front ? ng_ : -ng_;

@@ -7,8 +7,8 @@
 namespace pb {
 
 size_t trace_visible_points(const CameraPathInputs& in, size_t first,
-                            std::span<MeasurementPoint> points, std::span<GlossyPoint> glossy,
-                            std::span<PassGather> out) {
+                            std::span<const float> radii, std::span<MeasurementPoint> points,
+                            std::span<GlossyPoint> glossy, std::span<PassGather> out) {
   const int width = in.camera.width();
   size_t glossy_count = 0;
   for (size_t k = 0; k < points.size(); ++k) {
@@ -22,6 +22,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first,
     vec3 weight(1.0f);
     dvec3 emission(0.0);
     MeasurementPoint point;  // f = 0: none
+    DiscMoments disc;
     // The ray leaves a followed GGX lobe: the light it finds directly (an emitter, the
     // environment) is that vertex's direct light, which its next-event sample has counted.
     bool after_lobe = false;
@@ -52,6 +53,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first,
         point.normal = front ? s.ng : -s.ng;
         point.shading = front ? s.ns : -s.ns;
         Bsdf bsdf = s.bsdf;
+        bool direct_counted = false;  // this vertex's next-event sample is taken
         if (depth < in.max_depth && s.bsdf.has_lobe_below(in.follow_roughness)) {
           // This vertex's direct light with its whole Bsdf (so the choice below adds no noise
           // to it), then follow the GGX lobe with p_lobe or gather photons at the diffuse base
@@ -77,12 +79,40 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first,
           }
           w /= 1.0f - p_lobe;
           bsdf = s.bsdf.base_part();  // its direct light is counted: next_event_pass skips it
+          direct_counted = true;
+        }
+        point.triangle = in.world.triangle_index(hit);
+        if (in.boundary) {
+          disc = in.boundary->moments(point.triangle, point.position, point.normal, radii[k]);
+          if (disc.mass < kValidKernelMass && depth < in.max_depth) {
+            // Almost all of the disc is off reachable surface: photons cannot estimate the
+            // radiance here (ESTIMATOR.md section 11), but a path can. L = L_direct +
+            // integral of f L cos over the non-delta part, by one next-event sample and one
+            // direction from that part, and the photons gathered where it lands.
+            if (in.next_event && !direct_counted) {
+              const GlossyPoint here{0, wo, bsdf};
+              point.f = w;
+              emission += direct_light(in.world, point, &here, rng);
+            }
+            point = MeasurementPoint{};
+            disc = DiscMoments{};
+            BsdfSample b;
+            if (!bsdf.sample_non_delta_part(wo, rng, b)) break;
+            weight = w * b.weight;
+            if (!(max_component(weight) > 0.0f)) break;
+            origin = s.position;
+            origin_normal = s.ng;
+            origin_error = s.error;
+            dir = b.wi;
+            after_lobe = in.next_event;  // the next-event sample counted what it finds directly
+            continue;
+          }
         }
         const bool lambertian = bsdf.is_lambertian();
         point.f = lambertian ? w * bsdf.diffuse_f() : w;
-        point.triangle = in.world.triangle_index(hit);
         if (!(max_component(point.f) > 0.0f)) {
           point.f = vec3(0.0f);
+          disc = DiscMoments{};  // no visible point: the whole disc, as gather_pass leaves it
         } else if (!lambertian) {
           glossy[glossy_count++] = {uint32_t(k), wo, bsdf};
         }
@@ -101,6 +131,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first,
     points[k] = point;
     out[k] = PassGather{};
     out[k].direct = emission;
+    out[k].disc = disc;
   }
   return glossy_count;
 }

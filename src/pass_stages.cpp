@@ -230,10 +230,12 @@ void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
       const std::span<MeasurementPoint> pts = points.subspan(b, e - b);
       const std::span<PassGather> out = sums.subspan(b, e - b);
       const std::span<GlossyPoint> scratch = glossy.subspan(b, e - b);
-      const size_t n_glossy = trace_visible_points(camera, first + b, pts, scratch, out);
+      const std::span<const float> r = std::span<const float>(radii).subspan(first + b, e - b);
+      const size_t n_glossy = trace_visible_points(camera, first + b, r, pts, scratch, out);
       const GlossyTable table{scratch.first(n_glossy), 0};  // indices into pts
+      // The camera paths left each visible point's disc moments in out (boundary null here).
       gather_pass(pts, std::span<const PointState>(states).subspan(first + b, e - b), in.grid,
-                  in.hits, in.boundary, table, out);
+                  in.hits, nullptr, table, out);
       if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, first + b, out);
       for (size_t k = 0; k < pts.size(); ++k) {
         if (!(max_component(pts[k].f) > 0.0f)) continue;

@@ -115,6 +115,10 @@ class Bsdf {
   // otherwise in proportion to estimates of the two parts' albedos (photon weights: the same
   // for either transport direction).
   float delta_probability(const vec3& wo) const;
+  // A direction from the non-delta part alone, the part a visible point here gathers with
+  // (weight f |cos| / pdf of that part, radiance transport); false for a delta-only Bsdf. A
+  // camera path that cannot gather here continues with it (camera_paths.h).
+  bool sample_non_delta_part(const vec3& wo, Rng& rng, BsdfSample& out) const;
   // One delta branch, chosen in proportion to the branches' average weights (weight divided by
   // that probability); draws one number when there are two branches.
   bool sample_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const;

@@ -11,9 +11,14 @@
 // or to stop with the diffuse base alone: a sharp lobe gathers almost no photons in its cone,
 // so a visible point there has a noise and a sparse-photon bound (section 12) that fall
 // slowly, while the surfaces it reflects are seen through it as through a mirror (pbrt-v4's
-// SPPM follows glossy surfaces the same way).
+// SPPM follows glossy surfaces the same way). A visible point whose kernel disc lies almost
+// wholly off reachable surface (mass below kValidKernelMass, ESTIMATOR.md section 11: a crevice,
+// or a surface far smaller than the radius) has no sound photon estimate, so the path does not
+// stop there: it takes the vertex's direct light and continues with one direction drawn from
+// the non-delta part, as a path tracer would, and gathers at the next surface instead.
 #pragma once
 
+#include "photonbound/boundary.h"
 #include "photonbound/camera.h"
 #include "photonbound/estimator.h"
 #include "photonbound/eye_pass.h"
@@ -32,6 +37,11 @@ struct CameraPathInputs {
   // next-event direct light, which counts the followed vertex's direct light.
   float follow_roughness = 0.0f;
   uint64_t seed = 0, pass = 0;
+  // The next-event stage counts the visible points' direct light (--direct next-event): a
+  // path continuing past a point with an invalid disc takes that point's sample itself.
+  bool next_event = true;
+  // Where surfaces end for the gather; null: every disc is whole (no vertex is passed over).
+  const BoundaryIndex* boundary = nullptr;
 };
 
 // For pixels [first, first + points.size()) in row-major order: points[k] = pixel first + k's
@@ -39,9 +49,11 @@ struct CameraPathInputs {
 // without one: background, an emitter or a black surface, or the depth limit), and out[k] = a
 // fresh pass sum whose direct part holds the emission the path saw on its way. A visible point
 // on a non-Lambertian surface keeps the throughput alone in f, and its GlossyPoint (point = k)
-// goes to the front of `glossy` (room for points.size()), in pixel order. Returns their count.
+// goes to the front of `glossy` (room for points.size()), in pixel order. radii[k] is pixel
+// first + k's search radius this pass; out[k].disc its visible point's disc moments. Returns
+// the count of glossy points.
 size_t trace_visible_points(const CameraPathInputs& in, size_t first,
-                            std::span<MeasurementPoint> points, std::span<GlossyPoint> glossy,
-                            std::span<PassGather> out);
+                            std::span<const float> radii, std::span<MeasurementPoint> points,
+                            std::span<GlossyPoint> glossy, std::span<PassGather> out);
 
 }  // namespace pb
