@@ -6,9 +6,9 @@
 
 namespace pb {
 
-size_t trace_visible_points(const CameraPathInputs& in, size_t first,
-                            std::span<const float> radii, std::span<MeasurementPoint> points,
-                            std::span<GlossyPoint> glossy, std::span<PassGather> out) {
+size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
+                            std::span<MeasurementPoint> points, std::span<GlossyPoint> glossy,
+                            std::span<PassGather> out) {
   const int width = in.camera.width();
   size_t glossy_count = 0;
   for (size_t k = 0; k < points.size(); ++k) {
@@ -81,14 +81,20 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first,
           bsdf = s.bsdf.base_part();  // its direct light is counted: next_event_pass skips it
           direct_counted = true;
         }
+        const bool lambertian = bsdf.is_lambertian();
+        point.f = lambertian ? w * bsdf.diffuse_f() : w;
         point.triangle = in.world.triangle_index(hit);
+        if (!(max_component(point.f) > 0.0f)) {
+          point.f = vec3(0.0f);  // a black surface (or a path weight of 0): no visible point
+          break;
+        }
         if (in.boundary) {
           disc = in.boundary->moments(point.triangle, point.position, point.normal, radii[k]);
           if (disc.mass < kValidKernelMass && depth < in.max_depth) {
             // Almost all of the disc is off reachable surface: photons cannot estimate the
-            // radiance here (ESTIMATOR.md section 11), but a path can. L = L_direct +
-            // integral of f L cos over the non-delta part, by one next-event sample and one
-            // direction from that part, and the photons gathered where it lands.
+            // radiance here (ESTIMATOR.md section 10, "Passing over"), but a path can:
+            // L = L_direct + integral of f L cos over the non-delta part, by one next-event
+            // sample and one direction from that part, and the photons gathered where it lands.
             if (in.next_event && !direct_counted) {
               const GlossyPoint here{0, wo, bsdf};
               point.f = w;
@@ -108,14 +114,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first,
             continue;
           }
         }
-        const bool lambertian = bsdf.is_lambertian();
-        point.f = lambertian ? w * bsdf.diffuse_f() : w;
-        if (!(max_component(point.f) > 0.0f)) {
-          point.f = vec3(0.0f);
-          disc = DiscMoments{};  // no visible point: the whole disc, as gather_pass leaves it
-        } else if (!lambertian) {
-          glossy[glossy_count++] = {uint32_t(k), wo, bsdf};
-        }
+        if (!lambertian) glossy[glossy_count++] = {uint32_t(k), wo, bsdf};
         break;
       }
       if (depth >= in.max_depth) break;  // the chain is cut

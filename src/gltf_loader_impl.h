@@ -115,8 +115,9 @@ class Loader {
   Scene scene_;
   std::set<std::string> warned_;
   std::vector<char> visited_;
-  std::vector<int64_t> material_slot_;  // glTF material -> Scene::materials index, -1 unused
-  std::vector<int64_t> image_slot_;     // glTF image -> Scene::images index, -1 not decoded
+  std::vector<int64_t> material_slot_;         // glTF material -> Scene::materials index, -1 unused
+  std::vector<int64_t> image_slot_;            // glTF image -> Scene::images index, -1 not decoded
+  static constexpr int64_t kUndecodable = -2;  // a KTX2 image, warned about once
   int64_t default_material_ = -1;
   // Recentring (Loader::choose_origin): the world bounds of the POSITION accessors' min/max.
   dvec3 measured_lo_{INFINITY}, measured_hi_{-INFINITY};

@@ -49,6 +49,7 @@ int32_t Loader::image(int index, const std::string& where) {
     fail(where + " refers to " + absent("image", index, m_.images.size()));
   int64_t& slot = image_slot_[size_t(index)];
   if (slot >= 0) return int32_t(slot);
+  if (slot == kUndecodable) return -1;  // warned once
   const tinygltf::Image& gi = m_.images[size_t(index)];
   const std::string il = gi.uri.empty() || gi.uri.rfind("data:", 0) == 0
                              ? label("image", gi.name, size_t(index))
@@ -56,6 +57,16 @@ int32_t Loader::image(int index, const std::string& where) {
   Bytes bytes{gi.image.data(), gi.image.size()};
   if (gi.bufferView >= 0) bytes = view_bytes(gi.bufferView, il);  // validated range
   if (bytes.size == 0) fail(il + " has no data (a missing file, or an empty bufferView)");
+  // KTX2 (Basis Universal) has no decoder here. A file may point texture.source at one without
+  // requiring KHR_texture_basisu (glTF-Sample-Assets' KTX2 variants do): the textures using it
+  // fall back to their factors, as for a basisu-only texture, with one warning per image.
+  if (is_ktx2(bytes.data, bytes.size)) {
+    warn(il +
+         " is KTX2 (Basis Universal), which photonbound does not read; the textures using "
+         "it take their factors");
+    slot = kUndecodable;
+    return -1;
+  }
   // The uri's extension tells OpenImageIO the format where the signature does not.
   const std::string name = gi.uri.empty() ? il : one_line(gi.uri);
   try {
@@ -93,6 +104,7 @@ TextureRef Loader::texture(int index, int tex_coord, const tinygltf::ExtensionMa
     source = int(std::min(s, 1e9));
   }
   ref.image = image(source, tl);
+  if (ref.image < 0) return TextureRef{};  // undecodable (KTX2): the factor alone
   if (gt.sampler >= 0) {
     if (size_t(gt.sampler) >= m_.samplers.size())
       fail(tl + " refers to " + absent("sampler", gt.sampler, m_.samplers.size()));

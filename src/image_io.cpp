@@ -93,11 +93,15 @@ std::string format_name(const unsigned char* d, size_t n, const std::string& nam
 
 }  // namespace
 
+bool is_ktx2(const unsigned char* data, size_t size) {
+  return size >= 12 && std::memcmp(data, "\xabKTX 20\xbb\r\n\x1a\n", 12) == 0;
+}
+
 Image decode_image(const unsigned char* data, size_t size, const std::string& name) {
   // KTX2 (KHR_texture_basisu's container) has no OpenImageIO reader; without this, OpenImageIO
   // falls back to opening `name` as a path relative to the working directory and reports a
   // missing file.
-  if (size >= 12 && std::memcmp(data, "\xabKTX 20\xbb\r\n\x1a\n", 12) == 0)
+  if (is_ktx2(data, size))
     throw ImageError(name +
                      ": cannot decode the image: it is KTX2 (Basis Universal), which "
                      "photonbound does not read");

@@ -85,7 +85,8 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
     std::cerr << "photonbound: warning: --alpha " << options.alpha
               << " is at or below 2/3: the Laplacian (bias) estimate does not converge and the "
                  "error bounds are unreliable\n";
-  if (options.follow_roughness > 0.0 &&
+  // The default is silent where following does not apply; a chosen value is not.
+  if (options.follow_roughness > 0.0 && options.follow_roughness != pb::kDefaultFollowRoughness &&
       (options.method == pb::Method::PPM || options.direct != pb::DirectMode::NextEvent))
     std::cerr << "photonbound: warning: --follow-roughness does nothing here: it needs "
                  "--method sppm with next-event direct light\n";
@@ -136,8 +137,11 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   if (options.checkpoint_every) observers.push_back(&checkpoints);
 
   if (show)
-    std::cerr << "photonbound: " << renderer.eye().points.size() << " measurement points, "
-              << threads.threads() << " threads" << (saved ? ", resumed" : "") << "\n";
+    std::cerr << "photonbound: "
+              << (options.method == pb::Method::PPM
+                      ? std::to_string(renderer.eye().points.size()) + " measurement points"
+                      : std::to_string(renderer.states().size()) + " pixels (SPPM)")
+              << ", " << threads.threads() << " threads" << (saved ? ", resumed" : "") << "\n";
   pb::Driver driver(renderer, saved ? saved->schedule : pb::DriverState{});
   const pb::RenderReport report = driver.run(&g_stop, observers);
   // Ctrl-C keeps the work: the state is written then too.

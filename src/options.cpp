@@ -142,13 +142,6 @@ void validate(const RenderOptions& o) {
   if (!o.passes && !o.time_seconds && !o.target_error)
     fail("render: no stop condition: give --passes, --time or --target-error");
   for (const OptionSpec& s : option_table()) s.check(o);
-  // A followed lobe can end where its disc lies almost wholly off reachable surface, and that
-  // pixel stays unknown for good (README "Sharp lobes can be followed"): --target-error alone
-  // could then never stop.
-  if (o.follow_roughness > 0.0 && o.target_error && !o.passes && !o.time_seconds)
-    fail(
-        "--follow-roughness with --target-error needs --passes or --time as well: a followed "
-        "lobe can leave pixels unknown for good");
   if (!o.reference_path.empty() && o.log_path.empty())
     fail("--reference: only used by --log (give --log FILE.jsonl too)");
 }

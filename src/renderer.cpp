@@ -150,8 +150,8 @@ void Renderer::step(std::vector<PointState>* copy) {
   } else {
     // A followed lobe's direct light is its next-event sample (camera_paths.h).
     const float follow = nee ? float(options_.follow_roughness) : 0.0f;
-    const CameraPathInputs cam{world_, camera_, options_.max_depth, follow,
-                               options_.seed, pass, nee,          boundary};
+    const CameraPathInputs cam{world_, camera_, options_.max_depth, follow, options_.seed, pass,
+                               nee,    boundary};
     sppm_gather_and_fold(in, cam, states_, radii_, visible_, min_mass_, glossy_f_, visible_points_,
                          visible_glossy_, sums_, out);
   }

@@ -42,21 +42,6 @@ void expect_rejected(const RenderOptions& o, const std::string& message) {
   }
 }
 
-TEST(Extremes, FollowedLobesWithATargetNeedAnotherStop) {
-  // A followed lobe can leave a pixel unknown for good, and --target-error needs every pixel:
-  // alone it could run for ever, so it is refused; with --time or --passes it is a render.
-  RenderOptions o = valid_options();
-  o.passes.reset();
-  o.target_error = 0.01;
-  EXPECT_NO_THROW(validate(o));
-  o.follow_roughness = 0.7;
-  expect_rejected(o,
-                  "--follow-roughness with --target-error needs --passes or --time as well: "
-                  "a followed lobe can leave pixels unknown for good");
-  o.time_seconds = 60.0;
-  EXPECT_NO_THROW(validate(o));
-}
-
 // ---------------------------------------------------------------------------------------------
 // Option ranges, in process (the CLI side is in test_cli.cpp and test_slow_cli_fuzz.cpp).
 

@@ -529,6 +529,29 @@ TEST_F(LoaderTest, FileTangentsAreTransformedAndTexturesWithoutImagesWarn) {
   EXPECT_FALSE(s.materials[0].emissive_texture.present());
 }
 
+TEST_F(LoaderTest, KtxTwoImagesAsPlainSourcesFallBackToTheirFactorsWithOneWarning) {
+  // glTF-Sample-Assets' KTX2 variants point texture.source at a KTX2 image without requiring
+  // KHR_texture_basisu: that is the factor alone, warned once for the image however many
+  // textures use it, as a basisu-only texture is (above), not a refusal.
+  std::vector<unsigned char> ktx2 = {0xab, 'K',  'T',  'X',  ' ',  '2',
+                                     '0',  0xbb, '\r', '\n', 0x1a, '\n'};
+  ktx2.resize(64, 0);
+  write("lamp.ktx2", ktx2);
+  const Gltf g =
+      textured("\"images\":[{\"uri\":\"lamp.ktx2\"}],\"textures\":[{\"source\":0},{\"source\":0}],",
+               "\"pbrMetallicRoughness\":{\"baseColorFactor\":[0.5,0.25,1,1],"
+               "\"baseColorTexture\":{\"index\":0}},\"emissiveFactor\":[1,1,1],"
+               "\"emissiveTexture\":{\"index\":1}");
+  const Scene s = load(g);
+  EXPECT_TRUE(s.images.empty());
+  EXPECT_FALSE(s.materials[0].base_color_texture.present());
+  EXPECT_FALSE(s.materials[0].emissive_texture.present());
+  expect_vec(s.materials[0].base_color, vec3(0.5f, 0.25f, 1.0f));
+  size_t warned = 0;
+  for (const std::string& w : s.warnings) warned += w.find("is KTX2 (Basis Universal)") != w.npos;
+  EXPECT_EQ(warned, 1u);
+}
+
 TEST_F(LoaderTest, HierarchyComposesTrsAndMatrix) {
   Gltf g = basic();
   g.nodes[0] = "{\"mesh\":0}";

@@ -1,7 +1,8 @@
 // SPPM's camera paths through rough GGX lobes (--follow-roughness, camera_paths.h): a followed
 // lobe must estimate the same image as photons gathered at the lobe, count its direct light
 // once, and turn the sparse-photon bound of a sharp lobe (ESTIMATOR.md section 12) into the
-// bound of the diffuse surfaces it reflects.
+// bound of the diffuse surfaces it reflects. PassOver.*: a camera path passes over a visible
+// point whose disc lies almost wholly off reachable surface, so that no pixel stays unknown.
 #include "photonbound/renderer.h"
 
 #include "analytic.h"
@@ -150,6 +151,23 @@ TEST(PassOver, AStripFarNarrowerThanTheRadiusIsSeenThroughPaths) {
   EXPECT_EQ(gathered.summary.unknown_pixels, 0u);
   EXPECT_EQ(followed.summary.unknown_pixels, 0u);
   EXPECT_LT(std::fabs(z), 4.0);
+}
+
+TEST(PassOver, AFollowedRenderStopsOnItsTarget) {
+  // The same room at the default --follow-roughness: a pixel whose followed lobe reaches the
+  // strip used to stay unknown for good, so --target-error alone could not end (it was refused
+  // without --passes or --time). Now the target stops the render, with every bound finite,
+  // long before the pass cap that keeps this test from hanging if it did not.
+  RenderOptions o = sppm(kDefaultFollowRoughness, 3000);
+  o.target_error = 0.02;
+  Renderer r(room(Material::metal(vec3(0.9f, 0.8f, 0.6f), 0.3f), true, true), o);
+  const RenderReport report = test::run_to_stop(r);
+  std::printf("target 0.02: stopped after %llu passes (%s), %zu unknown pixels\n",
+              (unsigned long long)report.work.passes, stop_text(report.stop).c_str(),
+              size_t(report.summary.unknown_pixels));
+  EXPECT_EQ(report.stop, StopReason::TargetError);
+  EXPECT_EQ(report.summary.unknown_pixels, 0u);
+  EXPECT_TRUE(std::isfinite(report.summary.predicted_error_upper));
 }
 
 TEST(FollowLobe, GlossyPlaneUnderNextEventLightKeepsItsCoverage) {

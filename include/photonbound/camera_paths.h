@@ -52,8 +52,8 @@ struct CameraPathInputs {
 // goes to the front of `glossy` (room for points.size()), in pixel order. radii[k] is pixel
 // first + k's search radius this pass; out[k].disc its visible point's disc moments. Returns
 // the count of glossy points.
-size_t trace_visible_points(const CameraPathInputs& in, size_t first,
-                            std::span<const float> radii, std::span<MeasurementPoint> points,
-                            std::span<GlossyPoint> glossy, std::span<PassGather> out);
+size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
+                            std::span<MeasurementPoint> points, std::span<GlossyPoint> glossy,
+                            std::span<PassGather> out);
 
 }  // namespace pb

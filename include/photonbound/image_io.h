@@ -55,5 +55,8 @@ void write_png(const std::string& path, int width, int height,
 // (glTF's images are unassociated). At most 4 channels are kept. Throws ImageError naming
 // `name` when the bytes are not an image it can read, or the image is beyond 2^28 texels.
 Image decode_image(const unsigned char* data, size_t size, const std::string& name);
+// The bytes begin with KTX2's identifier (KHR_texture_basisu's container), which no reader here
+// decodes.
+bool is_ktx2(const unsigned char* data, size_t size);
 
 }  // namespace pb
