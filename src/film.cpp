@@ -21,6 +21,9 @@ struct PixelResult {
   uint32_t scale_tested = 0, scale_disagree = 0;  // states of the two-scale check (11c)
   float radius = 0.0f;
   bool exact = false;  // PPM: no point, so nothing random (background, exact emission)
+  // SPPM: no visible point in any pass, so no photon part: the bias model does not enter its
+  // bound (the emission and background its jittered paths saw), and a refuted model leaves it.
+  bool photon_free = false;
   bool known = true;
 };
 
@@ -75,6 +78,7 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
     r.sparse = sparse_term(layout, states[pixel], pixel, f, visible, confidence);
     // Without the photon cap a state with few photons has no bound (unknown); a pixel that never
     // had a visible point has no photon part to wait for.
+    r.photon_free = visible == 0;
     r.known = passes >= 2 && (e.known || layout.photon_cap > 0.0 || visible == 0) &&
               (layout.mass.empty() || visible == 0 || layout.mass[pixel] >= kValidKernelMass);
     return r;
@@ -268,7 +272,8 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
   std::vector<double> replica_linear(pixels, 0.0), replica_rest(pixels, 0.0);
   for (size_t p = 0; p < pixels; ++p) {
     const PixelResult& r = results[p];
-    const bool known_pixel = r.exact || (passes >= 2 && r.known && !sum.model_refuted);
+    const bool known_pixel =
+        r.exact || (passes >= 2 && r.known && (!sum.model_refuted || r.photon_free));
     dvec3 noise(0.0), bound(std::numeric_limits<double>::infinity());
     if (known_pixel) {
       // PPM pixels without points see only background or exact emission: bound 0.

@@ -151,7 +151,8 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
     std::cerr << "photonbound: warning: " << options.scene << ": " << *dark << "\n";
   if (report.summary.model_refuted)
     std::cerr << "photonbound: warning: " << options.scene
-              << ": every error bound is unknown: the bias model fails at this radius (in "
+              << ": every error bound with a photon part is unknown: the bias model fails at this "
+                 "radius (in "
               << std::setprecision(3) << 100.0 * report.summary.slope_disagreement
               << "% of the points' channels the samples' drift with the radius disagrees with the "
                  "Laplacian, in "

@@ -476,6 +476,39 @@ TEST(Extremes, TenTimesTheDefaultRadiusIsRefutedInTheFirstPasses) {
   }
 }
 
+// The same refutation seen with the plane's far edge in view, the sky above it black: a refuted
+// model makes every bound with a photon part unknown, but a pixel that never had a visible point
+// has none (its paths only ever saw the background), so it keeps its bound of 0 rather than turn
+// unknown with the rest (the helmet of glTF-Sample-Assets at 48x48 was all +inf, 88% of it
+// background).
+TEST(Extremes, ARefutedModelLeavesPixelsWithoutVisiblePointsKnown) {
+  RenderOptions o = extremes::options(test::scene_path("plane_point.gltf"), 16, 10000);
+  o.method = Method::SPPM;
+  o.passes = 16;
+  o.look_from = std::array<double, 3>{0.0, 1.0, 6.0};
+  o.look_at = std::array<double, 3>{0.0, 0.6, 0.0};
+  const Scene scene = load_gltf(o.scene);
+  o.radius = 10.0 * Renderer(scene, o).initial_radius();
+  Renderer r(scene, o);
+  while (r.passes() < 16) r.step();
+  FilmImage img;
+  const FilmSummary summary = develop(r.layout(), r.states(), r.passes(), r.film_settings(), &img);
+  ASSERT_TRUE(summary.model_refuted);
+  size_t sky = 0, plane = 0;
+  for (size_t p = 0; p < img.photons.size(); ++p) {
+    const bool lit = img.radiance[3 * p] > 0.0f;
+    for (int c = 0; c < 3; ++c) {
+      if (lit) EXPECT_EQ(img.bound[3 * p + c], INFINITY) << "pixel " << p;
+      if (!lit) EXPECT_EQ(img.bound[3 * p + c], 0.0f) << "pixel " << p;
+    }
+    (lit ? plane : sky) += 1;
+  }
+  std::printf("refuted: %zu plane pixels unknown, %zu sky pixels known (bound 0)\n", plane, sky);
+  EXPECT_GT(sky, 16u * 16u / 4);
+  EXPECT_GT(plane, 16u * 16u / 4);
+  EXPECT_EQ(summary.unknown_pixels, plane);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Scenes scaled by 1e-4 and 1e5.
 
