@@ -39,13 +39,23 @@ float Lights::shadow_margin(const Triangle& t, const vec3& receiver, float cos_l
   return cos_light > 0.0f ? plane_tolerance(t, receiver) / cos_light : INFINITY;
 }
 
-Lights::Lights(const Scene& scene)
+Lights::Lights(const Scene& scene, double piece_budget)
     : punctual_(scene.lights),
       images_(scene.images),
       centre_(0.5f * (scene.bounds.lo + scene.bounds.hi)),
       radius_(emission_radius(scene.bounds)) {
   if (scene.bounds.empty()) centre_ = vec3(0.0f);
   if (scene.environment) environment_.emplace(*scene.environment);
+  double pieces = 0.0;  // what the textured triangles ask for
+  for (const Mesh& mesh : scene.meshes) {
+    const Material& mat = scene.materials[mesh.material];
+    if (!mat.emits() || !(mat.emissive_texture.present() || mat.masked())) continue;
+    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+      const double n = textured_split(mesh, mat, uint32_t(t / 3), nullptr);
+      pieces += n * n;
+    }
+  }
+  if (pieces > piece_budget) split_scale_ = float(std::sqrt(piece_budget / pieces));
   for (const Mesh& mesh : scene.meshes) {
     const Material& mat = scene.materials[mesh.material];
     if (!mat.emits()) continue;

@@ -27,6 +27,26 @@ vec3 Lights::radiance_at(const Triangle& t, float c1, float c2) const {
   return emission_at(images_, *src.material, uv);
 }
 
+int Lights::textured_split(const Mesh& mesh, const Material& mat, uint32_t tri,
+                           double* texels_out) const {
+  const TextureRef& ref =
+      mat.emissive_texture.present() ? mat.emissive_texture : mat.base_color_texture;  // alpha
+  if (texels_out) *texels_out = -1.0;  // no texture, or no finite texel count
+  if (!ref.present()) return 1;
+  auto st_at = [&](vec2 b) {
+    const vec2 uv[2] = {mesh_uv(mesh, tri, 0, b.x, b.y), mesh_uv(mesh, tri, 1, b.x, b.y)};
+    return texture_coords(ref, uv);
+  };
+  const Image& im = images_[size_t(ref.image)];
+  const vec2 s0 = st_at(vec2(0.0f)), s1 = st_at(vec2(1.0f, 0.0f)), s2 = st_at(vec2(0.0f, 1.0f));
+  const vec2 a = s1 - s0, c = s2 - s0;
+  const double texels =
+      0.5 * std::fabs(double(a.x) * c.y - double(a.y) * c.x) * double(im.width) * double(im.height);
+  if (!std::isfinite(texels)) return 1;
+  if (texels_out) *texels_out = texels;
+  return int(std::clamp(std::ceil(2.0 * std::sqrt(texels)), 1.0, double(kMaxSplit)));
+}
+
 void Lights::add_textured(const Mesh& mesh, const Material& mat, uint32_t tri,
                           const Triangle& whole) {
   const TextureRef& ref =
@@ -41,27 +61,23 @@ void Lights::add_textured(const Mesh& mesh, const Material& mat, uint32_t tri,
     const vec2 lo = glm::min(p0, glm::min(p1, p2)), hi = glm::max(p0, glm::max(p1, p2));
     return max_texel(images_[size_t(ref.image)], ref, lo, hi, true);
   };
-  int n = 1;
-  if (ref.present()) {
-    const Image& im = images_[size_t(ref.image)];
-    const vec2 s0 = st_at(vec2(0.0f)), s1 = st_at(vec2(1.0f, 0.0f)), s2 = st_at(vec2(0.0f, 1.0f));
-    const vec2 a = s1 - s0, c = s2 - s0;
-    const double texels = 0.5 * std::fabs(double(a.x) * c.y - double(a.y) * c.x) *
-                          double(im.width) * double(im.height);
-    if (std::isfinite(texels))
-      n = int(std::clamp(std::ceil(2.0 * std::sqrt(texels)), 1.0, double(kMaxSplit)));
+  double texels = -1.0;
+  const int wanted = textured_split(mesh, mat, tri, &texels);
+  // Within the piece budget (lights.h); the choice stays unbiased with any pieces, since the
+  // radiance of the sampled point is looked up.
+  const int n = std::max(1, int(float(wanted) * split_scale_));
+  if (coloured && texels >= 0.0) {
     // A triangle whose texels are all black emits nowhere: one bound over its texture box
     // spares cutting it into n^2 dark pieces (most triangles of a model whose emissive map
     // lights a few details, such as glTF's DamagedHelmet). Read only when that box is not
     // much larger than the texels the pieces would read: a sliver across the image would
     // read all of it.
-    if (coloured) {
-      const vec2 lo = glm::min(s0, glm::min(s1, s2)), hi = glm::max(s0, glm::max(s1, s2));
-      const double box =
-          (double(hi.x - lo.x) * im.width + 2.0) * (double(hi.y - lo.y) * im.height + 2.0);
-      if (std::isfinite(texels) && box <= 16.0 * texels + 64.0 && brightest(s0, s1, s2) == 0.0f)
-        return;
-    }
+    const Image& im = images_[size_t(ref.image)];
+    const vec2 s0 = st_at(vec2(0.0f)), s1 = st_at(vec2(1.0f, 0.0f)), s2 = st_at(vec2(0.0f, 1.0f));
+    const vec2 lo = glm::min(s0, glm::min(s1, s2)), hi = glm::max(s0, glm::max(s1, s2));
+    const double box =
+        (double(hi.x - lo.x) * im.width + 2.0) * (double(hi.y - lo.y) * im.height + 2.0);
+    if (box <= 16.0 * texels + 64.0 && brightest(s0, s1, s2) == 0.0f) return;
   }
   const float step = 1.0f / float(n);
   // Piece with vertex 0 at barycentrics b0 and edges d1, d2 (as oriented as the triangle).

@@ -196,6 +196,35 @@ TEST(TexturedEmitter, DarkTrianglesAreSkippedButNoneABrightTexelReaches) {
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(lights.total_power()[c], want, 0.02 * want) << c;
 }
 
+TEST(TexturedEmitter, APieceBudgetCoarsensThePiecesButNotThePhotonFlux) {
+  // The 2 x 1 m quad under a 64 x 32 texture of random texels: its two triangles ask for 32^2
+  // pieces each (2048 in all). Under a budget of 200 each gets floor(32 sqrt(200 / 2048)) = 10
+  // per side, 100 pieces, and its choice follows the texture less closely; the photons' mean
+  // flux is the texture's integral either way (4 standard errors of the difference), since
+  // every photon carries the radiance looked up where it leaves.
+  Image im{"noise", 64, 32, 3, std::vector<uint8_t>(64 * 32 * 3), {}};
+  Rng texels(5, 0, 0, Stream::Test);
+  for (uint8_t& v : im.u8) v = uint8_t(255.0f * texels.next_float());
+  Material mat = Material::lambertian(vec3(0.0f));
+  mat.emission = vec3(1.0f);
+  mat.emissive_texture.image = 0;
+  const Scene scene = emissive_quad(mat, {im});
+  const Lights fine(scene), coarse(scene, 200.0);
+  EXPECT_EQ(fine.emitter_count(), 2u * 32u * 32u);
+  EXPECT_EQ(coarse.emitter_count(), 2u * 10u * 10u);
+  Mean a, b;
+  for (int i = 0; i < 200000; ++i) {
+    Rng ra(17, 0, uint64_t(i), Stream::Test), rb(19, 0, uint64_t(i), Stream::Test);
+    a.add(fine.sample_photon(ra).flux.x);
+    b.add(coarse.sample_photon(rb).flux.x);
+  }
+  std::printf("photon flux: %.5f fine (%.5f), %.5f coarse (%.5f)\n", a.mean(), a.se(), b.mean(),
+              b.se());
+  EXPECT_NEAR(a.mean(), b.mean(), 4.0 * std::hypot(a.se(), b.se()));
+  // The midpoint rule on 100 pieces of about 10 texels still finds the power to 2%.
+  EXPECT_NEAR(coarse.total_power().x, fine.total_power().x, 0.02 * fine.total_power().x);
+}
+
 TEST(TexturedEmitter, PhotonsLeaveWhereTheTextureIsBright) {
   // An 8 x 1 texture, bright in its first two texels (u < 1/4) and black elsewhere, NEAREST:
   // uniform sampling would start 25% of the photons in the bright quarter; choosing pieces by
