@@ -3,7 +3,11 @@
 #include <OpenImageIO/filesystem.h>
 #include <OpenImageIO/imageio.h>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include <algorithm>
+#include <cstdio>
 #include <cstring>
 
 #include "photonbound/file_io.h"
@@ -97,6 +101,38 @@ bool is_ktx2(const unsigned char* data, size_t size) {
   return size >= 12 && std::memcmp(data, "\xabKTX 20\xbb\r\n\x1a\n", 12) == 0;
 }
 
+namespace {
+
+// libpng's default error and warning handlers, which OpenImageIO's PNG reader keeps, write to
+// stderr themselves ("libpng error: IDAT: Read error", "libpng warning: iCCP: known incorrect
+// sRGB profile"): a line that names no file ahead of the one-line error that does, or noise on
+// a good texture. OpenImageIO passes the same text to geterror(), which the error below
+// carries, so stderr is pointed at /dev/null while a texture decodes (the loader decodes on
+// one thread, before any progress output).
+class QuietStderr {
+ public:
+  QuietStderr() {
+    std::fflush(stderr);
+    saved_ = ::dup(2);
+    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, 2);
+    if (null >= 0) ::close(null);
+  }
+  ~QuietStderr() {
+    if (saved_ < 0) return;
+    std::fflush(stderr);
+    ::dup2(saved_, 2);
+    ::close(saved_);
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  int saved_ = -1;
+};
+
+}  // namespace
+
 Image decode_image(const unsigned char* data, size_t size, const std::string& name) {
   // KTX2 (KHR_texture_basisu's container) has no OpenImageIO reader; without this, OpenImageIO
   // falls back to opening `name` as a path relative to the working directory and reports a
@@ -105,6 +141,7 @@ Image decode_image(const unsigned char* data, size_t size, const std::string& na
     throw ImageError(name +
                      ": cannot decode the image: it is KTX2 (Basis Universal), which "
                      "photonbound does not read");
+  const QuietStderr quiet;
   OIIO::Filesystem::IOMemReader memory(data, size);
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);  // keep colour as stored, not premultiplied

@@ -275,6 +275,32 @@ TEST(DecodeImage, PngFromMemoryKeepsItsTexels) {
   EXPECT_TRUE(im.f32.empty());
 }
 
+TEST(DecodeImage, ATruncatedPngIsOneErrorNamingItAndNothingOnStderr) {
+  // A PNG cut inside its image data: libpng reports it on stderr by itself ("libpng error:
+  // IDAT: ...", naming no file); that text must come once, in the ImageError naming the image.
+  const std::filesystem::path p =
+      std::filesystem::temp_directory_path() / ("pb_trunc_" + std::to_string(getpid()) + ".png");
+  std::vector<unsigned char> rgb(3 * 64 * 64);
+  std::mt19937 noise(7);  // incompressible: the IDAT holds most of the file
+  for (unsigned char& v : rgb) v = uint8_t(noise() >> 24);
+  write_png(p.string(), 64, 64, rgb);
+  std::vector<unsigned char> bytes = file_bytes(p.string());
+  std::filesystem::remove(p);
+  ASSERT_GT(bytes.size(), 4000u);
+  bytes.resize(bytes.size() / 2);
+  testing::internal::CaptureStderr();
+  std::string message;
+  try {
+    decode_image(bytes.data(), bytes.size(), "cut.png");
+  } catch (const ImageError& e) {
+    message = e.what();
+  }
+  const std::string printed = testing::internal::GetCapturedStderr();
+  EXPECT_EQ(printed, "");
+  EXPECT_EQ(message.rfind("cut.png: cannot decode the image: ", 0), 0u) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+}
+
 TEST(DecodeImage, JpegFromMemoryAndBadBytes) {
   // tests/data/textures/solid_200_100_50.jpg: 8 x 8 texels of (200, 100, 50), quality 100.
   const std::vector<unsigned char> bytes =
