@@ -46,6 +46,9 @@ std::string stop_figures(const pb::RenderOptions& o, const pb::FilmSummary& s) {
     out << pb::tested_name(o) << " <= " << tested << " at " << pb::number_text(100.0 * o.confidence)
         << "%, ";
   out << "mean bound " << s.mean_bound;
+  // The mean is over the known pixels: say how many it leaves out (+inf, not small).
+  if (s.unknown_pixels > 0 && std::isfinite(s.mean_bound))
+    out << " over the known pixels, " << s.unknown_pixels << " unknown";
   return out.str();
 }
 
