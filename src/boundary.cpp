@@ -266,8 +266,9 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
     truncated_ = true;
     found.clear();
     blockers.clear();
+  } else {
+    found.reserve(cuts.load());  // exactly: no doubling of millions of cuts
   }
-  found.reserve(cuts.load());  // exactly: no doubling of millions of cuts
   for (std::vector<Pending>& list : blockers) {
     found.insert(found.end(), list.begin(), list.end());
     std::vector<Pending>().swap(list);

@@ -17,6 +17,17 @@ namespace {
 // (the choice follows the texture to the texel), at most 32 x 32 pieces per triangle.
 constexpr int kMaxSplit = 32;
 
+// The texture coordinates of barycentrics b of the mesh's triangle `tri`, as `ref` reads them.
+vec2 texture_st(const Mesh& mesh, uint32_t tri, const TextureRef& ref, vec2 b) {
+  const vec2 uv[2] = {mesh_uv(mesh, tri, 0, b.x, b.y), mesh_uv(mesh, tri, 1, b.x, b.y)};
+  return texture_coords(ref, uv);
+}
+
+// What a textured emitter follows: its emissive texture, else the base colour's alpha (MASK).
+const TextureRef& emitter_texture(const Material& mat) {
+  return mat.emissive_texture.present() ? mat.emissive_texture : mat.base_color_texture;
+}
+
 }  // namespace
 
 vec3 Lights::radiance_at(const Triangle& t, float c1, float c2) const {
@@ -29,14 +40,10 @@ vec3 Lights::radiance_at(const Triangle& t, float c1, float c2) const {
 
 int Lights::textured_split(const Mesh& mesh, const Material& mat, uint32_t tri,
                            double* texels_out) const {
-  const TextureRef& ref =
-      mat.emissive_texture.present() ? mat.emissive_texture : mat.base_color_texture;  // alpha
+  const TextureRef& ref = emitter_texture(mat);
   if (texels_out) *texels_out = -1.0;  // no texture, or no finite texel count
   if (!ref.present()) return 1;
-  auto st_at = [&](vec2 b) {
-    const vec2 uv[2] = {mesh_uv(mesh, tri, 0, b.x, b.y), mesh_uv(mesh, tri, 1, b.x, b.y)};
-    return texture_coords(ref, uv);
-  };
+  auto st_at = [&](vec2 b) { return texture_st(mesh, tri, ref, b); };
   const Image& im = images_[size_t(ref.image)];
   const vec2 s0 = st_at(vec2(0.0f)), s1 = st_at(vec2(1.0f, 0.0f)), s2 = st_at(vec2(0.0f, 1.0f));
   const vec2 a = s1 - s0, c = s2 - s0;
@@ -49,13 +56,9 @@ int Lights::textured_split(const Mesh& mesh, const Material& mat, uint32_t tri,
 
 void Lights::add_textured(const Mesh& mesh, const Material& mat, uint32_t tri,
                           const Triangle& whole) {
-  const TextureRef& ref =
-      mat.emissive_texture.present() ? mat.emissive_texture : mat.base_color_texture;  // alpha
+  const TextureRef& ref = emitter_texture(mat);
   const bool coloured = mat.emissive_texture.present();
-  auto st_at = [&](vec2 b) {
-    const vec2 uv[2] = {mesh_uv(mesh, tri, 0, b.x, b.y), mesh_uv(mesh, tri, 1, b.x, b.y)};
-    return texture_coords(ref, uv);
-  };
+  auto st_at = [&](vec2 b) { return texture_st(mesh, tri, ref, b); };
   // The brightest texel a lookup inside the texture-space triangle (p0, p1, p2) may read.
   auto brightest = [&](vec2 p0, vec2 p1, vec2 p2) {
     const vec2 lo = glm::min(p0, glm::min(p1, p2)), hi = glm::max(p0, glm::max(p1, p2));
