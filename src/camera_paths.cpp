@@ -4,6 +4,8 @@
 #include "photonbound/pass_stages.h"
 #include "photonbound/rng.h"
 
+#include <algorithm>
+
 namespace pb {
 
 size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
@@ -28,7 +30,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
     bool after_lobe = false;
     for (int depth = 0;; ++depth) {
       Hit hit;
-      const bool found = depth == 0 ? in.world.accel().intersect(origin, dir, 0.0f, INFINITY, hit)
+      const bool found = depth == 0 ? in.world.camera_hit(origin, dir, hit)
                                     : in.world.trace(origin, origin_normal, origin_error, dir, hit);
       if (!found) {  // the environment (black without one), seen along the path
         if (!after_lobe) emission += dvec3(weight * in.world.lights().environment_radiance(dir));
@@ -133,6 +135,21 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
     out[k].disc = disc;
   }
   return glossy_count;
+}
+
+double culled_view_share(const World& world, const PinholeCamera& camera) {
+  const int nx = std::min(camera.width(), 128), ny = std::min(camera.height(), 128);
+  size_t culled = 0;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const float px = (float(i) + 0.5f) * float(camera.width()) / float(nx);
+      const float py = (float(j) + 0.5f) * float(camera.height()) / float(ny);
+      Hit hit;
+      int passed = 0;
+      world.camera_hit(camera.origin(), camera.direction(px, py), hit, &passed);
+      culled += passed > 0;
+    }
+  return double(culled) / double(nx * ny);
 }
 
 }  // namespace pb

@@ -35,7 +35,7 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
     const PathVertex v = stack[--top];
     Hit hit;
     const bool found = v.depth == 0
-                           ? world.accel().intersect(v.origin, v.dir, 0.0f, INFINITY, hit)
+                           ? world.camera_hit(v.origin, v.dir, hit)
                            : world.trace(v.origin, v.origin_normal, v.origin_error, v.dir, hit);
     if (!found) {  // the environment (black without one): exact for this ray
       out.emission += dvec3(v.weight * world.lights().environment_radiance(v.dir));

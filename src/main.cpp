@@ -1,5 +1,6 @@
 // photonbound command-line entry point. The only catch-all: maps failures to exit codes
 // (0 done, 1 runtime failure or bad input file, 2 bad usage).
+#include "photonbound/camera_paths.h"
 #include "photonbound/channels.h"
 #include "photonbound/checkpoint.h"
 #include "photonbound/checkpoint_writer.h"
@@ -31,6 +32,8 @@ std::atomic<bool> g_stop{false};
 
 // --radius above this fraction of the scene size draws a warning (render()).
 constexpr double kRadiusWarnFraction = 0.05;
+// The share of the view that back-face culling leaves out above which the render notes it.
+constexpr double kCulledNoteShare = 0.01;
 
 // First Ctrl-C (or SIGTERM): finish the pass and write the image. Second: leave at once.
 extern "C" void on_signal(int sig) {
@@ -100,6 +103,34 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   if (const std::string note = renderer.world().mirror_note();
       !note.empty() && options.progress != pb::ProgressMode::Never)
     std::cerr << "photonbound: note: " << options.scene << ": " << note << "\n";
+  // glTF's back-face culling (World::camera_hit) can leave out much of a view: say so, since a
+  // renderer that draws every face (a path tracer ignoring doubleSided) shows another picture.
+  if (const double culled = pb::culled_view_share(renderer.world(), renderer.camera());
+      culled >= kCulledNoteShare && options.progress != pb::ProgressMode::Never)
+    std::cerr << "photonbound: note: " << options.scene << ": " << std::setprecision(3)
+              << 100.0 * culled << std::setprecision(6)
+              << "% of the view looks through the back of single-sided faces (doubleSided "
+                 "false), which glTF culls as its viewers do; a face meant to be seen from "
+                 "behind needs doubleSided true\n";
+  // An environment outside a closed shell around the camera lights nothing it sees: a sky box
+  // or dome drawn for glTF viewers (which light it by the environment, without shadows) is
+  // opaque here. Said before the render, which would come out black.
+  if (const pb::Scene& sc = renderer.world().scene(); sc.environment)
+    if (const auto shell = renderer.world().camera_enclosure(renderer.camera().origin())) {
+      std::string outer;
+      for (const auto& [mesh, share] : shell->outermost) {
+        std::ostringstream item;
+        item << "'" << sc.meshes[mesh].name << "' in " << std::setprecision(3) << 100.0 * share
+             << "%";
+        outer += (outer.empty() ? " (outermost: mesh " : ", ") + item.str();
+      }
+      if (!outer.empty()) outer += " of the directions)";
+      std::cerr << "photonbound: warning: " << options.scene
+                << ": every ray from the camera meets a surface before the environment" << outer
+                << ", so " << sc.environment->source
+                << " cannot light what the camera sees; a sky box or dome made for viewers is "
+                   "opaque to light here: remove it from the file, or light the scene inside it\n";
+    }
   // The bias term models the radiance as smooth (second order) within the radius. A radius of
   // the scene's size breaks that (the extremes suite measured a bound of 0.128 against an error
   // of ~1 at R = scene size), so say so rather than report a bound that cannot be trusted.

@@ -1,6 +1,7 @@
 #include "photonbound/world.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace pb {
 
@@ -55,6 +56,52 @@ void World::triangle(uint32_t t, vec3& a, vec3& b, vec3& c) const {
   a = mv.positions[tri[0]];
   b = mv.positions[tri[1]];
   c = mv.positions[tri[2]];
+}
+
+bool World::camera_hit(const vec3& origin, const vec3& dir, Hit& hit, int* culled) const {
+  if (culled) *culled = 0;
+  if (!accel_.intersect(origin, dir, 0.0f, INFINITY, hit)) return false;
+  for (int k = 0; k < kMaxCulledFaces; ++k) {
+    const Material& m = *meshes_[hit.mesh].material;
+    const uint32_t t = triangle_index(hit);
+    if (m.double_sided || m.transmission > 0.0f || glm::dot(dir, face_normals_[t]) <= 0.0f)
+      return true;
+    // The back of a single-sided face: go on from just beyond it.
+    const Surface s = surface(hit);
+    if (culled) *culled = k + 1;
+    if (!trace(s.position, s.ng, s.error, dir, hit)) return false;
+  }
+  return true;
+}
+
+std::optional<World::Enclosure> World::camera_enclosure(const vec3& p) const {
+  constexpr int kDirections = 256, kMaxHits = 256;
+  std::vector<uint32_t> last_count(scene_.meshes.size(), 0);
+  for (int k = 0; k < kDirections; ++k) {
+    // Fibonacci points on the sphere: even coverage without randomness.
+    const float z = 1.0f - 2.0f * (float(k) + 0.5f) / float(kDirections);
+    const float r = std::sqrt(std::max(0.0f, 1.0f - z * z)), phi = 2.39996323f * float(k);
+    const vec3 dir(r * std::cos(phi), r * std::sin(phi), z);
+    Hit hit;
+    if (!camera_hit(p, dir, hit)) return std::nullopt;  // the camera sees the environment
+    int hits = 1;
+    uint32_t last = hit.mesh;
+    for (;;) {
+      const Surface s = surface(hit);
+      if (!trace(s.position, s.ng, s.error, dir, hit)) break;
+      last = hit.mesh;
+      if (++hits == kMaxHits) break;
+    }
+    ++last_count[last];
+  }
+  Enclosure e;
+  for (uint32_t m = 0; m < last_count.size(); ++m)
+    if (last_count[m] * 10 >= kDirections)
+      e.outermost.push_back({m, double(last_count[m]) / kDirections});
+  std::stable_sort(e.outermost.begin(), e.outermost.end(),
+                   [](const auto& a, const auto& b) { return a.second > b.second; });
+  if (e.outermost.size() > 3) e.outermost.resize(3);
+  return e;
 }
 
 }  // namespace pb

@@ -664,6 +664,45 @@ void modelnull_experiment() {
     }
 }
 
+// The model check on any file (PB_STUDY_FILE, PB_STUDY_SIZE, default 48): the share of
+// state-channels with |z| > 3 by the state's photon count, to see where a refutation comes from.
+void modelfile_experiment() {
+  const char* file = std::getenv("PB_STUDY_FILE");
+  if (!file) return;
+  const char* size = std::getenv("PB_STUDY_SIZE");
+  RenderOptions o = study_options("cornell.gltf", size ? std::atoi(size) : 48, 64);
+  o.scene = file;
+  o.method = g_method;
+  const char* seed = std::getenv("PB_STUDY_SEED");
+  o.seed = seed ? uint64_t(std::atoll(seed)) : 4u;
+  Renderer r(load_gltf(o.scene), o);
+  std::printf(
+      "| passes | photons | channels | share z>3 | mean z^2 | mean z "
+      "|\n|---|---|---|---|---|---|\n");
+  for (uint64_t passes : {4u, 16u, 64u}) {
+    while (r.passes() < passes) r.step();
+    const uint64_t edges[] = {5, 10, 20, 50, 100, 1000, ~0ull};
+    double n[7] = {}, d[7] = {}, z2[7] = {}, zs[7] = {};
+    for (const PointState& st : r.states()) {
+      const PointEstimate e = estimate(st, r.passes(), double(r.options().photons_per_pass));
+      int b = 0;
+      while (st.photons >= edges[b + 1]) ++b;
+      for (int c = 0; c < 3; ++c) {
+        const double z = e.slope_z[c];
+        if (z == 0.0) continue;
+        n[b] += 1;
+        d[b] += std::fabs(z) > kSlopeZ;
+        z2[b] += z * z;
+        zs[b] += z;
+      }
+    }
+    for (int b = 0; b < 6; ++b)
+      if (n[b] > 0)
+        std::printf("| %llu | %llu+ | %.0f | %.3f | %.2f | %.2f |\n", (unsigned long long)passes,
+                    (unsigned long long)edges[b], n[b], d[b] / n[b], z2[b] / n[b], zs[b] / n[b]);
+  }
+}
+
 int main(int argc, char** argv) {
   const std::string which = argc > 1 ? argv[1] : "all";
   if (argc > 2 && std::string(argv[2]) == "sppm") g_method = Method::SPPM;
@@ -674,6 +713,7 @@ int main(int argc, char** argv) {
   if (which == "slope") slope_experiment();
   if (which == "modelcheck") modelcheck_experiment();
   if (which == "modelnull") modelnull_experiment();
+  if (which == "modelfile") modelfile_experiment();
   if (which == "all" || which == "edges") edges_table();
   if (which == "all" || which == "cornell") cornell_table(argc > 3 ? std::atoi(argv[3]) : 4);
   if (which == "calibration") calibration_table(argc > 3 ? std::atoi(argv[3]) : 20);

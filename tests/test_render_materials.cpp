@@ -2,6 +2,7 @@
 // thin and volumetric glass (Fresnel and Beer-Lambert transmittance), double-sided emitters,
 // alphaMode MASK cut-outs for camera rays, shadow rays and photons, a base colour texture with
 // KHR_texture_transform, a normal texture, and glTF's default material (a rough metal).
+#include "photonbound/camera_paths.h"
 #include "photonbound/parallel.h"
 #include "photonbound/renderer.h"
 
@@ -85,6 +86,81 @@ Material emitter(vec3 le, bool double_sided = false) {
   m.emission = le;
   m.double_sided = double_sided;
   return m;
+}
+
+// glTF's doubleSided false is back-face culling: the camera's first ray passes through the back
+// of a single-sided face. The camera at z = 2 looks along -z at a quad at z = 0 whose front
+// faces -z (away from it), and behind it at a one-sided emitter of radiance 1 facing the camera.
+// Culled, every pixel sees the emitter itself: exactly 1. Double-sided, it sees the quad's back,
+// which nothing lights (the emitter is behind the quad, photons land on its front only, and
+// next-event shadow rays from the back side pass through the quad): exactly 0. A transmissive
+// single-sided quad keeps its back: thin glass between, the pixel sees the emitter through it,
+// less what Fresnel reflects.
+TEST(MaterialRender, TheCameraSeesThroughTheBackOfASingleSidedFace) {
+  auto scene = [](const Material& between) {
+    SceneBuilder b;
+    b.quad(vec3(0), vec3(0, 1, 0), vec3(1, 0, 0), b.material(between));  // front -z
+    b.quad(vec3(0, 0, -3), vec3(4, 0, 0), vec3(0, 4, 0), b.material(emitter(vec3(1.0f))));
+    b.camera(vec3(0, 0, 2), vec3(0, 0, -1), vec3(0, 1, 0), 0.3f);
+    return b.done();
+  };
+  Material single = Material::lambertian(vec3(0.5f)), both = single;
+  both.double_sided = true;
+  Material glass = Material::glass(1.5f, true);
+  for (Method m : {Method::PPM, Method::SPPM}) {
+    const RenderOptions o = options(4, m);
+    for (float l : render(scene(single), o, 2)) EXPECT_EQ(l, 1.0f);
+    for (float l : render(scene(both), o, 2)) EXPECT_EQ(l, 0.0f);
+  }
+  // The share of the view culling leaves out (the note the command line prints).
+  {
+    const RenderOptions o = options(4);
+    const Renderer culled(scene(single), o), drawn(scene(both), o);
+    EXPECT_EQ(culled_view_share(culled.world(), culled.camera()), 1.0);
+    EXPECT_EQ(culled_view_share(drawn.world(), drawn.camera()), 0.0);
+  }
+  // PPM follows both of the glass's delta branches (SPPM picks one at random per pass).
+  for (float l : render(scene(glass), options(4), 1)) {
+    EXPECT_GT(l, 0.8f);  // through thin glass at normal incidence, less Schlick's F
+    EXPECT_LT(l, 0.99f);
+  }
+}
+
+// World::camera_enclosure (the warning that an environment cannot light what the camera sees):
+// a camera inside a closed double-sided box, with a smaller box beside it, is enclosed, the
+// outer box last in every direction; single-sided, the box's inner faces are its backs, which
+// the camera sees through (camera_hit), so the environment is in view and nothing is enclosed;
+// with one face of the double-sided box missing the camera sees out as well.
+TEST(MaterialRender, CameraEnclosureNamesTheOutermostShell) {
+  auto world_of = [](bool double_sided, bool open) {
+    SceneBuilder b;
+    Material m = Material::lambertian(vec3(0.5f));
+    m.double_sided = double_sided;
+    const uint32_t mat = b.material(m);
+    const vec3 c(0.0f), h(5.0f);
+    const vec3 x(h.x, 0, 0), y(0, h.y, 0), z(0, 0, h.z);
+    b.quad(c + x, y, z, mat);
+    b.quad(c - x, z, y, mat);
+    b.quad(c + y, z, x, mat);
+    b.quad(c - y, x, z, mat);
+    b.quad(c + z, x, y, mat);
+    if (!open) b.quad(c - z, y, x, mat);
+    b.quad(vec3(2, 0, 0), vec3(0.5f, 0, 0), vec3(0, 0.5f, 0), mat);  // inside, not outermost
+    b.s.environment = Environment{"the sky", 1, 1, {vec3(1.0f)}};
+    return std::make_unique<World>(b.done());
+  };
+  const auto closed = world_of(true, false);
+  const auto e = closed->camera_enclosure(vec3(0.5f, 0.5f, 0.5f));
+  ASSERT_TRUE(e.has_value());
+  // Every direction ends on one of the outer box's faces: six meshes, the share of each about
+  // a sixth, all above a tenth; the three most frequent are listed.
+  ASSERT_EQ(e->outermost.size(), 3u);
+  for (const auto& [mesh, share] : e->outermost) {
+    EXPECT_LT(mesh, 6u);
+    EXPECT_GT(share, 0.1);
+  }
+  EXPECT_FALSE(world_of(false, false)->camera_enclosure(vec3(0.5f)).has_value());
+  EXPECT_FALSE(world_of(true, true)->camera_enclosure(vec3(0.5f)).has_value());
 }
 
 TEST(MaterialRender, VolumetricGlassSlabTransmitsByFresnelAndBeerLambert) {

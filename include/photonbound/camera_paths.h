@@ -56,4 +56,9 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
                             std::span<MeasurementPoint> points, std::span<GlossyPoint> glossy,
                             std::span<PassGather> out);
 
+// The share of the camera's pixel-centre rays (on a grid of at most 128 x 128 of them) whose
+// first hit passed through the back of a single-sided face (World::camera_hit): what glTF's
+// back-face culling leaves out of the view, for a note to the user.
+double culled_view_share(const World& world, const PinholeCamera& camera);
+
 }  // namespace pb

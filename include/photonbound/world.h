@@ -9,6 +9,7 @@
 #include "photonbound/surface.h"
 #include "photonbound/texture.h"
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -74,6 +75,28 @@ class World {
   bool trace(const vec3& p, const vec3& ng, float error, const vec3& dir, Hit& hit) const {
     return accel_.intersect(spawn(p, ng, error, dir), dir, 0.0f, INFINITY, hit);
   }
+  // The first surface a camera ray from `origin` sees. glTF culls the back faces of a material
+  // that is not doubleSided ("back-face culling is enabled", glTF 2.0 section 3.9.5), so the
+  // camera sees through them, as every glTF viewer draws the scene: a camera placed inside a
+  // vehicle's single-sided shell sees the street. Transmissive materials keep both sides (a
+  // camera under water sees the surface from below). Only the camera's first ray culls: light,
+  // shadows and the surfaces seen through mirrors and glass meet both sides of every surface.
+  // Returns the number of faces passed through in `culled` (at most kMaxCulledFaces; beyond,
+  // the last one is what the ray sees).
+  bool camera_hit(const vec3& origin, const vec3& dir, Hit& hit, int* culled = nullptr) const;
+  static constexpr int kMaxCulledFaces = 64;
+
+  // Whether the camera at p is enclosed: in none of 256 directions spread over the sphere does
+  // its ray (culling as camera_hit does) reach the environment unobstructed. Then `outermost`
+  // lists the meshes such rays meet last, passing through everything, before they would reach
+  // it, with the share of directions each is last in: those of at least a tenth, the most
+  // frequent first, at most three (a sky box or dome made for viewers, and the ground below).
+  // None when some direction is open.
+  struct Enclosure {
+    std::vector<std::pair<uint32_t, double>> outermost;  // index into Scene::meshes, share
+  };
+  std::optional<Enclosure> camera_enclosure(const vec3& p) const;
+
   // True when the segment from `origin` (already spawned off its surface) toward dir is blocked
   // before the point at `dist`, less `margin`: the distance within which that point's own
   // surface may be found by rounding (DirectSample::margin; 0 for a point light, and dist is
