@@ -120,8 +120,7 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
       std::string outer;
       for (const auto& [mesh, share] : shell->outermost) {
         std::ostringstream item;
-        item << "'" << sc.meshes[mesh].name << "' in " << std::setprecision(3) << 100.0 * share
-             << "%";
+        item << "'" << mesh << "' in " << std::setprecision(3) << 100.0 * share << "%";
         outer += (outer.empty() ? " (outermost: mesh " : ", ") + item.str();
       }
       if (!outer.empty()) outer += " of the directions)";

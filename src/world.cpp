@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
 
 namespace pb {
 
@@ -94,10 +95,11 @@ std::optional<World::Enclosure> World::camera_enclosure(const vec3& p) const {
     }
     ++last_count[last];
   }
+  std::map<std::string, uint32_t> by_name;
+  for (uint32_t m = 0; m < last_count.size(); ++m) by_name[scene_.meshes[m].name] += last_count[m];
   Enclosure e;
-  for (uint32_t m = 0; m < last_count.size(); ++m)
-    if (last_count[m] * 10 >= kDirections)
-      e.outermost.push_back({m, double(last_count[m]) / kDirections});
+  for (const auto& [name, count] : by_name)
+    if (count * 10 >= kDirections) e.outermost.push_back({name, double(count) / kDirections});
   std::stable_sort(e.outermost.begin(), e.outermost.end(),
                    [](const auto& a, const auto& b) { return a.second > b.second; });
   if (e.outermost.size() > 3) e.outermost.resize(3);

@@ -92,8 +92,9 @@ class World {
   // it, with the share of directions each is last in: those of at least a tenth, the most
   // frequent first, at most three (a sky box or dome made for viewers, and the ground below).
   // None when some direction is open.
+  // Meshes are counted by name: the primitives of one glTF mesh are one shell.
   struct Enclosure {
-    std::vector<std::pair<uint32_t, double>> outermost;  // index into Scene::meshes, share
+    std::vector<std::pair<std::string, double>> outermost;  // mesh name, share
   };
   std::optional<Enclosure> camera_enclosure(const vec3& p) const;
 
