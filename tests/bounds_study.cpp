@@ -666,6 +666,12 @@ void modelnull_experiment() {
 
 // The model check on any file (PB_STUDY_FILE, PB_STUDY_SIZE, default 48): the share of
 // state-channels with |z| > 3 by the state's photon count, to see where a refutation comes from.
+double median_of(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + long(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
 void modelfile_experiment() {
   const char* file = std::getenv("PB_STUDY_FILE");
   if (!file) return;
@@ -677,16 +683,26 @@ void modelfile_experiment() {
   o.seed = seed ? uint64_t(std::atoll(seed)) : 4u;
   Renderer r(load_gltf(o.scene), o);
   std::printf(
-      "| passes | photons | channels | share z>3 | mean z^2 | mean z "
-      "|\n|---|---|---|---|---|---|\n");
+      "| passes | photons | channels | share z>3 | mean z^2 | mean z | two-scale states | share "
+      "z>3 | median bias / sd there |\n|---|---|---|---|---|---|---|---|---|\n");
   for (uint64_t passes : {4u, 16u, 64u}) {
     while (r.passes() < passes) r.step();
-    const uint64_t edges[] = {5, 10, 20, 50, 100, 1000, ~0ull};
-    double n[7] = {}, d[7] = {}, z2[7] = {}, zs[7] = {};
+    const uint64_t edges[] = {0, 5, 10, 20, 50, 100, 1000, ~0ull};
+    double n[8] = {}, d[8] = {}, z2[8] = {}, zs[8] = {}, sn[8] = {}, sd[8] = {};
+    std::vector<double> ratios[8];  // |16/15 mean Y| / sum of the channels' noise sd, |z| > 3
     for (const PointState& st : r.states()) {
       const PointEstimate e = estimate(st, r.passes(), double(r.options().photons_per_pass));
       int b = 0;
       while (st.photons >= edges[b + 1]) ++b;
+      if (e.scale_z != 0.0) {
+        sn[b] += 1;
+        sd[b] += std::fabs(e.scale_z) > kSlopeZ;
+        if (std::fabs(e.scale_z) > kSlopeZ) {
+          const double sigma =
+              std::sqrt(e.variance.x) + std::sqrt(e.variance.y) + std::sqrt(e.variance.z);
+          ratios[b].push_back(std::fabs(16.0 / 15.0 * st.scale_mean) / sigma);
+        }
+      }
       for (int c = 0; c < 3; ++c) {
         const double z = e.slope_z[c];
         if (z == 0.0) continue;
@@ -696,10 +712,13 @@ void modelfile_experiment() {
         zs[b] += z;
       }
     }
-    for (int b = 0; b < 6; ++b)
-      if (n[b] > 0)
-        std::printf("| %llu | %llu+ | %.0f | %.3f | %.2f | %.2f |\n", (unsigned long long)passes,
-                    (unsigned long long)edges[b], n[b], d[b] / n[b], z2[b] / n[b], zs[b] / n[b]);
+    for (int b = 0; b < 7; ++b)
+      if (n[b] > 0 || sn[b] > 0)
+        std::printf("| %llu | %llu+ | %.0f | %.3f | %.2f | %.2f | %.0f | %.3f | %.2f |\n",
+                    (unsigned long long)passes, (unsigned long long)edges[b], n[b],
+                    n[b] > 0 ? d[b] / n[b] : 0.0, n[b] > 0 ? z2[b] / n[b] : 0.0,
+                    n[b] > 0 ? zs[b] / n[b] : 0.0, sn[b], sn[b] > 0 ? sd[b] / sn[b] : 0.0,
+                    median_of(ratios[b]));
   }
 }
 
