@@ -8,6 +8,9 @@
 
 namespace pb {
 
+// Passes over (ESTIMATOR.md section 10) a path may take beyond --max-depth, by roulette.
+constexpr int kPassOverDepth = 16;
+
 size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
                             std::span<MeasurementPoint> points, std::span<GlossyPoint> glossy,
                             std::span<PassGather> out) {
@@ -92,7 +95,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
         }
         if (in.boundary) {
           disc = in.boundary->moments(point.triangle, point.position, point.normal, radii[k]);
-          if (disc.mass < kValidKernelMass && depth < in.max_depth) {
+          if (disc.mass < kValidKernelMass) {
             // Almost all of the disc is off reachable surface: photons cannot estimate the
             // radiance here (ESTIMATOR.md section 10, "Passing over"), but a path can:
             // L = L_direct + integral of f L cos over the non-delta part, by one next-event
@@ -104,6 +107,15 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
             }
             point = MeasurementPoint{};
             disc = DiscMoments{};
+            // At --max-depth the path does not keep the point (its pixel would be unknown for
+            // good: validity is the least mass over the passes, and over thousands of passes a
+            // rare deep path comes): it goes on by Russian roulette, 1/2 with weight 2, so the
+            // indirect part keeps its mean; kPassOverDepth more vertices cut it (no point, the
+            // truncation every depth limit makes, here of weight 2^-16).
+            if (depth >= in.max_depth) {
+              if (depth >= in.max_depth + kPassOverDepth || rng.next_float() >= 0.5f) break;
+              w *= 2.0f;
+            }
             BsdfSample b;
             if (!bsdf.sample_non_delta_part(wo, rng, b)) break;
             weight = w * b.weight;
