@@ -78,6 +78,8 @@ BsdfParams BsdfParams::of(const Material& m) {
   p.specular_color = m.specular_color;
   p.transmission = m.transmission;
   p.thin = m.thin;
+  p.clearcoat = m.clearcoat;
+  p.clearcoat_roughness = m.clearcoat_roughness;
   return p;
 }
 
@@ -89,7 +91,8 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
   brdf_.specular = p.specular;
   brdf_.specular_color = p.specular_color;
   const float m = std::clamp(p.metallic, 0.0f, 1.0f), t = std::clamp(p.transmission, 0.0f, 1.0f);
-  if (m == 0.0f && t == 0.0f && p.specular == 0.0f) {  // KHR_materials_specular: no layer
+  const float coat = std::clamp(p.clearcoat, 0.0f, 1.0f);
+  if (m == 0.0f && t == 0.0f && p.specular == 0.0f && coat == 0.0f) {  // no layer at all
     brdf_.metallic = 0.0f;
     reflect_ = 1.0f;
     return;  // kind_ Lambertian
@@ -100,9 +103,23 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
   reflect_ = m + (1.0f - m) * (1.0f - t);
   brdf_.metallic = reflect_ > 0.0f ? m / reflect_ : 0.0f;
   smooth_ = p.roughness < mirror_roughness;
+  // A Lambertian under a coat: its layer reflects nothing, so it has no mirror either.
+  if (coat > 0.0f && m == 0.0f && p.specular == 0.0f) smooth_ = false;
   const float opaque = (1.0f - m) * (1.0f - t);
-  const bool non_delta = reflect_ > 0.0f && (!smooth_ || opaque > 0.0f);
-  const bool delta = glass_ > 0.0f || (smooth_ && reflect_ > 0.0f);
+  base_non_delta_ = reflect_ > 0.0f && (!smooth_ || opaque > 0.0f);
+  bool non_delta = base_non_delta_;
+  bool delta = glass_ > 0.0f || (smooth_ && reflect_ > 0.0f);
+  if (coat > 0.0f) {  // KHR_materials_clearcoat
+    coat_ = coat;
+    coat_smooth_ = p.clearcoat_roughness < mirror_roughness;
+    coat_roughness_ = p.clearcoat_roughness;
+    coat_alpha_ = ggx_alpha(p.clearcoat_roughness);
+    const float len = glm::length(p.coat_normal);
+    nc_ = len > 0.0f ? p.coat_normal / len : ns;
+    if (glm::dot(nc_, ng) < 0.0f) nc_ = -nc_;
+    non_delta = non_delta || !coat_smooth_;
+    delta = delta || coat_smooth_;
+  }
   kind_ = non_delta ? Kind::Layered : Kind::Delta;
   has_delta_ = non_delta && delta;
 }
@@ -130,6 +147,11 @@ vec3 Bsdf::eval_local(const vec3& wo, const vec3& wi, float* pdf) const {
     if (pdf) *pdf = ggx_reflection_pdf(wo, wi, ggx_alpha(brdf_.roughness));
     return reflect_ * brdf_.eval_specular(wo, wi);
   }
+  if (pdf) *pdf = wi.z / kPi;
+  return diffuse_term(wo, wi);
+}
+
+vec3 Bsdf::diffuse_term(const vec3& wo, const vec3& wi) const {
   // The mirror limit of appendix B's dielectric: the GGX layer is a delta branch, the diffuse
   // base keeps its weight 1 - max F(v.h) at this pair's half vector (v.h averaged over both
   // directions, so that f stays reciprocal bit for bit). base_part() is the same term of a
@@ -138,7 +160,6 @@ vec3 Bsdf::eval_local(const vec3& wo, const vec3& wi, float* pdf) const {
   const float v_h = 0.5f * (glm::dot(wo, h) + glm::dot(wi, h));
   const vec3 f0 = brdf_.dielectric_f0();
   const vec3 fr = f0 + (vec3(brdf_.dielectric_f90()) - f0) * schlick_weight(v_h);
-  if (pdf) *pdf = wi.z / kPi;
   const float opaque = reflect_ * (1.0f - brdf_.metallic);
   return (opaque * (1.0f - max_component(fr)) / kPi) * brdf_.base_color;
 }
@@ -148,8 +169,85 @@ vec3 Bsdf::eval(const vec3& wo, const vec3& wi) const {
   // Both directions on one side of the true surface: reflection only.
   if (glm::dot(wo, ng_) * glm::dot(wi, ng_) <= 0.0f) return vec3(0.0f);
   if (kind_ == Kind::Lambertian) return diffuse_f();
+  if (coat_ > 0.0f) return eval_with_view(wo, wi, wo, nullptr);
   const Frame f(glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_);
   return eval_local(f.local(wo), f.local(wi), nullptr);
+}
+
+float Bsdf::coat_weight(const vec3& v) const {
+  if (coat_ == 0.0f) return 0.0f;
+  // fresnel_coat: f0 = ((1 - 1.5) / (1 + 1.5))^2 = 0.04, Schlick at |v.n_c|.
+  return coat_ * schlick_fresnel(0.04f, std::min(1.0f, std::fabs(glm::dot(v, nc_))));
+}
+
+float Bsdf::coat_dv(const vec3& wo, const vec3& wi, float* pdf) const {
+  if (pdf) *pdf = 0.0f;
+  const Frame f(glm::dot(wo, ng_) > 0.0f ? nc_ : -nc_);
+  const vec3 lo = f.local(wo), li = f.local(wi);
+  if (lo.z <= 0.0f || li.z <= 0.0f) return 0.0f;
+  if (pdf) *pdf = ggx_reflection_pdf(lo, li, coat_alpha_);
+  // glTF's specular_brdf without its Fresnel (the coat's is in k): V D.
+  return ggx_d(glm::normalize(lo + li), coat_alpha_) * ggx_visibility(lo.z, li.z, coat_alpha_);
+}
+
+Bsdf::Terms Bsdf::terms() const {
+  const bool lobe = base_non_delta_ && !smooth_, coat = coat_lobe();
+  switch (part_) {
+    case Part::Lobe:
+      return {false, lobe && follow_lobe_, coat && follow_coat_};
+    case Part::Base:
+      return {base_non_delta_, lobe && !follow_lobe_, coat && !follow_coat_};
+    default:
+      return {base_non_delta_, lobe, coat};
+  }
+}
+
+void Bsdf::term_albedos(const vec3& wo, float a[3]) const {
+  // Estimates only (they choose among the terms; the weights stay exact), as
+  // non_delta_albedo's: the diffuse base's (1 - f0) max(base), Schlick's Fresnel at the macro
+  // normal for the base's lobe, each x (1 - k), and k for the coat's lobe (D V has albedo
+  // about 1). The floor keeps each term's probability above 0.
+  const Terms t = terms();
+  const float k = coat_weight(wo), cos_o = std::fabs(glm::dot(wo, ns_));
+  const float mu = brdf_.metallic, f0 = max_component(brdf_.dielectric_f0());
+  const float under = (1.0f - k) * reflect_;
+  a[0] = t.diffuse
+             ? std::max(under * (1.0f - mu) * (1.0f - f0) * max_component(brdf_.base_color), 1e-3f)
+             : 0.0f;
+  a[1] = t.lobe ? std::max(under * ((1.0f - mu) * (f0 + (brdf_.dielectric_f90() - f0) *
+                                                            schlick_weight(cos_o)) +
+                                    mu * max_component(schlick_fresnel(brdf_.base_color, cos_o))),
+                           1e-3f)
+                : 0.0f;
+  a[2] = t.coat ? std::max(k, 1e-3f) : 0.0f;
+}
+
+vec3 Bsdf::eval_with_view(const vec3& wo, const vec3& wi, const vec3& v, float* pdf) const {
+  const Frame f(glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_);
+  const vec3 lo = f.local(wo), li = f.local(wi);
+  const Terms t = terms();
+  vec3 base(0.0f);
+  float p[3] = {0.0f, 0.0f, 0.0f};
+  if (lo.z > 0.0f && li.z > 0.0f) {
+    if (t.diffuse) {
+      base += diffuse_term(lo, li);
+      p[0] = li.z / kPi;
+    }
+    if (t.lobe) {
+      base += reflect_ * brdf_.eval_specular(lo, li);
+      p[1] = ggx_reflection_pdf(lo, li, ggx_alpha(brdf_.roughness));
+    }
+  }
+  const float k = coat_weight(v);
+  vec3 out = (1.0f - k) * base;
+  if (t.coat) out += vec3(k * coat_dv(wo, wi, &p[2]));
+  if (pdf) {  // the mixture sample_non_delta draws from (its choice reads wo alone)
+    float a[3];
+    term_albedos(wo, a);
+    const float sum = a[0] + a[1] + a[2];
+    *pdf = sum > 0.0f ? (a[0] * p[0] + a[1] * p[1] + a[2] * p[2]) / sum : 0.0f;
+  }
+  return out;
 }
 
 namespace {
@@ -184,21 +282,38 @@ float ggx_term_bound(float zo, float alpha, Fresnel&& fresnel) {
 
 }  // namespace
 
+float Bsdf::lobe_bound(const vec3& wo) const {
+  const float mu = brdf_.metallic;
+  const float zo = std::max(std::fabs(glm::dot(wo, ns_)), kMinCosine);
+  const vec3 f0 = brdf_.dielectric_f0();
+  const float f90 = brdf_.dielectric_f90();
+  return ggx_term_bound(zo, ggx_alpha(brdf_.roughness), [&](float v_h) {
+    const float w = schlick_weight(v_h);
+    return (1.0f - mu) * max_component(f0 + (vec3(f90) - f0) * w) +
+           mu * max_component(schlick_fresnel(brdf_.base_color, v_h));
+  });
+}
+
 vec3 Bsdf::max_f(const vec3& wo) const {
   if (kind_ == Kind::Lambertian) return diffuse_f();
   if (kind_ == Kind::Delta) return vec3(0.0f);
   const float mu = brdf_.metallic;
   const vec3 diffuse = (1.0f - mu) / kPi * brdf_.base_color;  // 1 - max F <= 1
+  if (coat_ > 0.0f) {  // (1 - k) f_material + k D V, k read at wo (the gather's view)
+    const Terms t = terms();
+    vec3 base(0.0f);
+    if (t.diffuse) base += reflect_ * diffuse;
+    if (t.lobe) base += vec3(reflect_ * lobe_bound(wo));
+    const float k = coat_weight(wo);
+    vec3 out = (1.0f - k) * base;
+    if (t.coat) {
+      const float zo = std::max(std::fabs(glm::dot(wo, nc_)), kMinCosine);
+      out += vec3(k * ggx_term_bound(zo, coat_alpha_, [](float) { return 1.0f; }));
+    }
+    return out;
+  }
   if (smooth_ || part_ == Part::Base) return reflect_ * diffuse;
-  const float zo = std::max(std::fabs(glm::dot(wo, ns_)), kMinCosine);
-  const vec3 f0 = brdf_.dielectric_f0();
-  const float f90 = brdf_.dielectric_f90();
-  const float spec = ggx_term_bound(zo, ggx_alpha(brdf_.roughness), [&](float v_h) {
-    const float w = schlick_weight(v_h);
-    return (1.0f - mu) * max_component(f0 + (vec3(f90) - f0) * w) +
-           mu * max_component(schlick_fresnel(brdf_.base_color, v_h));
-  });
-  return reflect_ * ((part_ == Part::Lobe ? vec3(0.0f) : diffuse) + vec3(spec));
+  return reflect_ * ((part_ == Part::Lobe ? vec3(0.0f) : diffuse) + vec3(lobe_bound(wo)));
 }
 
 float Bsdf::pdf(const vec3& wo, const vec3& wi) const {
@@ -209,7 +324,10 @@ float Bsdf::pdf(const vec3& wo, const vec3& wi) const {
     return std::max(0.0f, glm::dot(wi, ns)) / kPi;  // cosine-weighted about the shading normal
   const Frame f(ns);
   float p = 0.0f;
-  eval_local(f.local(wo), f.local(wi), &p);
+  if (coat_ > 0.0f)
+    eval_with_view(wo, wi, wo, &p);
+  else
+    eval_local(f.local(wo), f.local(wi), &p);
   return has_delta_ && part_ == Part::All ? (1.0f - delta_probability(wo)) * p : p;
 }
 
@@ -229,11 +347,16 @@ float Bsdf::non_delta_albedo(float cos_o) const {
 float Bsdf::delta_probability(const vec3& wo) const {
   if (kind_ != Kind::Layered) return kind_ == Kind::Delta ? 1.0f : 0.0f;
   if (!has_delta_) return 0.0f;
-  SpecularBranch b[2];
+  SpecularBranch b[kMaxDeltaBranches];
   const int n = delta_branches(wo, Transport::Importance, b);
   float wd = 0.0f;
   for (int k = 0; k < n; ++k) wd += average(b[k].weight);
-  const float wn = non_delta_albedo(std::fabs(glm::dot(wo, ns_)));
+  float wn = non_delta_albedo(std::fabs(glm::dot(wo, ns_)));
+  if (coat_ > 0.0f) {  // the coat's lobe (if rough) and the material under it
+    float a[3];
+    term_albedos(wo, a);
+    wn = a[0] + a[1] + a[2];
+  }
   return wd > 0.0f ? wd / (wd + wn) : 0.0f;
 }
 
@@ -254,7 +377,7 @@ bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) con
     return true;
   }
   if (kind_ == Kind::Delta) return sample_delta(wo, rng, mode, out);
-  if (part_ != Part::All) return sample_non_delta(wo, rng, out);  // one term, no delta part
+  if (part_ != Part::All) return sample_non_delta(wo, rng, mode, out);  // one term, no delta
   const float pd = delta_probability(wo);
   if (pd > 0.0f) {
     const float u = rng.next_float();  // which part, then that part's numbers
@@ -264,7 +387,7 @@ bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) con
       return true;
     }
   }
-  if (!sample_non_delta(wo, rng, out)) return false;
+  if (!sample_non_delta(wo, rng, mode, out)) return false;
   out.weight /= 1.0f - pd;
   out.pdf *= 1.0f - pd;
   return true;
@@ -273,10 +396,61 @@ bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) con
 bool Bsdf::sample_non_delta_part(const vec3& wo, Rng& rng, BsdfSample& out) const {
   if (kind_ == Kind::Lambertian) return sample(wo, rng, Transport::Radiance, out);
   if (kind_ == Kind::Delta) return false;
-  return sample_non_delta(wo, rng, out);
+  return sample_non_delta(wo, rng, Transport::Radiance, out);
 }
 
-bool Bsdf::sample_non_delta(const vec3& wo, Rng& rng, BsdfSample& out) const {
+bool Bsdf::sample_non_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const {
+  if (coat_ == 0.0f) return sample_base(wo, rng, out);
+  // One of this part's terms by its albedo estimate, then the weight of the whole part over
+  // the mixture density (one-sample, Veach thesis 9.2.4's balance heuristic), with the view
+  // where the light leaves: wo for radiance, wi for photons.
+  const bool front = glm::dot(wo, ng_) > 0.0f;
+  const vec3 ng = front ? ng_ : -ng_, ns = front ? ns_ : -ns_;
+  const Frame fs(ns);
+  if (fs.local(wo).z <= 0.0f) return false;  // seen from below the shading hemisphere
+  float a[3];
+  term_albedos(wo, a);
+  const float sum = a[0] + a[1] + a[2];
+  if (!(sum > 0.0f)) return false;
+  int pick = a[2] > 0.0f ? 2 : a[1] > 0.0f ? 1 : 0;  // the last term there is
+  if ((a[0] > 0.0f) + (a[1] > 0.0f) + (a[2] > 0.0f) > 1) {
+    const float u = rng.next_float() * sum;
+    float acc = 0.0f;
+    for (int j = 0; j < 3; ++j) {
+      acc += a[j];
+      if (a[j] > 0.0f && u < acc) {
+        pick = j;
+        break;
+      }
+    }
+  }
+  const float u1 = rng.next_float(), u2 = rng.next_float();
+  vec3 wi;
+  if (pick == 0) {
+    wi = sample_cosine_hemisphere(ns, u1, u2);
+  } else {
+    const Frame f(pick == 1 ? ns : front ? nc_ : -nc_);
+    const vec3 lo = f.local(wo);
+    if (lo.z <= 0.0f) return false;
+    const float alpha = pick == 1 ? ggx_alpha(brdf_.roughness) : coat_alpha_;
+    const vec3 h = sample_ggx_vndf(lo, alpha, u1, u2);
+    const vec3 li = 2.0f * glm::dot(lo, h) * h - lo;
+    if (li.z <= 0.0f) return false;
+    wi = f.world(li);
+  }
+  if (glm::dot(wi, ng) <= 0.0f) return false;  // below the true surface: absorbed
+  float p = 0.0f;
+  const vec3 value = eval_with_view(wo, wi, mode == Transport::Radiance ? wo : wi, &p);
+  const float cos_i = glm::dot(wi, ns);
+  if (!(p > 0.0f) || !(cos_i > 0.0f)) return false;
+  out.wi = wi;
+  out.weight = value * (cos_i / p);
+  out.pdf = p;
+  out.delta = false;
+  return true;
+}
+
+bool Bsdf::sample_base(const vec3& wo, Rng& rng, BsdfSample& out) const {
   const bool front = glm::dot(wo, ng_) > 0.0f;
   const vec3 ng = front ? ng_ : -ng_;
   const Frame f(front ? ns_ : -ns_);
@@ -313,7 +487,7 @@ bool Bsdf::sample_non_delta(const vec3& wo, Rng& rng, BsdfSample& out) const {
 }
 
 bool Bsdf::sample_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const {
-  SpecularBranch b[2];
+  SpecularBranch b[kMaxDeltaBranches];
   const int n = delta_branches(wo, mode, b);
   if (n == 0) return false;
   int pick = 0;
@@ -326,6 +500,11 @@ bool Bsdf::sample_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& ou
       pick = 1;
       p = 1.0f - p;
     }
+  } else if (n == 3) {
+    const float a[3] = {average(b[0].weight), average(b[1].weight), average(b[2].weight)};
+    const float total = a[0] + a[1] + a[2], u = rng.next_float() * total;
+    pick = u < a[0] ? 0 : u < a[0] + a[1] ? 1 : 2;
+    p = a[pick] / total;
   }
   if (!(p > 0.0f)) return false;
   out.wi = b[pick].dir;
@@ -335,8 +514,29 @@ bool Bsdf::sample_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& ou
   return true;
 }
 
-int Bsdf::delta_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) const {
+int Bsdf::delta_branches(const vec3& wo, Transport mode,
+                         SpecularBranch out[kMaxDeltaBranches]) const {
   if (kind_ == Kind::Lambertian) return 0;
+  const int n = base_branches(wo, mode, out);
+  if (coat_ == 0.0f) return n;
+  // Under the coat: each branch x (1 - k), k at the view (wo, or for photons the branch's own
+  // direction); a smooth coat adds its mirror about n_c, of weight k.
+  for (int j = 0; j < n; ++j)
+    out[j].weight *= 1.0f - coat_weight(mode == Transport::Radiance ? wo : out[j].dir);
+  if (!coat_smooth_) return n;
+  const bool front = glm::dot(wo, ng_) > 0.0f;
+  const vec3 dir = reflect_checked(wo, front ? nc_ : -nc_, front ? ng_ : -ng_);
+  const float k = coat_weight(mode == Transport::Radiance ? wo : dir);
+  if (!(k > 0.0f)) return n;
+  if (n > 0 && out[0].dir == dir) {
+    out[0].weight += vec3(k);
+    return n;
+  }
+  out[n] = {dir, vec3(k)};
+  return n + 1;
+}
+
+int Bsdf::base_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) const {
   const bool front = glm::dot(wo, ng_) > 0.0f;
   const vec3 ng = front ? ng_ : -ng_;  // normals on wo's side
   const vec3 ns = front ? ns_ : -ns_;
@@ -383,25 +583,46 @@ int Bsdf::delta_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) 
 }
 
 bool Bsdf::has_lobe_below(float below) const {
+  if (coat_ > 0.0f)
+    return kind_ == Kind::Layered && part_ == Part::All &&
+           (follows_lobe(below) || follows_coat(below));
   if (kind_ != Kind::Layered || smooth_ || part_ != Part::All || !(brdf_.roughness < below))
     return false;
   return brdf_.metallic > 0.0f || brdf_.specular > 0.0f;
 }
 
-float Bsdf::lobe_probability(const vec3& wo) const {
+bool Bsdf::follows_lobe(float below) const {
+  return base_non_delta_ && !smooth_ && brdf_.roughness < below &&
+         (brdf_.metallic > 0.0f || brdf_.specular > 0.0f);
+}
+
+bool Bsdf::follows_coat(float below) const { return coat_lobe() && coat_roughness_ < below; }
+
+float Bsdf::lobe_probability(const vec3& wo, float below) const {
+  if (coat_ > 0.0f) {  // the followed terms' share of the albedo estimates
+    float all[3], lobe[3];
+    term_albedos(wo, all);
+    lobe_part(below).term_albedos(wo, lobe);
+    const float sum = all[0] + all[1] + all[2];
+    return sum > 0.0f ? std::min(1.0f, (lobe[0] + lobe[1] + lobe[2]) / sum) : 0.0f;
+  }
   // specular_probability reads only the cosine of wo with the shading normal.
   return brdf_.specular_probability(vec3(0.0f, 0.0f, std::fabs(glm::dot(wo, ns_))));
 }
 
-Bsdf Bsdf::base_part() const {
+Bsdf Bsdf::base_part(float below) const {
   Bsdf b = *this;
   b.part_ = Part::Base;
+  b.follow_lobe_ = follows_lobe(below);
+  b.follow_coat_ = follows_coat(below);
   return b;
 }
 
-Bsdf Bsdf::lobe_part() const {
+Bsdf Bsdf::lobe_part(float below) const {
   Bsdf b = *this;
   b.part_ = Part::Lobe;
+  b.follow_lobe_ = follows_lobe(below);
+  b.follow_coat_ = follows_coat(below);
   return b;
 }
 

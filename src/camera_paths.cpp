@@ -66,9 +66,9 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
           const GlossyPoint whole{0, wo, s.bsdf};
           point.f = w;
           emission += direct_light(in.world, point, &whole, rng);
-          const float p_lobe = s.bsdf.lobe_probability(wo);
+          const float p_lobe = s.bsdf.lobe_probability(wo, in.follow_roughness);
           if (p_lobe >= 1.0f || (p_lobe > 0.0f && rng.next_float() < p_lobe)) {
-            const GlossyPoint lobe{0, wo, s.bsdf.lobe_part()};
+            const GlossyPoint lobe{0, wo, s.bsdf.lobe_part(in.follow_roughness)};
             weight = w / p_lobe;
             point = MeasurementPoint{};  // no visible point here
             BsdfSample b;
@@ -83,7 +83,8 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
             continue;
           }
           w /= 1.0f - p_lobe;
-          bsdf = s.bsdf.base_part();  // its direct light is counted: next_event_pass skips it
+          bsdf = s.bsdf.base_part(
+              in.follow_roughness);  // its direct light is counted: next_event_pass skips it
           direct_counted = true;
         }
         const bool lambertian = bsdf.is_lambertian();

@@ -65,7 +65,7 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
       if (!s.bsdf.has_delta()) continue;
     }
     if (v.depth >= max_depth) continue;  // the chain is cut
-    SpecularBranch branches[2];
+    SpecularBranch branches[kMaxDeltaBranches];
     const int n = s.bsdf.delta_branches(wo, Transport::Radiance, branches);
     for (int k = 0; k < n; ++k) {
       const vec3 w = weight * branches[k].weight;

@@ -13,8 +13,9 @@
 // Material rules (README "Materials" repeats them): glTF 2.0's metallic-roughness material with
 // glTF's defaults (metallicFactor and roughnessFactor 1: a material without
 // pbrMetallicRoughness is a rough metal), KHR_materials_ior, _specular, _transmission,
-// _volume and _emissive_strength, textures (base colour, metallic-roughness, normal,
-// emissive, transmission, specular, specular colour) with KHR_texture_transform, alphaMode
+// _volume, _clearcoat and _emissive_strength, textures (base colour, metallic-roughness, normal,
+// emissive, transmission, specular, specular colour, the clear coat's three) with
+// KHR_texture_transform, alphaMode
 // MASK cut-outs and doubleSided emitters. Factors must be in their documented ranges (a
 // reflectance above 1 creates energy) or the file is rejected; what is rendered approximately
 // (BLEND, rough transmission) is warned about. Primitives without a material share one
@@ -106,6 +107,12 @@ tinygltf::Model parse(const std::string& path, const std::vector<unsigned char>&
                         : !notes.empty()      ? notes[0]
                                               : "tinygltf could not read it and gave no reason";
     if (first.size() > 160) first = first.substr(0, 160) + "...";  // it may quote a data URI
+    // tinygltf's words for a buffer file that is not there ("File not found : NAME"): the file
+    // is not malformed, it is incomplete.
+    const std::string missing = "File not found : ";
+    if (first.rfind(missing, 0) == 0)
+      throw SceneError(path + ": the buffer file '" + first.substr(missing.size()) +
+                       "' it refers to cannot be opened (it is missing or unreadable)");
     throw SceneError(path + ": malformed glTF: " + first);
   }
   for (const std::string& l : notes) warnings.push_back("glTF: " + l);
@@ -151,12 +158,13 @@ Scene Loader::run(const std::vector<std::string>& parse_warnings) {
 
 void Loader::check_extensions() {
   static const std::set<std::string> known = {
-      "KHR_lights_punctual",        "KHR_materials_transmission",
-      "KHR_materials_ior",          "KHR_materials_emissive_strength",
-      "KHR_materials_specular",     "KHR_materials_volume",
-      "KHR_draco_mesh_compression", "EXT_meshopt_compression",
-      "KHR_mesh_quantization",      "KHR_texture_transform",
-      "KHR_texture_basisu",         "EXT_texture_webp"};  // basisu: the fallback image or a warning
+      "KHR_lights_punctual",     "KHR_materials_transmission",
+      "KHR_materials_ior",       "KHR_materials_emissive_strength",
+      "KHR_materials_specular",  "KHR_materials_volume",
+      "KHR_materials_clearcoat", "KHR_draco_mesh_compression",
+      "EXT_meshopt_compression", "KHR_mesh_quantization",
+      "KHR_texture_transform",   "KHR_texture_basisu",
+      "EXT_texture_webp"};  // basisu: the fallback image or a warning
   // Unknown extensions, even required ones, are rendered without (README "Scenes"): a material
   // extension then falls back to the core factors; data an unknown extension holds is missing,
   // and the accessors that lack it are refused with their own message.

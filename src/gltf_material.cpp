@@ -130,6 +130,32 @@ Material Loader::convert_material(size_t index) {  // the rules are in the comme
       warn(ml + ": KHR_materials_specular does not change a volume boundary (exact Fresnel)");
   }
 
+  // KHR_materials_clearcoat: a GGX layer (ior 1.5) over the whole material, weighted by
+  // clearcoat x Schlick's Fresnel at the coat normal's cosine with the view (Bsdf).
+  out.clearcoat = unit(ext_number(ext, ml, "KHR_materials_clearcoat", "clearcoatFactor", 0.0),
+                       "clearcoatFactor");
+  out.clearcoat_roughness =
+      unit(ext_number(ext, ml, "KHR_materials_clearcoat", "clearcoatRoughnessFactor", 0.0),
+           "clearcoatRoughnessFactor");
+  out.clearcoat_texture = ext_texture(ext, ml, "KHR_materials_clearcoat", "clearcoatTexture");
+  out.clearcoat_roughness_texture =
+      ext_texture(ext, ml, "KHR_materials_clearcoat", "clearcoatRoughnessTexture");
+  out.clearcoat_normal_texture =
+      ext_texture(ext, ml, "KHR_materials_clearcoat", "clearcoatNormalTexture");
+  if (out.clearcoat_normal_texture.present()) {
+    const tinygltf::Value& info = ext.at("KHR_materials_clearcoat").Get("clearcoatNormalTexture");
+    if (info.Has("scale")) {
+      const tinygltf::Value& v = info.Get("scale");
+      if (!v.IsNumber() || !std::isfinite(v.GetNumberAsDouble()))
+        fail(ml + ": KHR_materials_clearcoat.clearcoatNormalTexture.scale is not a finite number");
+      out.clearcoat_normal_scale = float(v.GetNumberAsDouble());
+    }
+  }
+  if (out.clearcoat == 0.0f) {  // the extension: clearcoatFactor 0 disables the whole layer
+    out.clearcoat_texture = out.clearcoat_roughness_texture = out.clearcoat_normal_texture =
+        TextureRef{};
+  }
+
   const double strength =
       ext_number(ext, ml, "KHR_materials_emissive_strength", "emissiveStrength", 1.0);
   if (gm.emissiveFactor.size() != 3) fail(ml + ": emissiveFactor must have 3 numbers");
@@ -139,6 +165,10 @@ Material Loader::convert_material(size_t index) {  // the rules are in the comme
       fail(ml + ": emission (emissiveFactor x emissiveStrength) must be finite and >= 0");
     out.emission[c] = float(e);
   }
+  if (out.clearcoat > 0.0f && out.emits())
+    warn(ml +
+         ": emission is not darkened by the clear coat (KHR_materials_clearcoat's "
+         "1 - clearcoat x Fresnel: 4% head-on, more toward grazing); it is rendered uncoated");
   out.double_sided = gm.doubleSided;
   if (gm.alphaMode == "MASK") {
     out.alpha_mode = AlphaMode::Mask;

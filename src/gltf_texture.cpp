@@ -157,7 +157,10 @@ TextureRef Loader::ext_texture(const tinygltf::ExtensionMap& ext, const std::str
 void Loader::add_tangents(Mesh& out, const tinygltf::Primitive& prim, const DracoPrimitive* dp,
                           const Xform& xf, const std::string& where) {
   const Material& mat = scene_.materials[out.material];
-  if (!mat.normal_texture.present()) return;
+  // One tangent space for both normal textures (KHR_materials_clearcoat asks them to share it).
+  const TextureRef& normal =
+      mat.normal_texture.present() ? mat.normal_texture : mat.clearcoat_normal_texture;
+  if (!normal.present()) return;
   if (const std::optional<View> tan = attribute(prim, dp, "TANGENT", where)) {
     if (tan->count != out.positions.size())
       fail(where + " has " + std::to_string(tan->count) + " tangents for " +
@@ -176,12 +179,12 @@ void Loader::add_tangents(Mesh& out, const tinygltf::Primitive& prim, const Drac
     }
     if (!out.tangents.empty()) return;
   }
-  const std::vector<vec2>& uv = out.texcoords[mat.normal_texture.texcoord];
+  const std::vector<vec2>& uv = out.texcoords[normal.texcoord];
   if (uv.empty()) return;  // no coordinates: the normal texture reads one texel (warned)
   std::vector<vec2> st(uv.size());
   for (size_t i = 0; i < uv.size(); ++i) {
     const vec2 both[2] = {uv[i], uv[i]};
-    st[i] = texture_coords(mat.normal_texture, both);
+    st[i] = texture_coords(normal, both);
   }
   out.tangents = compute_tangents(out, st);
 }

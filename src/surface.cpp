@@ -69,11 +69,25 @@ Surface World::surface(const Hit& hit) const {
   p.transmission *= lookup(images, m.transmission_texture, s.uv, false).x;
   p.specular *= lookup(images, m.specular_texture, s.uv, false).w;
   p.specular_color *= vec3(lookup(images, m.specular_color_texture, s.uv, true));
-  if (mesh.tangents && m.normal_texture.present()) {
+  if (p.clearcoat > 0.0f) {  // KHR_materials_clearcoat: clearcoat x R, roughness x G
+    p.clearcoat *= lookup(images, m.clearcoat_texture, s.uv, false).x;
+    p.clearcoat_roughness *= lookup(images, m.clearcoat_roughness_texture, s.uv, false).y;
+  }
+  if (mesh.tangents && (m.normal_texture.present() || m.clearcoat_normal_texture.present())) {
     const glm::vec4 t =
         w * mesh.tangents[i0] + hit.u * mesh.tangents[i1] + hit.v * mesh.tangents[i2];
-    const vec3 tex = vec3(lookup(images, m.normal_texture, s.uv, false));
-    s.ns = mapped_normal(s.ns, s.ng, t, tex, m.normal_scale);
+    // The coat's normal: its own texture, or the interpolated normal ("no normal mapping is
+    // applied to the clear coat layer, even if normal mapping is applied to the base").
+    if (p.clearcoat > 0.0f && m.clearcoat_normal_texture.present())
+      p.coat_normal = mapped_normal(s.ns, s.ng, t,
+                                    vec3(lookup(images, m.clearcoat_normal_texture, s.uv, false)),
+                                    m.clearcoat_normal_scale);
+    else
+      p.coat_normal = s.ns;
+    if (m.normal_texture.present()) {
+      const vec3 tex = vec3(lookup(images, m.normal_texture, s.uv, false));
+      s.ns = mapped_normal(s.ns, s.ng, t, tex, m.normal_scale);
+    }
   }
   s.bsdf = Bsdf(p, s.ng, s.ns, mirror_roughness_);
   return s;

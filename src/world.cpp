@@ -25,11 +25,12 @@ World::World(Scene scene, float mirror_roughness)
       face_normals_[first + t] = glm::normalize(glm::cross(p1 - p0, p2 - p0));
     }
     const Material& mat = scene_.materials[m.material];
-    const bool textured = mat.base_color_texture.present() ||
-                          mat.metallic_roughness_texture.present() ||
-                          mat.normal_texture.present() || mat.emissive_texture.present() ||
-                          mat.transmission_texture.present() || mat.specular_texture.present() ||
-                          mat.specular_color_texture.present() || mat.masked();
+    const bool textured =
+        mat.base_color_texture.present() || mat.metallic_roughness_texture.present() ||
+        mat.normal_texture.present() || mat.emissive_texture.present() ||
+        mat.transmission_texture.present() || mat.specular_texture.present() ||
+        mat.specular_color_texture.present() || mat.masked() || mat.clearcoat_texture.present() ||
+        mat.clearcoat_roughness_texture.present() || mat.clearcoat_normal_texture.present();
     auto uv = [&](int set) { return m.texcoords[set].empty() ? nullptr : m.texcoords[set].data(); };
     first_triangle_.push_back(uint32_t(first));
     meshes_.push_back({m.positions.data(),

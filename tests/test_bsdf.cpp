@@ -418,7 +418,7 @@ TEST(SpecularBranches, MirrorReflectsWithSchlicksFresnelOfBaseColor) {
   const Surface s = make_surface(m, n, n);
   for (const vec3& wo : {unit(0.3f, 0.2f, 0.9f), unit(-0.9f, 0.1f, 0.1f), vec3(0, 0, 1)}) {
     for (Transport mode : {Transport::Radiance, Transport::Importance}) {
-      SpecularBranch br[2];
+      SpecularBranch br[kMaxDeltaBranches];
       ASSERT_EQ(s.bsdf.delta_branches(wo, mode, br), 1);
       const double w5 = std::pow(1.0 - double(wo.z), 5.0);
       for (int c = 0; c < 3; ++c)
@@ -428,7 +428,7 @@ TEST(SpecularBranches, MirrorReflectsWithSchlicksFresnelOfBaseColor) {
     }
   }
   // From the back side the mirror reflects about -ng.
-  SpecularBranch br[2];
+  SpecularBranch br[kMaxDeltaBranches];
   const vec3 wo = unit(0.2f, 0.1f, -0.8f);
   ASSERT_EQ(s.bsdf.delta_branches(wo, Transport::Radiance, br), 1);
   expect_mirror_image(wo, br[0].dir, -n, "mirror back");
@@ -448,7 +448,7 @@ TEST(SpecularBranches, DielectricFromOutsideSplitsByFresnel) {
     const double th = k * kPi_ / 180.0;
     const vec3 wo(float(std::sin(th)), 0.0f, float(std::cos(th)));
     const double F = fresnel_reference(double(wo.z), 1.0, 1.5);
-    SpecularBranch imp[2], rad[2], tr[2];
+    SpecularBranch imp[kMaxDeltaBranches], rad[kMaxDeltaBranches], tr[kMaxDeltaBranches];
     ASSERT_EQ(sw.bsdf.delta_branches(wo, Transport::Importance, imp), 2) << k;
     ASSERT_EQ(sw.bsdf.delta_branches(wo, Transport::Radiance, rad), 2) << k;
     ASSERT_EQ(st.bsdf.delta_branches(wo, Transport::Radiance, tr), 2) << k;
@@ -481,7 +481,7 @@ TEST(SpecularBranches, DielectricFromInside) {
     const double th = k * kPi_ / 180.0;
     if (std::fabs(th - theta_c) < 1e-3) continue;
     const vec3 wo(float(std::sin(th)), 0.0f, -float(std::cos(th)));
-    SpecularBranch imp[2], rad[2];
+    SpecularBranch imp[kMaxDeltaBranches], rad[kMaxDeltaBranches];
     const int ni = s.bsdf.delta_branches(wo, Transport::Importance, imp);
     const int nr = s.bsdf.delta_branches(wo, Transport::Radiance, rad);
     expect_mirror_image(wo, imp[0].dir, -n, "inside reflection");
@@ -521,7 +521,7 @@ TEST(SpecularBranches, WhiteDielectricConservesPhotonEnergyWithShadingNormals) {
   const Material glass = make_material(Model::Dielectric, vec3(1.0f), 1.5f);
   {
     const Surface s = make_surface(glass, ng, ns);
-    SpecularBranch br[2];
+    SpecularBranch br[kMaxDeltaBranches];
     const int nb = s.bsdf.delta_branches(wo, Transport::Importance, br);
     float sum = br[0].weight.x;
     if (nb == 2) sum += br[1].weight.x;
@@ -537,7 +537,7 @@ TEST(SpecularBranches, WhiteDielectricConservesPhotonEnergyWithShadingNormals) {
     const vec3 w = random_unit(rng);
     if (std::fabs(glm::dot(w, ng)) < 1e-3f) continue;
     const Surface s = make_surface(glass, ng, nsr);
-    SpecularBranch br[2];
+    SpecularBranch br[kMaxDeltaBranches];
     const int nb = s.bsdf.delta_branches(w, Transport::Importance, br);
     float sum = br[0].weight.x;
     if (nb == 2) sum += br[1].weight.x;
@@ -563,7 +563,7 @@ TEST(SpecularBranches, TiltedShadingNormalKeepsDirectionsOnCorrectSide) {
   for (Model model : {Model::Mirror, Model::Dielectric}) {
     const Material m = make_material(model, vec3(1.0f), 1.5f);
     const Surface s = make_surface(m, ng, ns30);
-    SpecularBranch br[2];
+    SpecularBranch br[kMaxDeltaBranches];
     const int nb = s.bsdf.delta_branches(wo, Transport::Radiance, br);
     ASSERT_GE(nb, 1);
     EXPECT_GT(glm::dot(br[0].dir, ng), 0.0f);
@@ -580,7 +580,7 @@ TEST(SpecularBranches, TiltedShadingNormalKeepsDirectionsOnCorrectSide) {
     for (Model model : {Model::Mirror, Model::Dielectric}) {
       const Material m = make_material(model, vec3(1.0f), 1.5f);
       const Surface s = make_surface(m, ng, glm::dot(nsr, ng) > 0.0f ? nsr : -nsr);
-      SpecularBranch br[2];
+      SpecularBranch br[kMaxDeltaBranches];
       const int nb = s.bsdf.delta_branches(w, Transport::Importance, br);
       ASSERT_GE(nb, 1);
       ASSERT_LE(nb, 2);

@@ -250,7 +250,7 @@ TEST(GltfBsdf, SampleWeightIsEvalCosOverPdfAndDeltaDrawsAreBranches) {
       if (!bsdf.sample(wo, rng, mode, s)) continue;
       ASSERT_TRUE(is_finite(s.weight)) << c.name;
       if (s.delta) {
-        SpecularBranch b[2];
+        SpecularBranch b[kMaxDeltaBranches];
         const int nb = bsdf.delta_branches(wo, mode, b);
         bool found = false;
         for (int i = 0; i < nb; ++i) found |= glm::length(b[i].dir - s.wi) < 1e-6f;
@@ -378,13 +378,13 @@ TEST(GltfBsdf, BaseAndLobeSumToTheWholeAndEachSamplesItself) {
       vec3 ng, ns;
       random_normals(rng, ng, ns);
       const Bsdf bsdf(c.p, ng, ns);
-      const Bsdf parts[2] = {bsdf.base_part(), bsdf.lobe_part()};
+      const Bsdf parts[2] = {bsdf.base_part(1.0f), bsdf.lobe_part(1.0f)};
       const vec3 wo = random_unit(rng), wi = random_unit(rng);
       const vec3 n = glm::dot(wo, ng) > 0.0f ? ns : -ns;
       if (glm::dot(wo, n) < 0.02f) continue;
       const vec3 whole = bsdf.eval(wo, wi), sum = parts[0].eval(wo, wi) + parts[1].eval(wo, wi);
       for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(sum[ch], whole[ch], 1e-5f * whole[ch]) << c.name;
-      const float p_lobe = bsdf.lobe_probability(wo);
+      const float p_lobe = bsdf.lobe_probability(wo, 1.0f);
       EXPECT_TRUE(p_lobe > 0.0f && p_lobe <= 1.0f) << c.name;
       if (c.p.metallic == 1.0f) EXPECT_EQ(p_lobe, 1.0f) << c.name;  // no base to gather at
       for (int part = 0; part < 2; ++part) {
@@ -413,7 +413,7 @@ TEST(GltfBsdf, LobeAlbedoByItsSamplerEqualsItsQuadrature) {
   const Basis f(ng);
   for (const BsdfParams& p : {params(vec3(0.9f, 0.6f, 0.5f), 1.0f, 0.15f),
                               params(vec3(0.6f), 0.0f, 0.3f), params(vec3(0.6f), 0.5f, 0.45f)}) {
-    const Bsdf lobe = Bsdf(p, ng, ng).lobe_part();
+    const Bsdf lobe = Bsdf(p, ng, ng).lobe_part(1.0f);
     MetalRoughBrdf only = brdf_of(p);
     for (double mu : {0.9, 0.5, 0.2}) {
       const vec3 wo = f.world(std::acos(mu), 1.1);
@@ -483,7 +483,7 @@ TEST(GltfBsdf, WhiteFurnacePerRoughness) {
     for (int k = 0; k < 2000; ++k) {
       const vec3 wo = random_unit(rng);
       if (std::fabs(glm::dot(wo, ng)) < 1e-3f) continue;
-      SpecularBranch b[2];
+      SpecularBranch b[kMaxDeltaBranches];
       const int nb = bsdf.delta_branches(wo, Transport::Importance, b);
       float sum = 0.0f;
       for (int i = 0; i < nb; ++i) sum += b[i].weight.x;
@@ -538,7 +538,7 @@ TEST(GltfBsdf, PhotonsCarryTheAdjoint) {
   // Refraction: radiance weight = importance weight / eta^2 entering, x eta^2 leaving.
   const Bsdf glass(Material::glass(1.5f, false), ng, ng), thin(Material::glass(1.5f, true), ng, ng);
   for (const vec3& w : {fg.world(0.3, 0.0), -fg.world(0.3, 0.0)}) {
-    SpecularBranch r[2], q[2];
+    SpecularBranch r[kMaxDeltaBranches], q[kMaxDeltaBranches];
     ASSERT_EQ(glass.delta_branches(w, Transport::Radiance, r), 2);
     ASSERT_EQ(glass.delta_branches(w, Transport::Importance, q), 2);
     const float eta2 = glm::dot(w, ng) > 0.0f ? 2.25f : 1.0f / 2.25f;
@@ -562,7 +562,7 @@ TEST(GltfBsdf, ThinAndVolumetricGlassByHand) {
   for (double deg : {0.0, 60.0}) {
     const double th = deg * kPiD / 180.0;
     const vec3 wo(float(std::sin(th)), 0.0f, float(std::cos(th)));
-    SpecularBranch b[2];
+    SpecularBranch b[kMaxDeltaBranches];
     ASSERT_EQ(t.delta_branches(wo, Transport::Radiance, b), 2);
     const double schlick = 0.04 + 0.96 * std::pow(1.0 - std::cos(th), 5.0);
     EXPECT_NEAR(b[0].weight.x, schlick, 1e-6);

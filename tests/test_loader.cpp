@@ -376,6 +376,10 @@ TEST_F(LoaderTest, MaterialFactorsOutOfRangeAreRefused) {
        "attenuationDistance 0"},
       {"\"extensions\":{\"KHR_materials_volume\":{\"attenuationColor\":[2,0,0]}}",
        "attenuationColor must be 3 numbers in [0, 1]"},
+      {"\"extensions\":{\"KHR_materials_clearcoat\":{\"clearcoatFactor\":1.5}}",
+       "clearcoatFactor 1.5"},
+      {"\"extensions\":{\"KHR_materials_clearcoat\":{\"clearcoatRoughnessFactor\":-1}}",
+       "clearcoatRoughnessFactor -1"},
       {"\"alphaMode\":\"SOMETIMES\"", "unknown alphaMode 'SOMETIMES'"},
       {"\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":3}}",
        "texture 3, which does not"},
@@ -465,6 +469,37 @@ TEST_F(LoaderTest, TexturesAreDecodedWithSamplersAndTransforms) {
   }
   ASSERT_EQ(s.meshes[0].texcoords[1].size(), 3u);
   EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+}
+
+TEST_F(LoaderTest, ClearcoatIsReadWithItsTexturesAndTangents) {
+  // KHR_materials_clearcoat: the factors, clearcoatTexture (R), clearcoatRoughnessTexture (G)
+  // and clearcoatNormalTexture with its scale; tangents for the coat's normal texture alone;
+  // not warned about as an ignored extension. clearcoatFactor 0 disables the whole layer.
+  const std::vector<unsigned char> png = png_bytes(2, 2, dir_);
+  const std::string images =
+      "\"extensionsUsed\":[\"KHR_materials_clearcoat\"],"
+      "\"images\":[{\"uri\":\"data:image/png;base64," +
+      base64(png) + "\"}],\"textures\":[{\"source\":0}],";
+  const std::string coat =
+      "\"extensions\":{\"KHR_materials_clearcoat\":{\"clearcoatFactor\":0.75,"
+      "\"clearcoatRoughnessFactor\":0.25,\"clearcoatTexture\":{\"index\":0},"
+      "\"clearcoatRoughnessTexture\":{\"index\":0,\"texCoord\":1},"
+      "\"clearcoatNormalTexture\":{\"index\":0,\"scale\":0.5}}}";
+  const Scene s = load(textured(images, coat));
+  const pb::Material& m = s.materials[s.meshes[0].material];
+  EXPECT_NEAR(m.clearcoat, 0.75f, 1e-7f);
+  EXPECT_NEAR(m.clearcoat_roughness, 0.25f, 1e-7f);
+  EXPECT_TRUE(m.clearcoat_texture.present());
+  EXPECT_EQ(m.clearcoat_roughness_texture.texcoord, 1);
+  EXPECT_TRUE(m.clearcoat_normal_texture.present());
+  EXPECT_NEAR(m.clearcoat_normal_scale, 0.5f, 1e-7f);
+  EXPECT_EQ(s.meshes[0].tangents.size(), 3u);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  const Scene off = load(textured(images, std::string(coat).replace(coat.find("0.75"), 4, "0")));
+  const pb::Material& o = off.materials[off.meshes[0].material];
+  EXPECT_EQ(o.clearcoat, 0.0f);
+  EXPECT_FALSE(o.clearcoat_texture.present() || o.clearcoat_normal_texture.present());
+  EXPECT_TRUE(off.meshes[0].tangents.empty());
 }
 
 TEST_F(LoaderTest, ImagesInBufferViewsAndTheirErrors) {
@@ -1225,7 +1260,8 @@ TEST_F(LoaderTest, GlbTruncatedChunk) {
 TEST_F(LoaderTest, ExternalBufferMissing) {
   Gltf g = basic();
   g.buffer_uri = "missing.bin";
-  expect_error(g, "malformed glTF: File not found : missing.bin");
+  // In its own words, naming the file that is missing, and only once (not "malformed").
+  expect_error(g, ": the buffer file 'missing.bin' it refers to cannot be opened");
 }
 
 TEST_F(LoaderTest, ExternalBufferWrongSize) {

@@ -190,6 +190,33 @@ TEST(MaterialRender, VolumetricGlassSlabTransmitsByFresnelAndBeerLambert) {
   }
 }
 
+TEST(MaterialRender, ASmoothClearCoatOverBlackMirrorsByItsViewWeight) {
+  // KHR_materials_clearcoat over a black base: the camera sees the coat's mirror image of an
+  // emitter of radiance 2, weighted by k = clearcoat (0.04 + 0.96 (1 - cos theta)^5) at the
+  // view angle theta. The base is black, so photons and next-event add nothing. PPM follows the
+  // mirror branch: exact to float rounding (2e-6). SPPM picks the branch by delta_probability
+  // p per pass, dividing by it: a pass gives 2k / p with probability p, else 0, so 1024 passes
+  // are within 4 standard deviations, 4 x 2k sqrt((1 - p) / (1024 p)) (about 2%).
+  for (double theta : {0.4, 1.1}) {
+    SceneBuilder b;
+    Material coat = Material::lambertian(vec3(0.0f));
+    coat.clearcoat = 0.8f;
+    b.quad(vec3(0), vec3(20, 0, 0), vec3(0, 0, -20), b.material(coat));  // front +y
+    const vec3 d(0.0f, -float(std::cos(theta)), -float(std::sin(theta)));
+    const vec3 mirror(0.0f, -d.y, d.z), hit = vec3(0, 1, 0) + d / -d.y;
+    const vec3 c = hit + 5.0f * mirror, u = glm::normalize(glm::cross(mirror, vec3(1, 0, 0)));
+    b.quad(c, vec3(10, 0, 0), 10.0f * u, b.material(emitter(vec3(2.0f), true)));
+    b.camera(vec3(0, 1, 0), d, vec3(0.0f, -d.z, d.y), 0.01f);
+    const double k = 0.8 * (0.04 + 0.96 * std::pow(1.0 - std::cos(theta), 5.0));
+    const std::vector<float> ppm = render(b.done(), options(1));
+    EXPECT_NEAR(ppm[0], 2.0 * k, 2e-6) << theta;
+    const double p = Bsdf(coat, vec3(0, 1, 0), vec3(0, 1, 0)).delta_probability(-d);
+    EXPECT_GT(p, 0.9);
+    const std::vector<float> sppm = render(b.done(), options(1, Method::SPPM), 1024);
+    EXPECT_NEAR(sppm[0], 2.0 * k, 4.0 * 2.0 * k * std::sqrt((1.0 - p) / (1024.0 * p))) << theta;
+  }
+}
+
 TEST(MaterialRender, ThinGlassTransmitsOnceStraightThrough) {
   // A thin-walled pane (no volume): the ray goes straight through once, T = b (1 - 0.04), and
   // no attenuation applies (a thin wall has no inside).

@@ -44,6 +44,10 @@ float adjoint_shading_factor(const vec3& wo, const vec3& wi, const vec3& ng, con
 // factor at refraction; photons carry flux and do not (Veach thesis section 5.2).
 enum class Transport : uint8_t { Radiance, Importance };
 
+// At most: the mirror of smooth lobes (with a thin wall's or a volume's Fresnel reflection), a
+// transmission, and a smooth clear coat's mirror about its own normal.
+inline constexpr int kMaxDeltaBranches = 3;
+
 struct SpecularBranch {
   vec3 dir{0.0f};
   vec3 weight{0.0f};  // throughput factor of the branch (Fresnel term included)
@@ -64,6 +68,8 @@ struct BsdfParams {
   vec3 specular_color{1.0f};
   float transmission = 0.0f;
   bool thin = true;
+  float clearcoat = 0.0f, clearcoat_roughness = 0.0f;  // KHR_materials_clearcoat
+  vec3 coat_normal{0.0f};  // the coat's shading normal; zero: ns (no clearcoatNormalTexture)
   static BsdfParams of(const Material& m);  // the factors alone (no textures)
 };
 
@@ -80,6 +86,14 @@ struct BsdfParams {
 // transmitting part is always smooth: reflection and refraction (KHR_materials_volume) or
 // straight transmission (thin-walled), both delta branches. eval() and pdf() are the non-delta
 // parts; delta_branches() the delta ones.
+//
+// KHR_materials_clearcoat lays a GGX layer (ior 1.5, its own roughness and normal) over all of
+// it: f = (1 - k) f_material + k D V (alpha = clearcoatRoughness^2, about the coat normal), k =
+// clearcoat (0.04 + 0.96 (1 - |v.n_c|)^5) with v the view (the extension's fresnel_coat). The
+// weight reads only the view, so f is not reciprocal: radiance transport takes v = wo, photons
+// (Transport::Importance) the direction they leave in (the adjoint f*(wo, wi) = f(wi, wo), Veach
+// thesis 3.7.6). A coat below the mirror roughness is a delta branch (the mirror limit of D V is
+// a mirror of weight 1: k reflects).
 class Bsdf {
  public:
   Bsdf() = default;
@@ -126,25 +140,29 @@ class Bsdf {
   // part's Fresnel reflection) and the transmission, refracted (KHR_materials_volume; closed
   // meshes in vacuum: the side of ng tells whether the path enters, eta = ior, or leaves,
   // eta = 1/ior) or straight through (thin-walled). Returns the count (0, 1 or 2).
-  int delta_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) const;
+  // With a smooth clear coat, its mirror about the coat normal is one more (merged with the
+  // mirror when the directions agree); the others are weighted by 1 - k.
+  int delta_branches(const vec3& wo, Transport mode, SpecularBranch out[kMaxDeltaBranches]) const;
 
   // The split SPPM's camera paths make at a rough GGX lobe (camera_paths.h, ESTIMATOR.md
   // section 10): the non-delta part is the diffuse base plus the lobe (MetalRoughBrdf's
   // eval_diffuse and eval_specular), and a path may follow the lobe by sampling it and gather
   // photons at the base alone.
   // True when the non-delta part has a GGX lobe that is not a mirror, of roughness below
-  // `below`, that can reflect something (metal, or a dielectric layer with specular > 0).
+  // `below`, that can reflect something (metal, or a dielectric layer with specular > 0), or a
+  // clear coat's lobe (not a mirror) of roughness below `below`. The lobes below `below` are
+  // followed, the rest (the diffuse base, and a lobe at or above `below`) gathered.
   bool has_lobe_below(float below) const;
   // The probability of following the lobe instead of gathering at the base: the lobe's share
   // of the two parts' albedo estimates (MetalRoughBrdf::specular_probability); 1 where the
   // base is black (metal).
-  float lobe_probability(const vec3& wo) const;
+  float lobe_probability(const vec3& wo, float below) const;
   // This Bsdf with its non-delta part restricted to the base (base_part) or the lobe
   // (lobe_part): eval, max_f and pdf of that term alone, and sample() draws from it alone
   // (never a delta branch; delta_branches() is unchanged).
   // Only for a Bsdf with has_lobe_below(1) (any lobe).
-  Bsdf base_part() const;
-  Bsdf lobe_part() const;
+  Bsdf base_part(float below) const;
+  Bsdf lobe_part(float below) const;
   // A visible point on base_part() is where a camera path chose not to follow the lobe after
   // it had counted the vertex's direct light with the whole Bsdf: the next-event stage skips it.
   bool is_base_part() const { return part_ == Part::Base; }
@@ -155,7 +173,26 @@ class Bsdf {
   // eval and pdf of the non-delta part in the shading frame of wo's side (both above it).
   vec3 eval_local(const vec3& wo, const vec3& wi, float* pdf) const;
   float non_delta_albedo(float cos_o) const;
-  bool sample_non_delta(const vec3& wo, Rng& rng, BsdfSample& out) const;
+  bool sample_non_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const;
+  bool sample_base(const vec3& wo, Rng& rng, BsdfSample& out) const;  // the uncoated part
+  int base_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) const;
+  // The clear coat (no coat: k = 0). k at the view v; the coat lobe's D V about n_c on wo's side
+  // and its sampling density; the non-delta f with the view v and its mixture density.
+  float coat_weight(const vec3& v) const;
+  bool coat_lobe() const { return coat_ > 0.0f && !coat_smooth_; }
+  float coat_dv(const vec3& wo, const vec3& wi, float* pdf) const;
+  vec3 eval_with_view(const vec3& wo, const vec3& wi, const vec3& v, float* pdf) const;
+  // Under a coat the non-delta part is up to three terms: the diffuse base, the base's GGX
+  // lobe and the coat's; a part (base_part, lobe_part) keeps some of them.
+  struct Terms {
+    bool diffuse, lobe, coat;
+  };
+  Terms terms() const;
+  void term_albedos(const vec3& wo, float a[3]) const;  // estimates, 0 for absent terms
+  bool follows_lobe(float below) const;
+  bool follows_coat(float below) const;
+  vec3 diffuse_term(const vec3& wo, const vec3& wi) const;  // local frame, both above
+  float lobe_bound(const vec3& wo) const;                   // of F D V of the base's lobe (max_f)
 
   Kind kind_ = Kind::Lambertian;
   bool smooth_ = false;     // GGX lobes below the mirror roughness: delta branches
@@ -166,8 +203,15 @@ class Bsdf {
   // reflect_ = m + o; the Lambertian kind keeps its reflectance in brdf_.base_color.
   MetalRoughBrdf brdf_;
   float reflect_ = 0.0f;
-  float glass_ = 0.0f;  // (1 - m) t
+  float glass_ = 0.0f;                            // (1 - m) t
+  bool base_non_delta_ = false;                   // the uncoated material has a non-delta part
+  bool coat_smooth_ = false;                      // the clear coat is a mirror
+  float coat_ = 0.0f;                             // clearcoat (0: none)
+  float coat_roughness_ = 0.0f;                   // clearcoatRoughness
+  float coat_alpha_ = 0.0f;                       // its GGX alpha
+  bool follow_lobe_ = true, follow_coat_ = true;  // which lobes a coated part follows
   vec3 ng_{0.0f}, ns_{0.0f};
+  vec3 nc_{0.0f};  // the coat's normal, on ng's side
 };
 
 }  // namespace pb

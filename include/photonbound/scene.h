@@ -45,24 +45,30 @@ struct Material {
   vec3 base_color{1.0f};  // baseColorFactor.rgb, linear
   float alpha = 1.0f;     // baseColorFactor.a
   float metallic = 1.0f, roughness = 1.0f;
-  float ior = 1.5f;           // KHR_materials_ior
-  float specular = 1.0f;      // KHR_materials_specular specularFactor
-  vec3 specular_color{1.0f};  // KHR_materials_specular specularColorFactor
-  float transmission = 0.0f;  // KHR_materials_transmission transmissionFactor
-  bool thin = true;           // no KHR_materials_volume (or thicknessFactor 0)
-  vec3 attenuation{0.0f};     // KHR_materials_volume: Beer-Lambert coefficient, 1/length
-  vec3 emission{0.0f};        // emissiveFactor x KHR_materials_emissive_strength
-  bool double_sided = false;  // doubleSided: an emitter emits from both sides
+  float ior = 1.5f;                     // KHR_materials_ior
+  float specular = 1.0f;                // KHR_materials_specular specularFactor
+  vec3 specular_color{1.0f};            // KHR_materials_specular specularColorFactor
+  float transmission = 0.0f;            // KHR_materials_transmission transmissionFactor
+  bool thin = true;                     // no KHR_materials_volume (or thicknessFactor 0)
+  float clearcoat = 0.0f;               // KHR_materials_clearcoat clearcoatFactor (0: no coat)
+  float clearcoat_roughness = 0.0f;     // clearcoatRoughnessFactor
+  float clearcoat_normal_scale = 1.0f;  // clearcoatNormalTexture.scale
+  vec3 attenuation{0.0f};               // KHR_materials_volume: Beer-Lambert coefficient, 1/length
+  vec3 emission{0.0f};                  // emissiveFactor x KHR_materials_emissive_strength
+  bool double_sided = false;            // doubleSided: an emitter emits from both sides
   AlphaMode alpha_mode = AlphaMode::Opaque;
   float alpha_cutoff = 0.5f;
-  float normal_scale = 1.0f;              // normalTexture.scale
-  TextureRef base_color_texture;          // sRGB; alpha in A
-  TextureRef metallic_roughness_texture;  // B metal, G rough (linear)
-  TextureRef normal_texture;              // tangent-space normal (linear)
-  TextureRef emissive_texture;            // sRGB
-  TextureRef transmission_texture;        // R (linear)
-  TextureRef specular_texture;            // A (linear)
-  TextureRef specular_color_texture;      // sRGB
+  float normal_scale = 1.0f;               // normalTexture.scale
+  TextureRef base_color_texture;           // sRGB; alpha in A
+  TextureRef metallic_roughness_texture;   // B metal, G rough (linear)
+  TextureRef normal_texture;               // tangent-space normal (linear)
+  TextureRef emissive_texture;             // sRGB
+  TextureRef transmission_texture;         // R (linear)
+  TextureRef specular_texture;             // A (linear)
+  TextureRef specular_color_texture;       // sRGB
+  TextureRef clearcoat_texture;            // R (linear)
+  TextureRef clearcoat_roughness_texture;  // G (linear)
+  TextureRef clearcoat_normal_texture;     // tangent-space normal of the coat (linear)
 
   // Emits somewhere: the factor is positive (an emissive texture may still be black in places).
   bool emits() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
