@@ -174,7 +174,8 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
               << (options.method == pb::Method::PPM
                       ? std::to_string(renderer.eye().points.size()) + " measurement points"
                       : std::to_string(renderer.states().size()) + " pixels (SPPM)")
-              << ", " << threads.threads() << " threads" << (saved ? ", resumed" : "") << "\n";
+              << ", " << threads.threads() << (threads.threads() == 1 ? " thread" : " threads")
+              << (saved ? ", resumed" : "") << "\n";
   pb::Driver driver(renderer, saved ? saved->schedule : pb::DriverState{});
   const pb::RenderReport report = driver.run(&g_stop, observers);
   // Ctrl-C keeps the work: the state is written then too.

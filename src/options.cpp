@@ -182,7 +182,11 @@ Command parse_command_line(int argc, const char* const* argv) {
   Command c;
   if (argc < 2) fail("no command given (see photonbound --help)");
   const std::string cmd = argv[1];
-  if (cmd == "--help" || cmd == "-h" || cmd == "help") {
+  // `photonbound render --help` and the like ask for the same text as `photonbound --help`.
+  bool asks_help = false;
+  for (int k = 2; k < argc; ++k)
+    asks_help = asks_help || std::string(argv[k]) == "--help" || std::string(argv[k]) == "-h";
+  if (cmd == "--help" || cmd == "-h" || cmd == "help" || asks_help) {
     c.kind = Command::Kind::Help;
   } else if (cmd == "--help-table") {
     c.kind = Command::Kind::HelpTable;

@@ -30,6 +30,11 @@ void expect_one_line(const Outcome& r) {
 
 TEST_F(Cli, HelpAndVersion) {
   EXPECT_EQ(run("--help").code, 0);
+  for (const char* cmd : {"render --help", "resume -h", "compare --help"}) {
+    const auto r = run(cmd);
+    EXPECT_EQ(r.code, 0) << cmd;
+    EXPECT_TRUE(r.err.empty()) << cmd << ": " << r.err;  // the usage goes to stdout
+  }
   EXPECT_EQ(run("--version").code, 0);
 }
 
