@@ -1,5 +1,7 @@
 #include "photonbound/bsdf.h"
 
+#include "photonbound/sheen.h"
+
 #include <algorithm>
 
 namespace pb {
@@ -80,6 +82,8 @@ BsdfParams BsdfParams::of(const Material& m) {
   p.thin = m.thin;
   p.clearcoat = m.clearcoat;
   p.clearcoat_roughness = m.clearcoat_roughness;
+  p.sheen_color = m.sheen_color;
+  p.sheen_roughness = m.sheen_roughness;
   return p;
 }
 
@@ -92,7 +96,8 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
   brdf_.specular_color = p.specular_color;
   const float m = std::clamp(p.metallic, 0.0f, 1.0f), t = std::clamp(p.transmission, 0.0f, 1.0f);
   const float coat = std::clamp(p.clearcoat, 0.0f, 1.0f);
-  if (m == 0.0f && t == 0.0f && p.specular == 0.0f && coat == 0.0f) {  // no layer at all
+  const float sheen = max_component(p.sheen_color);
+  if (m == 0.0f && t == 0.0f && p.specular == 0.0f && coat == 0.0f && !(sheen > 0.0f)) {
     brdf_.metallic = 0.0f;
     reflect_ = 1.0f;
     return;  // kind_ Lambertian
@@ -103,8 +108,8 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
   reflect_ = m + (1.0f - m) * (1.0f - t);
   brdf_.metallic = reflect_ > 0.0f ? m / reflect_ : 0.0f;
   smooth_ = p.roughness < mirror_roughness;
-  // A Lambertian under a coat: its layer reflects nothing, so it has no mirror either.
-  if (coat > 0.0f && m == 0.0f && p.specular == 0.0f) smooth_ = false;
+  // A Lambertian under a coat or a sheen: its layer reflects nothing, so it has no mirror either.
+  if ((coat > 0.0f || sheen > 0.0f) && m == 0.0f && p.specular == 0.0f) smooth_ = false;
   const float opaque = (1.0f - m) * (1.0f - t);
   base_non_delta_ = reflect_ > 0.0f && (!smooth_ || opaque > 0.0f);
   bool non_delta = base_non_delta_;
@@ -119,6 +124,13 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
     if (glm::dot(nc_, ng) < 0.0f) nc_ = -nc_;
     non_delta = non_delta || !coat_smooth_;
     delta = delta || coat_smooth_;
+  }
+  if (sheen > 0.0f) {  // KHR_materials_sheen: a broad lobe of its own, never a mirror
+    sheen_ = glm::max(p.sheen_color, vec3(0.0f));
+    sheen_max_ = std::min(sheen, 1.0f);
+    sheen_roughness_ = p.sheen_roughness;
+    sheen_alpha_ = sheen_alpha(p.sheen_roughness);
+    non_delta = true;
   }
   kind_ = non_delta ? Kind::Layered : Kind::Delta;
   has_delta_ = non_delta && delta;
@@ -169,7 +181,7 @@ vec3 Bsdf::eval(const vec3& wo, const vec3& wi) const {
   // Both directions on one side of the true surface: reflection only.
   if (glm::dot(wo, ng_) * glm::dot(wi, ng_) <= 0.0f) return vec3(0.0f);
   if (kind_ == Kind::Lambertian) return diffuse_f();
-  if (coat_ > 0.0f) return eval_with_view(wo, wi, wo, nullptr);
+  if (layered()) return eval_with_view(wo, wi, wo, nullptr);
   const Frame f(glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_);
   return eval_local(f.local(wo), f.local(wi), nullptr);
 }
@@ -191,26 +203,37 @@ float Bsdf::coat_dv(const vec3& wo, const vec3& wi, float* pdf) const {
 }
 
 Bsdf::Terms Bsdf::terms() const {
-  const bool lobe = base_non_delta_ && !smooth_, coat = coat_lobe();
+  const bool lobe = base_non_delta_ && !smooth_, coat = coat_lobe(), sheen = sheen_max_ > 0.0f;
   switch (part_) {
     case Part::Lobe:
-      return {false, lobe && follow_lobe_, coat && follow_coat_};
+      return {false, lobe && follow_lobe_, coat && follow_coat_, false};
     case Part::Base:
-      return {base_non_delta_, lobe && !follow_lobe_, coat && !follow_coat_};
+      return {base_non_delta_, lobe && !follow_lobe_, coat && !follow_coat_, sheen};
     default:
-      return {base_non_delta_, lobe, coat};
+      return {base_non_delta_, lobe, coat, sheen};
   }
 }
 
-void Bsdf::term_albedos(const vec3& wo, float a[3]) const {
+float Bsdf::sheen_scaling(float cos_o, float cos_i) const {
+  if (!(sheen_max_ > 0.0f)) return 1.0f;
+  // KHR_materials_sheen's albedo scaling, in its reciprocal form: min over both directions of
+  // 1 - max(sheen colour) E(cos), and not below 0 where E exceeds 1 (sheen.h).
+  return std::max(0.0f,
+                  std::min(1.0f - sheen_max_ * sheen_albedo(std::fabs(cos_o), sheen_roughness_),
+                           1.0f - sheen_max_ * sheen_albedo(std::fabs(cos_i), sheen_roughness_)));
+}
+
+void Bsdf::term_albedos(const vec3& wo, float a[kTerms]) const {
   // Estimates only (they choose among the terms; the weights stay exact), as
   // non_delta_albedo's: the diffuse base's (1 - f0) max(base), Schlick's Fresnel at the macro
-  // normal for the base's lobe, each x (1 - k), and k for the coat's lobe (D V has albedo
-  // about 1). The floor keeps each term's probability above 0.
+  // normal for the base's lobe, each x (1 - k) and under a sheen x (1 - max(sheen) E); k for
+  // the coat's lobe (D V has albedo about 1) and (1 - k) max(sheen) E for the sheen. The floor
+  // keeps each term's probability above 0.
   const Terms t = terms();
   const float k = coat_weight(wo), cos_o = std::fabs(glm::dot(wo, ns_));
   const float mu = brdf_.metallic, f0 = max_component(brdf_.dielectric_f0());
-  const float under = (1.0f - k) * reflect_;
+  const float e = sheen_max_ > 0.0f ? sheen_max_ * sheen_albedo(cos_o, sheen_roughness_) : 0.0f;
+  const float under = (1.0f - k) * std::max(0.0f, 1.0f - e) * reflect_;
   a[0] = t.diffuse
              ? std::max(under * (1.0f - mu) * (1.0f - f0) * max_component(brdf_.base_color), 1e-3f)
              : 0.0f;
@@ -220,15 +243,17 @@ void Bsdf::term_albedos(const vec3& wo, float a[3]) const {
                            1e-3f)
                 : 0.0f;
   a[2] = t.coat ? std::max(k, 1e-3f) : 0.0f;
+  a[3] = t.sheen ? std::max((1.0f - k) * e, 1e-3f) : 0.0f;
 }
 
 vec3 Bsdf::eval_with_view(const vec3& wo, const vec3& wi, const vec3& v, float* pdf) const {
   const Frame f(glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_);
   const vec3 lo = f.local(wo), li = f.local(wi);
   const Terms t = terms();
-  vec3 base(0.0f);
-  float p[3] = {0.0f, 0.0f, 0.0f};
+  vec3 under(0.0f);  // everything below the coat
+  float p[kTerms] = {0.0f, 0.0f, 0.0f, 0.0f};
   if (lo.z > 0.0f && li.z > 0.0f) {
+    vec3 base(0.0f);
     if (t.diffuse) {
       base += diffuse_term(lo, li);
       p[0] = li.z / kPi;
@@ -237,15 +262,24 @@ vec3 Bsdf::eval_with_view(const vec3& wo, const vec3& wi, const vec3& v, float* 
       base += reflect_ * brdf_.eval_specular(lo, li);
       p[1] = ggx_reflection_pdf(lo, li, ggx_alpha(brdf_.roughness));
     }
+    under = sheen_scaling(lo.z, li.z) * base;
+    if (t.sheen) {  // f_sheen + scaling x f_material (KHR_materials_sheen, "albedo scaling")
+      under += sheen_ * sheen_dv(lo, li, sheen_alpha_);
+      p[3] = 1.0f / (2.0f * kPi);  // drawn uniformly over the hemisphere
+    }
   }
   const float k = coat_weight(v);
-  vec3 out = (1.0f - k) * base;
+  vec3 out = (1.0f - k) * under;
   if (t.coat) out += vec3(k * coat_dv(wo, wi, &p[2]));
   if (pdf) {  // the mixture sample_non_delta draws from (its choice reads wo alone)
-    float a[3];
+    float a[kTerms];
     term_albedos(wo, a);
-    const float sum = a[0] + a[1] + a[2];
-    *pdf = sum > 0.0f ? (a[0] * p[0] + a[1] * p[1] + a[2] * p[2]) / sum : 0.0f;
+    float sum = 0.0f, mix = 0.0f;
+    for (int j = 0; j < kTerms; ++j) {
+      sum += a[j];
+      mix += a[j] * p[j];
+    }
+    *pdf = sum > 0.0f ? mix / sum : 0.0f;
   }
   return out;
 }
@@ -299,11 +333,15 @@ vec3 Bsdf::max_f(const vec3& wo) const {
   if (kind_ == Kind::Delta) return vec3(0.0f);
   const float mu = brdf_.metallic;
   const vec3 diffuse = (1.0f - mu) / kPi * brdf_.base_color;  // 1 - max F <= 1
-  if (coat_ > 0.0f) {  // (1 - k) f_material + k D V, k read at wo (the gather's view)
+  if (layered()) {  // (1 - k) (f_sheen + s f_material) + k D V, k read at wo (the gather's view)
     const Terms t = terms();
     vec3 base(0.0f);
     if (t.diffuse) base += reflect_ * diffuse;
     if (t.lobe) base += vec3(reflect_ * lobe_bound(wo));
+    const float cos_o = std::fabs(glm::dot(wo, ns_));
+    if (sheen_max_ > 0.0f)  // s <= 1 - max(sheen) E(wo); D <= its horizon value, V <= 1
+      base *= std::max(0.0f, 1.0f - sheen_max_ * sheen_albedo(cos_o, sheen_roughness_));
+    if (t.sheen) base += sheen_ * charlie_d_max(sheen_alpha_);
     const float k = coat_weight(wo);
     vec3 out = (1.0f - k) * base;
     if (t.coat) {
@@ -324,7 +362,7 @@ float Bsdf::pdf(const vec3& wo, const vec3& wi) const {
     return std::max(0.0f, glm::dot(wi, ns)) / kPi;  // cosine-weighted about the shading normal
   const Frame f(ns);
   float p = 0.0f;
-  if (coat_ > 0.0f)
+  if (layered())
     eval_with_view(wo, wi, wo, &p);
   else
     eval_local(f.local(wo), f.local(wi), &p);
@@ -352,10 +390,10 @@ float Bsdf::delta_probability(const vec3& wo) const {
   float wd = 0.0f;
   for (int k = 0; k < n; ++k) wd += average(b[k].weight);
   float wn = non_delta_albedo(std::fabs(glm::dot(wo, ns_)));
-  if (coat_ > 0.0f) {  // the coat's lobe (if rough) and the material under it
-    float a[3];
+  if (layered()) {  // the coat's lobe (if rough), the sheen and the material under them
+    float a[kTerms];
     term_albedos(wo, a);
-    wn = a[0] + a[1] + a[2];
+    wn = a[0] + a[1] + a[2] + a[3];
   }
   return wd > 0.0f ? wd / (wd + wn) : 0.0f;
 }
@@ -400,7 +438,7 @@ bool Bsdf::sample_non_delta_part(const vec3& wo, Rng& rng, BsdfSample& out) cons
 }
 
 bool Bsdf::sample_non_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const {
-  if (coat_ == 0.0f) return sample_base(wo, rng, out);
+  if (!layered()) return sample_base(wo, rng, out);
   // One of this part's terms by its albedo estimate, then the weight of the whole part over
   // the mixture density (one-sample, Veach thesis 9.2.4's balance heuristic), with the view
   // where the light leaves: wo for radiance, wi for photons.
@@ -408,15 +446,22 @@ bool Bsdf::sample_non_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample
   const vec3 ng = front ? ng_ : -ng_, ns = front ? ns_ : -ns_;
   const Frame fs(ns);
   if (fs.local(wo).z <= 0.0f) return false;  // seen from below the shading hemisphere
-  float a[3];
+  float a[kTerms];
   term_albedos(wo, a);
-  const float sum = a[0] + a[1] + a[2];
+  float sum = 0.0f;
+  int pick = 0, present = 0;
+  for (int j = 0; j < kTerms; ++j) {
+    sum += a[j];
+    if (a[j] > 0.0f) {
+      pick = j;  // the last term there is
+      ++present;
+    }
+  }
   if (!(sum > 0.0f)) return false;
-  int pick = a[2] > 0.0f ? 2 : a[1] > 0.0f ? 1 : 0;  // the last term there is
-  if ((a[0] > 0.0f) + (a[1] > 0.0f) + (a[2] > 0.0f) > 1) {
+  if (present > 1) {
     const float u = rng.next_float() * sum;
     float acc = 0.0f;
-    for (int j = 0; j < 3; ++j) {
+    for (int j = 0; j < kTerms; ++j) {
       acc += a[j];
       if (a[j] > 0.0f && u < acc) {
         pick = j;
@@ -428,6 +473,11 @@ bool Bsdf::sample_non_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample
   vec3 wi;
   if (pick == 0) {
     wi = sample_cosine_hemisphere(ns, u1, u2);
+  } else if (pick == 3) {  // uniform over the hemisphere: the sheen peaks toward its horizon
+    const float z = u1, r = std::sqrt(std::max(0.0f, 1.0f - z * z)), phi = 2.0f * kPi * u2;
+    vec3 t, b;
+    orthonormal_basis(ns, t, b);
+    wi = glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b + z * ns);
   } else {
     const Frame f(pick == 1 ? ns : front ? nc_ : -nc_);
     const vec3 lo = f.local(wo);
@@ -518,12 +568,15 @@ int Bsdf::delta_branches(const vec3& wo, Transport mode,
                          SpecularBranch out[kMaxDeltaBranches]) const {
   if (kind_ == Kind::Lambertian) return 0;
   const int n = base_branches(wo, mode, out);
-  if (coat_ == 0.0f) return n;
-  // Under the coat: each branch x (1 - k), k at the view (wo, or for photons the branch's own
-  // direction); a smooth coat adds its mirror about n_c, of weight k.
+  if (!layered()) return n;
+  // Under a sheen each branch x its albedo scaling (wo and the branch's direction); under the
+  // coat x (1 - k), k at the view (wo, or for photons the branch's own direction); a smooth
+  // coat adds its mirror about n_c, of weight k.
+  const float cos_o = glm::dot(wo, ns_);
   for (int j = 0; j < n; ++j)
-    out[j].weight *= 1.0f - coat_weight(mode == Transport::Radiance ? wo : out[j].dir);
-  if (!coat_smooth_) return n;
+    out[j].weight *= sheen_scaling(cos_o, glm::dot(out[j].dir, ns_)) *
+                     (1.0f - coat_weight(mode == Transport::Radiance ? wo : out[j].dir));
+  if (coat_ == 0.0f || !coat_smooth_) return n;
   const bool front = glm::dot(wo, ng_) > 0.0f;
   const vec3 dir = reflect_checked(wo, front ? nc_ : -nc_, front ? ng_ : -ng_);
   const float k = coat_weight(mode == Transport::Radiance ? wo : dir);
@@ -583,7 +636,7 @@ int Bsdf::base_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) c
 }
 
 bool Bsdf::has_lobe_below(float below) const {
-  if (coat_ > 0.0f)
+  if (layered())
     return kind_ == Kind::Layered && part_ == Part::All &&
            (follows_lobe(below) || follows_coat(below));
   if (kind_ != Kind::Layered || smooth_ || part_ != Part::All || !(brdf_.roughness < below))
@@ -599,12 +652,16 @@ bool Bsdf::follows_lobe(float below) const {
 bool Bsdf::follows_coat(float below) const { return coat_lobe() && coat_roughness_ < below; }
 
 float Bsdf::lobe_probability(const vec3& wo, float below) const {
-  if (coat_ > 0.0f) {  // the followed terms' share of the albedo estimates
-    float all[3], lobe[3];
+  if (layered()) {  // the followed terms' share of the albedo estimates
+    float all[kTerms], lobe[kTerms];
     term_albedos(wo, all);
     lobe_part(below).term_albedos(wo, lobe);
-    const float sum = all[0] + all[1] + all[2];
-    return sum > 0.0f ? std::min(1.0f, (lobe[0] + lobe[1] + lobe[2]) / sum) : 0.0f;
+    float sum = 0.0f, followed = 0.0f;
+    for (int j = 0; j < kTerms; ++j) {
+      sum += all[j];
+      followed += lobe[j];
+    }
+    return sum > 0.0f ? std::min(1.0f, followed / sum) : 0.0f;
   }
   // specular_probability reads only the cosine of wo with the shading normal.
   return brdf_.specular_probability(vec3(0.0f, 0.0f, std::fabs(glm::dot(wo, ns_))));

@@ -32,10 +32,11 @@ const char* const kAttributes[] = {"POSITION", "NORMAL", "TEXCOORD_0", "TEXCOORD
 
 // The texture coordinate sets a material's textures read.
 bool uses_set(const Material& m, int set) {
-  for (const TextureRef* t : {&m.base_color_texture, &m.metallic_roughness_texture,
-                              &m.normal_texture, &m.emissive_texture, &m.transmission_texture,
-                              &m.specular_texture, &m.specular_color_texture, &m.clearcoat_texture,
-                              &m.clearcoat_roughness_texture, &m.clearcoat_normal_texture})
+  for (const TextureRef* t :
+       {&m.base_color_texture, &m.metallic_roughness_texture, &m.normal_texture,
+        &m.emissive_texture, &m.transmission_texture, &m.specular_texture,
+        &m.specular_color_texture, &m.clearcoat_texture, &m.clearcoat_roughness_texture,
+        &m.clearcoat_normal_texture, &m.sheen_color_texture, &m.sheen_roughness_texture})
     if (t->present() && t->texcoord == set) return true;
   return false;
 }

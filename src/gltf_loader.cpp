@@ -13,8 +13,9 @@
 // Material rules (README "Materials" repeats them): glTF 2.0's metallic-roughness material with
 // glTF's defaults (metallicFactor and roughnessFactor 1: a material without
 // pbrMetallicRoughness is a rough metal), KHR_materials_ior, _specular, _transmission,
-// _volume, _clearcoat and _emissive_strength, textures (base colour, metallic-roughness, normal,
-// emissive, transmission, specular, specular colour, the clear coat's three) with
+// _volume, _clearcoat, _sheen and _emissive_strength, textures (base colour,
+// metallic-roughness, normal, emissive, transmission, specular, specular colour, the clear
+// coat's three, the sheen's two) with
 // KHR_texture_transform, alphaMode
 // MASK cut-outs and doubleSided emitters. Factors must be in their documented ranges (a
 // reflectance above 1 creates energy) or the file is rejected; what is rendered approximately
@@ -158,13 +159,13 @@ Scene Loader::run(const std::vector<std::string>& parse_warnings) {
 
 void Loader::check_extensions() {
   static const std::set<std::string> known = {
-      "KHR_lights_punctual",     "KHR_materials_transmission",
-      "KHR_materials_ior",       "KHR_materials_emissive_strength",
-      "KHR_materials_specular",  "KHR_materials_volume",
-      "KHR_materials_clearcoat", "KHR_draco_mesh_compression",
-      "EXT_meshopt_compression", "KHR_mesh_quantization",
-      "KHR_texture_transform",   "KHR_texture_basisu",
-      "EXT_texture_webp"};  // basisu: the fallback image or a warning
+      "KHR_lights_punctual",        "KHR_materials_transmission",
+      "KHR_materials_ior",          "KHR_materials_emissive_strength",
+      "KHR_materials_specular",     "KHR_materials_volume",
+      "KHR_materials_clearcoat",    "KHR_materials_sheen",
+      "KHR_draco_mesh_compression", "EXT_meshopt_compression",
+      "KHR_mesh_quantization",      "KHR_texture_transform",
+      "KHR_texture_basisu",         "EXT_texture_webp"};  // basisu: the fallback image or a warning
   // Unknown extensions, even required ones, are rendered without (README "Scenes"): a material
   // extension then falls back to the core factors; data an unknown extension holds is missing,
   // and the accessors that lack it are refused with their own message.

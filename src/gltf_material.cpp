@@ -151,6 +151,17 @@ Material Loader::convert_material(size_t index) {  // the rules are in the comme
       out.clearcoat_normal_scale = float(v.GetNumberAsDouble());
     }
   }
+  // KHR_materials_sheen: a Charlie sheen between the material and the coat (Bsdf, sheen.h).
+  out.sheen_color =
+      ext_color(ext, ml, "KHR_materials_sheen", "sheenColorFactor", 1.0).value_or(vec3(0.0f));
+  out.sheen_roughness =
+      unit(ext_number(ext, ml, "KHR_materials_sheen", "sheenRoughnessFactor", 0.0),
+           "sheenRoughnessFactor");
+  out.sheen_color_texture = ext_texture(ext, ml, "KHR_materials_sheen", "sheenColorTexture");
+  out.sheen_roughness_texture =
+      ext_texture(ext, ml, "KHR_materials_sheen", "sheenRoughnessTexture");
+  if (max_component(out.sheen_color) == 0.0f)  // "If sheenColorFactor is zero, the whole sheen
+    out.sheen_color_texture = out.sheen_roughness_texture = TextureRef{};  // layer is disabled"
   if (out.clearcoat == 0.0f) {  // the extension: clearcoatFactor 0 disables the whole layer
     out.clearcoat_texture = out.clearcoat_roughness_texture = out.clearcoat_normal_texture =
         TextureRef{};

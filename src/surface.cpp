@@ -73,6 +73,10 @@ Surface World::surface(const Hit& hit) const {
     p.clearcoat *= lookup(images, m.clearcoat_texture, s.uv, false).x;
     p.clearcoat_roughness *= lookup(images, m.clearcoat_roughness_texture, s.uv, false).y;
   }
+  if (max_component(p.sheen_color) > 0.0f) {  // KHR_materials_sheen: colour sRGB, roughness A
+    p.sheen_color *= vec3(lookup(images, m.sheen_color_texture, s.uv, true));
+    p.sheen_roughness *= lookup(images, m.sheen_roughness_texture, s.uv, false).w;
+  }
   if (mesh.tangents && (m.normal_texture.present() || m.clearcoat_normal_texture.present())) {
     const glm::vec4 t =
         w * mesh.tangents[i0] + hit.u * mesh.tangents[i1] + hit.v * mesh.tangents[i2];

@@ -90,9 +90,9 @@ TEST(Clearcoat, EvalIsTheExtensionsFresnelCoat) {
   for (int k = 0; k < 20000; ++k) {
     vec3 ng, ns, nc;
     random_normals(rng, ng, ns, nc);
-    BsdfParams p = coated(vec3(rng.next_float(), rng.next_float(), rng.next_float()),
-                          rng.next_float(), 0.1f + 0.9f * rng.next_float(), rng.next_float(),
-                          0.05f + 0.9f * rng.next_float());
+    BsdfParams p =
+        coated(vec3(rng.next_float(), rng.next_float(), rng.next_float()), rng.next_float(),
+               0.1f + 0.9f * rng.next_float(), rng.next_float(), 0.05f + 0.9f * rng.next_float());
     p.coat_normal = nc;
     const Bsdf bsdf(p, ng, ns);
     const vec3 wo = random_unit(rng), wi = random_unit(rng);
@@ -110,10 +110,9 @@ TEST(Clearcoat, EvalIsTheExtensionsFresnelCoat) {
     const double kc = coat_k(p.clearcoat, wo, nc);
     const float alpha = ggx_alpha(p.clearcoat_roughness);
     // Each layer only above its own normal's horizon, on wo's side.
-    const double dv = co.z > 0.0f && ci.z > 0.0f
-                          ? double(ggx_d(glm::normalize(co + ci), alpha)) *
-                                double(ggx_visibility(co.z, ci.z, alpha))
-                          : 0.0;
+    const double dv = co.z > 0.0f && ci.z > 0.0f ? double(ggx_d(glm::normalize(co + ci), alpha)) *
+                                                       double(ggx_visibility(co.z, ci.z, alpha))
+                                                 : 0.0;
     const vec3 base = lo.z > 0.0f && li.z > 0.0f ? brdf_of(p).eval(lo, li) : vec3(0.0f);
     for (int c = 0; c < 3; ++c) {
       const double want = (1.0 - kc) * double(base[c]) + kc * dv;
@@ -175,13 +174,14 @@ struct Case {
   BsdfParams p;
 };
 std::vector<Case> cases() {
-  return {{"rough coat over glossy dielectric", coated(vec3(0.7f, 0.4f, 0.2f), 0.0f, 0.5f, 1.0f, 0.2f)},
-          {"rough coat over metal", coated(vec3(0.95f, 0.64f, 0.54f), 1.0f, 0.3f, 0.7f, 0.1f)},
-          {"smooth coat over glossy mixture", coated(vec3(0.5f), 0.5f, 0.6f, 1.0f, 0.0f)},
-          {"smooth coat over Lambertian", coated(vec3(0.6f, 0.3f, 0.3f), 0.0f, 1.0f, 1.0f, 0.0f, 0.0f)},
-          {"rough coat over smooth metal", coated(vec3(0.9f), 1.0f, 0.0f, 1.0f, 0.3f)},
-          {"smooth coat over thin glass", coated(vec3(0.8f), 0.0f, 0.0f, 1.0f, 0.0f, 1.0f, 1.0f)},
-          {"rough coat over thin glass", coated(vec3(0.8f), 0.0f, 0.4f, 0.5f, 0.3f, 1.0f, 0.6f)}};
+  return {
+      {"rough coat over glossy dielectric", coated(vec3(0.7f, 0.4f, 0.2f), 0.0f, 0.5f, 1.0f, 0.2f)},
+      {"rough coat over metal", coated(vec3(0.95f, 0.64f, 0.54f), 1.0f, 0.3f, 0.7f, 0.1f)},
+      {"smooth coat over glossy mixture", coated(vec3(0.5f), 0.5f, 0.6f, 1.0f, 0.0f)},
+      {"smooth coat over Lambertian", coated(vec3(0.6f, 0.3f, 0.3f), 0.0f, 1.0f, 1.0f, 0.0f, 0.0f)},
+      {"rough coat over smooth metal", coated(vec3(0.9f), 1.0f, 0.0f, 1.0f, 0.3f)},
+      {"smooth coat over thin glass", coated(vec3(0.8f), 0.0f, 0.0f, 1.0f, 0.0f, 1.0f, 1.0f)},
+      {"rough coat over thin glass", coated(vec3(0.8f), 0.0f, 0.4f, 0.5f, 0.3f, 1.0f, 0.6f)}};
 }
 
 TEST(Clearcoat, SampleWeightIsTheViewsEvalCosOverPdf) {
@@ -289,9 +289,9 @@ TEST(Clearcoat, FollowedAndGatheredPartsSumToTheWholeAndEachSamplesItself) {
   }
   // The followed part under a coat of 0.2 over black: its albedo by sampling is k x the D V
   // albedo by quadrature (4 standard errors + 2e-4), as the whole's was.
-  const Bsdf lobe = Bsdf(coated(vec3(0.0f), 0.0f, 0.6f, 1.0f, 0.2f, 0.0f), vec3(0, 0, 1),
-                         vec3(0, 0, 1))
-                        .lobe_part(below);
+  const Bsdf lobe =
+      Bsdf(coated(vec3(0.0f), 0.0f, 0.6f, 1.0f, 0.2f, 0.0f), vec3(0, 0, 1), vec3(0, 0, 1))
+          .lobe_part(below);
   MetalRoughBrdf dv;
   dv.base_color = vec3(1.0f);
   dv.metallic = 1.0f;
@@ -466,14 +466,14 @@ TEST(Clearcoat, FurnacesInClosedFormAndByQuadrature) {
     const double k = coat_k(0.9, wo, n);
     const double quad_r = k * quad::albedo(dv, wo).x;
     const auto [r_mean, r_se] = albedo(rough, Transport::Radiance);
-    const double quad_i =
-        quad::albedo_of(ggx_alpha(0.3f), wo, [&](const vec3& o, const vec3& i) {
-          return float(coat_k(0.9, i, n)) * dv.eval(o, i);
-        }).x;
+    const double quad_i = quad::albedo_of(ggx_alpha(0.3f), wo, [&](const vec3& o, const vec3& i) {
+                            return float(coat_k(0.9, i, n)) * dv.eval(o, i);
+                          }).x;
     const auto [i_mean, i_se] = albedo(rough, Transport::Importance);
-    std::printf("mu %.2f: white %.5f +- %.5f, black %.5f (k %.5f), rough coat %.5f +- %.5f "
-                "(quadrature %.5f), photons %.5f +- %.5f (quadrature %.5f)\n",
-                mu, w_mean, w_se, b_mean, k, r_mean, r_se, quad_r, i_mean, i_se, quad_i);
+    std::printf(
+        "mu %.2f: white %.5f +- %.5f, black %.5f (k %.5f), rough coat %.5f +- %.5f "
+        "(quadrature %.5f), photons %.5f +- %.5f (quadrature %.5f)\n",
+        mu, w_mean, w_se, b_mean, k, r_mean, r_se, quad_r, i_mean, i_se, quad_i);
     EXPECT_NEAR(r_mean, quad_r, 4.0 * r_se + 2e-4) << mu;
     EXPECT_NEAR(i_mean, quad_i, 4.0 * i_se + 2e-4) << mu;
   }
@@ -494,7 +494,8 @@ TEST(Clearcoat, ZeroCoatIsTheUncoatedMaterialBitForBit) {
     EXPECT_EQ(a.max_f(wo), b.max_f(wo));
     Rng r1(408, 0, uint64_t(k), Stream::Test), r2(408, 0, uint64_t(k), Stream::Test);
     BsdfSample s1, s2;
-    ASSERT_EQ(a.sample(wo, r1, Transport::Importance, s1), b.sample(wo, r2, Transport::Importance, s2));
+    ASSERT_EQ(a.sample(wo, r1, Transport::Importance, s1),
+              b.sample(wo, r2, Transport::Importance, s2));
     EXPECT_EQ(s1.wi, s2.wi);
   }
 }

@@ -380,6 +380,10 @@ TEST_F(LoaderTest, MaterialFactorsOutOfRangeAreRefused) {
        "clearcoatFactor 1.5"},
       {"\"extensions\":{\"KHR_materials_clearcoat\":{\"clearcoatRoughnessFactor\":-1}}",
        "clearcoatRoughnessFactor -1"},
+      {"\"extensions\":{\"KHR_materials_sheen\":{\"sheenColorFactor\":[2,0,0]}}",
+       "sheenColorFactor must be 3 numbers in [0, 1]"},
+      {"\"extensions\":{\"KHR_materials_sheen\":{\"sheenRoughnessFactor\":1.5}}",
+       "sheenRoughnessFactor 1.5"},
       {"\"alphaMode\":\"SOMETIMES\"", "unknown alphaMode 'SOMETIMES'"},
       {"\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":3}}",
        "texture 3, which does not"},
@@ -500,6 +504,32 @@ TEST_F(LoaderTest, ClearcoatIsReadWithItsTexturesAndTangents) {
   EXPECT_EQ(o.clearcoat, 0.0f);
   EXPECT_FALSE(o.clearcoat_texture.present() || o.clearcoat_normal_texture.present());
   EXPECT_TRUE(off.meshes[0].tangents.empty());
+}
+
+TEST_F(LoaderTest, SheenIsReadWithItsTextures) {
+  // KHR_materials_sheen: sheenColorFactor, sheenRoughnessFactor, sheenColorTexture (sRGB) and
+  // sheenRoughnessTexture (A); a black sheenColorFactor disables the layer, textures and all.
+  const std::vector<unsigned char> png = png_bytes(2, 2, dir_);
+  const std::string images =
+      "\"extensionsUsed\":[\"KHR_materials_sheen\"],"
+      "\"images\":[{\"uri\":\"data:image/png;base64," +
+      base64(png) + "\"}],\"textures\":[{\"source\":0}],";
+  const std::string sheen =
+      "\"extensions\":{\"KHR_materials_sheen\":{\"sheenColorFactor\":[0.9,0.5,0.25],"
+      "\"sheenRoughnessFactor\":0.75,\"sheenColorTexture\":{\"index\":0},"
+      "\"sheenRoughnessTexture\":{\"index\":0,\"texCoord\":1}}}";
+  const Scene s = load(textured(images, sheen));
+  const pb::Material& m = s.materials[s.meshes[0].material];
+  expect_vec(m.sheen_color, vec3(0.9f, 0.5f, 0.25f));
+  EXPECT_NEAR(m.sheen_roughness, 0.75f, 1e-7f);
+  EXPECT_TRUE(m.sheen_color_texture.present());
+  EXPECT_EQ(m.sheen_roughness_texture.texcoord, 1);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  const Scene off = load(
+      textured(images, std::string(sheen).replace(sheen.find("[0.9,0.5,0.25]"), 14, "[0,0,0]")));
+  const pb::Material& o = off.materials[off.meshes[0].material];
+  EXPECT_EQ(o.sheen_color, vec3(0.0f));
+  EXPECT_FALSE(o.sheen_color_texture.present() || o.sheen_roughness_texture.present());
 }
 
 TEST_F(LoaderTest, ImagesInBufferViewsAndTheirErrors) {
@@ -1204,14 +1234,14 @@ TEST_F(LoaderTest, NegativeEmission) {
 TEST_F(LoaderTest, UnsupportedRequiredExtension) {
   Gltf g = basic();
   g.top =
-      "\"extensionsUsed\":[\"EXT_mesh_gpu_instancing\",\"KHR_materials_sheen\"],"
+      "\"extensionsUsed\":[\"EXT_mesh_gpu_instancing\",\"KHR_materials_iridescence\"],"
       "\"extensionsRequired\":[\"EXT_mesh_gpu_instancing\"],";
   const Scene s = load(g);
   ASSERT_EQ(s.warnings.size(), 2u);
   EXPECT_EQ(s.warnings[0],
             "extension 'EXT_mesh_gpu_instancing' is required but not implemented; rendered "
             "without it: each instanced mesh is drawn once, at its node");
-  EXPECT_EQ(s.warnings[1], "extension 'KHR_materials_sheen' is ignored");
+  EXPECT_EQ(s.warnings[1], "extension 'KHR_materials_iridescence' is ignored");
 }
 
 TEST_F(LoaderTest, MorphTargetsAreIgnoredWithAWarning) {

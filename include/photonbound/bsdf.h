@@ -70,6 +70,8 @@ struct BsdfParams {
   bool thin = true;
   float clearcoat = 0.0f, clearcoat_roughness = 0.0f;  // KHR_materials_clearcoat
   vec3 coat_normal{0.0f};  // the coat's shading normal; zero: ns (no clearcoatNormalTexture)
+  vec3 sheen_color{0.0f};  // KHR_materials_sheen (black: no sheen)
+  float sheen_roughness = 0.0f;
   static BsdfParams of(const Material& m);  // the factors alone (no textures)
 };
 
@@ -94,6 +96,10 @@ struct BsdfParams {
 // (Transport::Importance) the direction they leave in (the adjoint f*(wo, wi) = f(wi, wo), Veach
 // thesis 3.7.6). A coat below the mirror roughness is a delta branch (the mirror limit of D V is
 // a mirror of weight 1: k reflects).
+//
+// KHR_materials_sheen lies between the material and the coat: f_sheen + s f_material, f_sheen =
+// sheen colour x D V (sheen.h), s = min(1 - max(sheen) E(wo), 1 - max(sheen) E(wi)) (its
+// albedo scaling, in the reciprocal form it gives); delta branches are scaled by s as well.
 class Bsdf {
  public:
   Bsdf() = default;
@@ -182,13 +188,16 @@ class Bsdf {
   bool coat_lobe() const { return coat_ > 0.0f && !coat_smooth_; }
   float coat_dv(const vec3& wo, const vec3& wi, float* pdf) const;
   vec3 eval_with_view(const vec3& wo, const vec3& wi, const vec3& v, float* pdf) const;
-  // Under a coat the non-delta part is up to three terms: the diffuse base, the base's GGX
-  // lobe and the coat's; a part (base_part, lobe_part) keeps some of them.
+  // Under a coat or a sheen the non-delta part is up to four terms: the diffuse base, the
+  // base's GGX lobe, the coat's and the sheen; a part (base_part, lobe_part) keeps some.
+  static constexpr int kTerms = 4;  // diffuse, the base's lobe, the coat's lobe, the sheen
   struct Terms {
-    bool diffuse, lobe, coat;
+    bool diffuse, lobe, coat, sheen;
   };
+  bool layered() const { return coat_ > 0.0f || sheen_max_ > 0.0f; }
   Terms terms() const;
-  void term_albedos(const vec3& wo, float a[3]) const;  // estimates, 0 for absent terms
+  void term_albedos(const vec3& wo, float a[kTerms]) const;  // estimates, 0 for absent terms
+  float sheen_scaling(float cos_o, float cos_i) const;       // 1 without a sheen
   bool follows_lobe(float below) const;
   bool follows_coat(float below) const;
   vec3 diffuse_term(const vec3& wo, const vec3& wi) const;  // local frame, both above
@@ -210,6 +219,10 @@ class Bsdf {
   float coat_roughness_ = 0.0f;                   // clearcoatRoughness
   float coat_alpha_ = 0.0f;                       // its GGX alpha
   bool follow_lobe_ = true, follow_coat_ = true;  // which lobes a coated part follows
+  vec3 sheen_{0.0f};                              // sheen colour (black: none)
+  float sheen_max_ = 0.0f;                        // its largest channel
+  float sheen_roughness_ = 0.0f;                  // sheenRoughness
+  float sheen_alpha_ = 0.0f;                      // its alpha (sheen.h)
   vec3 ng_{0.0f}, ns_{0.0f};
   vec3 nc_{0.0f};  // the coat's normal, on ng's side
 };

@@ -53,6 +53,8 @@ struct Material {
   float clearcoat = 0.0f;               // KHR_materials_clearcoat clearcoatFactor (0: no coat)
   float clearcoat_roughness = 0.0f;     // clearcoatRoughnessFactor
   float clearcoat_normal_scale = 1.0f;  // clearcoatNormalTexture.scale
+  vec3 sheen_color{0.0f};               // KHR_materials_sheen sheenColorFactor (black: none)
+  float sheen_roughness = 0.0f;         // sheenRoughnessFactor
   vec3 attenuation{0.0f};               // KHR_materials_volume: Beer-Lambert coefficient, 1/length
   vec3 emission{0.0f};                  // emissiveFactor x KHR_materials_emissive_strength
   bool double_sided = false;            // doubleSided: an emitter emits from both sides
@@ -69,6 +71,8 @@ struct Material {
   TextureRef clearcoat_texture;            // R (linear)
   TextureRef clearcoat_roughness_texture;  // G (linear)
   TextureRef clearcoat_normal_texture;     // tangent-space normal of the coat (linear)
+  TextureRef sheen_color_texture;          // sRGB
+  TextureRef sheen_roughness_texture;      // A (linear)
 
   // Emits somewhere: the factor is positive (an emissive texture may still be black in places).
   bool emits() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
