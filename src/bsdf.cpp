@@ -118,7 +118,6 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
     coat_ = coat;
     coat_smooth_ = p.clearcoat_roughness < mirror_roughness;
     coat_roughness_ = p.clearcoat_roughness;
-    coat_alpha_ = ggx_alpha(p.clearcoat_roughness);
     const float len = glm::length(p.coat_normal);
     nc_ = len > 0.0f ? p.coat_normal / len : ns;
     if (glm::dot(nc_, ng) < 0.0f) nc_ = -nc_;
@@ -127,9 +126,7 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
   }
   if (sheen > 0.0f) {  // KHR_materials_sheen: a broad lobe of its own, never a mirror
     sheen_ = glm::max(p.sheen_color, vec3(0.0f));
-    sheen_max_ = std::min(sheen, 1.0f);
     sheen_roughness_ = p.sheen_roughness;
-    sheen_alpha_ = sheen_alpha(p.sheen_roughness);
     non_delta = true;
   }
   kind_ = non_delta ? Kind::Layered : Kind::Delta;
@@ -197,13 +194,14 @@ float Bsdf::coat_dv(const vec3& wo, const vec3& wi, float* pdf) const {
   const Frame f(glm::dot(wo, ng_) > 0.0f ? nc_ : -nc_);
   const vec3 lo = f.local(wo), li = f.local(wi);
   if (lo.z <= 0.0f || li.z <= 0.0f) return 0.0f;
-  if (pdf) *pdf = ggx_reflection_pdf(lo, li, coat_alpha_);
+  const float alpha = ggx_alpha(coat_roughness_);
+  if (pdf) *pdf = ggx_reflection_pdf(lo, li, alpha);
   // glTF's specular_brdf without its Fresnel (the coat's is in k): V D.
-  return ggx_d(glm::normalize(lo + li), coat_alpha_) * ggx_visibility(lo.z, li.z, coat_alpha_);
+  return ggx_d(glm::normalize(lo + li), alpha) * ggx_visibility(lo.z, li.z, alpha);
 }
 
 Bsdf::Terms Bsdf::terms() const {
-  const bool lobe = base_non_delta_ && !smooth_, coat = coat_lobe(), sheen = sheen_max_ > 0.0f;
+  const bool lobe = base_non_delta_ && !smooth_, coat = coat_lobe(), sheen = sheen_max() > 0.0f;
   switch (part_) {
     case Part::Lobe:
       return {false, lobe && follow_lobe_, coat && follow_coat_, false};
@@ -215,12 +213,12 @@ Bsdf::Terms Bsdf::terms() const {
 }
 
 float Bsdf::sheen_scaling(float cos_o, float cos_i) const {
-  if (!(sheen_max_ > 0.0f)) return 1.0f;
+  const float sm = sheen_max();
+  if (!(sm > 0.0f)) return 1.0f;
   // KHR_materials_sheen's albedo scaling, in its reciprocal form: min over both directions of
   // 1 - max(sheen colour) E(cos), and not below 0 where E exceeds 1 (sheen.h).
-  return std::max(0.0f,
-                  std::min(1.0f - sheen_max_ * sheen_albedo(std::fabs(cos_o), sheen_roughness_),
-                           1.0f - sheen_max_ * sheen_albedo(std::fabs(cos_i), sheen_roughness_)));
+  return std::max(0.0f, std::min(1.0f - sm * sheen_albedo(std::fabs(cos_o), sheen_roughness_),
+                                 1.0f - sm * sheen_albedo(std::fabs(cos_i), sheen_roughness_)));
 }
 
 void Bsdf::term_albedos(const vec3& wo, float a[kTerms]) const {
@@ -232,7 +230,8 @@ void Bsdf::term_albedos(const vec3& wo, float a[kTerms]) const {
   const Terms t = terms();
   const float k = coat_weight(wo), cos_o = std::fabs(glm::dot(wo, ns_));
   const float mu = brdf_.metallic, f0 = max_component(brdf_.dielectric_f0());
-  const float e = sheen_max_ > 0.0f ? sheen_max_ * sheen_albedo(cos_o, sheen_roughness_) : 0.0f;
+  const float sm = sheen_max();
+  const float e = sm > 0.0f ? sm * sheen_albedo(cos_o, sheen_roughness_) : 0.0f;
   const float under = (1.0f - k) * std::max(0.0f, 1.0f - e) * reflect_;
   a[0] = t.diffuse
              ? std::max(under * (1.0f - mu) * (1.0f - f0) * max_component(brdf_.base_color), 1e-3f)
@@ -264,7 +263,7 @@ vec3 Bsdf::eval_with_view(const vec3& wo, const vec3& wi, const vec3& v, float* 
     }
     under = sheen_scaling(lo.z, li.z) * base;
     if (t.sheen) {  // f_sheen + scaling x f_material (KHR_materials_sheen, "albedo scaling")
-      under += sheen_ * sheen_dv(lo, li, sheen_alpha_);
+      under += sheen_ * sheen_dv(lo, li, sheen_alpha(sheen_roughness_));
       p[3] = 1.0f / (2.0f * kPi);  // drawn uniformly over the hemisphere
     }
   }
@@ -339,14 +338,14 @@ vec3 Bsdf::max_f(const vec3& wo) const {
     if (t.diffuse) base += reflect_ * diffuse;
     if (t.lobe) base += vec3(reflect_ * lobe_bound(wo));
     const float cos_o = std::fabs(glm::dot(wo, ns_));
-    if (sheen_max_ > 0.0f)  // s <= 1 - max(sheen) E(wo); D <= its horizon value, V <= 1
-      base *= std::max(0.0f, 1.0f - sheen_max_ * sheen_albedo(cos_o, sheen_roughness_));
-    if (t.sheen) base += sheen_ * charlie_d_max(sheen_alpha_);
+    if (sheen_max() > 0.0f)  // s <= 1 - max(sheen) E(wo); D <= its horizon value, V <= 1
+      base *= std::max(0.0f, 1.0f - sheen_max() * sheen_albedo(cos_o, sheen_roughness_));
+    if (t.sheen) base += sheen_ * charlie_d_max(sheen_alpha(sheen_roughness_));
     const float k = coat_weight(wo);
     vec3 out = (1.0f - k) * base;
     if (t.coat) {
       const float zo = std::max(std::fabs(glm::dot(wo, nc_)), kMinCosine);
-      out += vec3(k * ggx_term_bound(zo, coat_alpha_, [](float) { return 1.0f; }));
+      out += vec3(k * ggx_term_bound(zo, ggx_alpha(coat_roughness_), [](float) { return 1.0f; }));
     }
     return out;
   }
@@ -482,7 +481,7 @@ bool Bsdf::sample_non_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample
     const Frame f(pick == 1 ? ns : front ? nc_ : -nc_);
     const vec3 lo = f.local(wo);
     if (lo.z <= 0.0f) return false;
-    const float alpha = pick == 1 ? ggx_alpha(brdf_.roughness) : coat_alpha_;
+    const float alpha = pick == 1 ? ggx_alpha(brdf_.roughness) : ggx_alpha(coat_roughness_);
     const vec3 h = sample_ggx_vndf(lo, alpha, u1, u2);
     const vec3 li = 2.0f * glm::dot(lo, h) * h - lo;
     if (li.z <= 0.0f) return false;

@@ -27,9 +27,8 @@ namespace {
 float lambda_fit(float x, float alpha) {
   const float t = (1.0f - alpha) * (1.0f - alpha);
   auto mix = [t](float u, float v) { return u + (v - u) * t; };
-  const float a = mix(21.5473f, 25.3245f), b = mix(3.82987f, 3.32435f),
-              c = mix(0.19823f, 0.16801f), d = mix(-1.97760f, -1.27393f),
-              e = mix(-4.32054f, -4.85967f);
+  const float a = mix(21.5473f, 25.3245f), b = mix(3.82987f, 3.32435f), c = mix(0.19823f, 0.16801f),
+              d = mix(-1.97760f, -1.27393f), e = mix(-4.32054f, -4.85967f);
   return a / (1.0f + b * std::pow(x, c)) + d * x + e;
 }
 

@@ -49,7 +49,8 @@ double spec_d(double cos_h, double alpha) {
 double spec_l(double x, double alpha) {
   const double t = (1.0 - alpha) * (1.0 - alpha);
   auto mix = [t](double u, double v) { return u * (1.0 - t) + v * t; };
-  return mix(21.5473, 25.3245) / (1.0 + mix(3.82987, 3.32435) * std::pow(x, mix(0.19823, 0.16801))) +
+  return mix(21.5473, 25.3245) /
+             (1.0 + mix(3.82987, 3.32435) * std::pow(x, mix(0.19823, 0.16801))) +
          mix(-1.97760, -1.27393) * x + mix(-4.32054, -4.85967);
 }
 double spec_lambda(double c, double alpha) {
@@ -166,8 +167,8 @@ TEST(Sheen, EvalIsTheExtensionsAlbedoScaling) {
     }
     if (lo.z < 1e-3f || li.z < 1e-3f) continue;
     const double alpha = sheen_alpha(sr), m = max_component(sheen);
-    const double s = std::max(
-        0.0, std::min(1.0 - m * sheen_albedo(lo.z, sr), 1.0 - m * sheen_albedo(li.z, sr)));
+    const double s =
+        std::max(0.0, std::min(1.0 - m * sheen_albedo(lo.z, sr), 1.0 - m * sheen_albedo(li.z, sr)));
     const double dv = spec_d(glm::normalize(lo + li).z, alpha) * spec_v(lo.z, li.z, alpha);
     const vec3 base = brdf_of(p).eval(lo, li);
     for (int c = 0; c < 3; ++c) {
@@ -361,9 +362,10 @@ TEST(Sheen, FurnacesOverBlackAndOverWhite) {
       const double e = fine_albedo(mu, r);
       const auto [b_mean, b_se] = albedo(black);
       const auto [w_mean, w_se] = albedo(white);
-      std::printf("roughness %.1f mu %.2f: E %.4f, over black %.4f +- %.4f, over white %.4f +- "
-                  "%.4f\n",
-                  r, mu, e, b_mean, b_se, w_mean, w_se);
+      std::printf(
+          "roughness %.1f mu %.2f: E %.4f, over black %.4f +- %.4f, over white %.4f +- "
+          "%.4f\n",
+          r, mu, e, b_mean, b_se, w_mean, w_se);
       EXPECT_NEAR(b_mean, e, 4.0 * b_se + 3e-3) << r << " " << mu;
       EXPECT_LE(w_mean, 1.0 + 4.0 * w_se) << r << " " << mu;
       EXPECT_GT(w_mean, b_mean) << r << " " << mu;

@@ -194,7 +194,8 @@ class Bsdf {
   struct Terms {
     bool diffuse, lobe, coat, sheen;
   };
-  bool layered() const { return coat_ > 0.0f || sheen_max_ > 0.0f; }
+  bool layered() const { return coat_ > 0.0f || sheen_max() > 0.0f; }
+  float sheen_max() const { return max_component(sheen_); }
   Terms terms() const;
   void term_albedos(const vec3& wo, float a[kTerms]) const;  // estimates, 0 for absent terms
   float sheen_scaling(float cos_o, float cos_i) const;       // 1 without a sheen
@@ -207,22 +208,19 @@ class Bsdf {
   bool smooth_ = false;     // GGX lobes below the mirror roughness: delta branches
   bool has_delta_ = false;  // Layered with a delta part too
   bool thin_ = true;
-  Part part_ = Part::All;  // base_part() and lobe_part()
+  Part part_ = Part::All;                         // base_part() and lobe_part()
+  bool base_non_delta_ = false;                   // the uncoated material has a non-delta part
+  bool coat_smooth_ = false;                      // the clear coat is a mirror
+  bool follow_lobe_ = true, follow_coat_ = true;  // which lobes a coated part follows
   // The reflecting parts as one MetalRoughBrdf whose metallic is m / (m + o), scaled by
   // reflect_ = m + o; the Lambertian kind keeps its reflectance in brdf_.base_color.
   MetalRoughBrdf brdf_;
   float reflect_ = 0.0f;
-  float glass_ = 0.0f;                            // (1 - m) t
-  bool base_non_delta_ = false;                   // the uncoated material has a non-delta part
-  bool coat_smooth_ = false;                      // the clear coat is a mirror
-  float coat_ = 0.0f;                             // clearcoat (0: none)
-  float coat_roughness_ = 0.0f;                   // clearcoatRoughness
-  float coat_alpha_ = 0.0f;                       // its GGX alpha
-  bool follow_lobe_ = true, follow_coat_ = true;  // which lobes a coated part follows
-  vec3 sheen_{0.0f};                              // sheen colour (black: none)
-  float sheen_max_ = 0.0f;                        // its largest channel
-  float sheen_roughness_ = 0.0f;                  // sheenRoughness
-  float sheen_alpha_ = 0.0f;                      // its alpha (sheen.h)
+  float glass_ = 0.0f;            // (1 - m) t
+  float coat_ = 0.0f;             // clearcoat (0: none)
+  float coat_roughness_ = 0.0f;   // clearcoatRoughness (alpha: ggx_alpha of it)
+  vec3 sheen_{0.0f};              // sheen colour (black: none)
+  float sheen_roughness_ = 0.0f;  // sheenRoughness (alpha: sheen_alpha of it)
   vec3 ng_{0.0f}, ns_{0.0f};
   vec3 nc_{0.0f};  // the coat's normal, on ng's side
 };
