@@ -75,7 +75,12 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
     const uint64_t visible = layout.visible_passes.empty() ? passes : layout.visible_passes[pixel];
     const vec3 f = layout.glossy_f.empty() ? layout.max_f
                                            : glm::max(layout.max_f, vec3(layout.glossy_f[pixel]));
-    r.sparse = sparse_term(layout, states[pixel], pixel, f, visible, confidence);
+    // The pixel's estimate averages its samples over every pass, and a pass without a visible
+    // point has no photon part: the photon part's mean is at most k_v lambda_u / i times a
+    // photon's cap, with lambda_u the bound per visible pass (n photons in k_v such passes), so
+    // chi^2 / (2 i) times the cap, over all i passes (ESTIMATOR.md section 12).
+    r.sparse = visible == 0 ? dvec3(0.0)
+                            : sparse_term(layout, states[pixel], pixel, f, passes, confidence);
     // Without the photon cap a state with few photons has no bound (unknown); a pixel that never
     // had a visible point has no photon part to wait for.
     r.photon_free = visible == 0;
