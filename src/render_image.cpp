@@ -48,6 +48,21 @@ ExrImage Renderer::image(const RunInfo& run, const View& v) const {
                           {"unknown_pixels", std::to_string(summary.unknown_pixels)},
                           {"estimator_states", std::to_string(v.states.size())},
                       });
+  // The view rendered, in the file's coordinates: the values of --look-from, --look-at, --up
+  // and --fov that reproduce it here or frame it in another renderer (the entries above say
+  // only how it was chosen, e.g. "the camera's, or 45").
+  const Camera& c = camera_.camera();
+  const dvec3 origin = world_.scene().origin;
+  auto triple = [](const dvec3& p) {
+    return number_text(p.x) + "," + number_text(p.y) + "," + number_text(p.z);
+  };
+  out.metadata.insert(out.metadata.end(),
+                      {
+                          {"view_from", triple(dvec3(c.position) + origin)},
+                          {"view_at", triple(dvec3(c.position + c.forward) + origin)},
+                          {"view_up", triple(dvec3(c.up))},
+                          {"view_fov", number_text(double(c.yfov) * 180.0 / kPiD)},
+                      });
   return out;
 }
 
