@@ -31,6 +31,10 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
     // The ray leaves a followed GGX lobe: the light it finds directly (an emitter, the
     // environment) is that vertex's direct light, which its next-event sample has counted.
     bool after_lobe = false;
+    // The path went past --max-depth by roulette (a pass-over or a followed lobe): it goes on by
+    // roulette through delta branches too, up to kPassOverDepth beyond, instead of being cut
+    // where the limit would cut a path that reached it.
+    bool past_limit = false;
     for (int depth = 0;; ++depth) {
       Hit hit;
       const bool found = depth == 0 ? in.world.camera_hit(origin, dir, hit)
@@ -59,7 +63,10 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
         point.shading = front ? s.ns : -s.ns;
         Bsdf bsdf = s.bsdf;
         bool direct_counted = false;  // this vertex's next-event sample is taken
-        if (depth < in.max_depth && s.bsdf.has_lobe_below(in.follow_roughness)) {
+        // A sharp lobe is followed at --max-depth too (by roulette beyond it, below): gathered
+        // with it, a rare deep path would give its pixel the lobe's peak f in the sparse-photon
+        // bound (ESTIMATOR.md section 12) for good.
+        if (depth < in.max_depth + kPassOverDepth && s.bsdf.has_lobe_below(in.follow_roughness)) {
           // This vertex's direct light with its whole Bsdf (so the choice below adds no noise
           // to it), then follow the GGX lobe with p_lobe or gather photons at the diffuse base
           // with 1 - p_lobe, each divided by its probability (ESTIMATOR.md section 10).
@@ -71,6 +78,13 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
             const GlossyPoint lobe{0, wo, s.bsdf.lobe_part(in.follow_roughness)};
             weight = w / p_lobe;
             point = MeasurementPoint{};  // no visible point here
+            // At or beyond --max-depth the followed path goes on by Russian roulette (1/2,
+            // weight 2), as a pass-over does: the lobe's indirect light keeps its mean.
+            if (depth >= in.max_depth) {
+              if (rng.next_float() >= 0.5f) break;
+              weight *= 2.0f;
+              past_limit = true;
+            }
             BsdfSample b;
             if (!lobe.bsdf.sample(wo, rng, Transport::Radiance, b)) break;
             weight *= b.weight;
@@ -116,6 +130,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
             if (depth >= in.max_depth) {
               if (depth >= in.max_depth + kPassOverDepth || rng.next_float() >= 0.5f) break;
               w *= 2.0f;
+              past_limit = true;
             }
             BsdfSample b;
             if (!bsdf.sample_non_delta_part(wo, rng, b)) break;
@@ -132,7 +147,11 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
         if (!lambertian) glossy[glossy_count++] = {uint32_t(k), wo, bsdf};
         break;
       }
-      if (depth >= in.max_depth) break;  // the chain is cut
+      if (depth >= in.max_depth) {  // the chain is cut, unless it is past the limit already
+        if (!past_limit || depth >= in.max_depth + kPassOverDepth || rng.next_float() >= 0.5f)
+          break;
+        weight *= 2.0f;
+      }
       BsdfSample b;
       if (!s.bsdf.sample_delta(wo, rng, Transport::Radiance, b)) break;
       weight *= p_delta < 1.0f ? b.weight / p_delta : b.weight;

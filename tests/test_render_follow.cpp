@@ -173,6 +173,34 @@ TEST(PassOver, AtTheDepthLimitThePathGoesOnByRoulette) {
   EXPECT_TRUE(std::isfinite(r.max_bound));
 }
 
+TEST(PassOver, ASharpLobeAtTheDepthLimitIsFollowedNotGathered) {
+  // At --max-depth 0 every camera path's first vertex is at the limit. A metal floor of
+  // roughness 0.1 gathered there with its whole Bsdf gives its pixels the lobe's peak f (about
+  // 1/(pi alpha^2) = 3183 here) as the sparse-photon bound's f (ESTIMATOR.md section 12); split
+  // off and followed by roulette, the floor's pixels gather where the lobe leads (the
+  // Lambertian walls), so no pixel's glossy f exceeds the walls' 0.6 / pi. The image stays an
+  // estimate of the same light: within 4 sd of a render at --max-depth 8, whose only extra light
+  // is what depth-1+ delta chains would add (there are none in this room).
+  RenderOptions o = sppm(kDefaultFollowRoughness, 32);
+  o.max_depth = 0;
+  const Scene scene = room(Material::metal(vec3(0.9f, 0.8f, 0.6f), 0.1f));
+  Renderer r(scene, o);
+  for (uint64_t p = 0; p < 32; ++p) r.step();
+  const PixelLayout l = r.layout();
+  float largest = 0.0f;
+  for (float f : l.glossy_f) largest = std::max(largest, f);
+  std::printf("sharp lobe at --max-depth 0: largest glossy f %.3g\n", double(largest));
+  EXPECT_LT(largest, 1.0f);
+  const Result limited = render(scene, o);
+  RenderOptions deep = o;
+  deep.max_depth = 8;
+  const Result full = render(scene, deep);
+  const double z = agreement_z(limited, full);
+  std::printf("  image mean %.5f (depth 0) and %.5f (depth 8), z %.2f\n", limited.mean, full.mean,
+              z);
+  EXPECT_LT(std::fabs(z), 4.0);
+}
+
 TEST(PassOver, AFollowedRenderStopsOnItsTarget) {
   // The same room at the default --follow-roughness: a pixel whose followed lobe reaches the
   // strip used to stay unknown for good, so --target-error alone could not end (it was refused
