@@ -176,10 +176,6 @@ Material Loader::convert_material(size_t index) {  // the rules are in the comme
       fail(ml + ": emission (emissiveFactor x emissiveStrength) must be finite and >= 0");
     out.emission[c] = float(e);
   }
-  if (out.clearcoat > 0.0f && out.emits())
-    warn(ml +
-         ": emission is not darkened by the clear coat (KHR_materials_clearcoat's "
-         "1 - clearcoat x Fresnel: 4% head-on, more toward grazing); it is rendered uncoated");
   out.double_sided = gm.doubleSided;
   if (gm.alphaMode == "MASK") {
     out.alpha_mode = AlphaMode::Mask;

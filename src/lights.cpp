@@ -72,6 +72,7 @@ Lights::Lights(const Scene& scene, double piece_budget)
       tri.radiance = mat.emission;
       tri.select = average(tri.radiance);
       tri.two_sided = mat.double_sided;
+      tri.coat = mat.clearcoat;
       if (mat.emissive_texture.present() || mat.masked())
         add_textured(mesh, mat, uint32_t(t / 3), tri);
       else
@@ -203,6 +204,7 @@ EmittedPhoton Lights::sample_photon(Rng& rng) const {
   // Cosine-weighted direction and uniform area: flux = Le cos / (pdf_A pdf_w) = pi A Le.
   const vec3 le = t.source < 0 ? t.radiance : radiance_at(t, b1, b2);
   ph.flux = le * (kPi * t.area * sides) / p_pick;
+  if (t.coat > 0.0f) ph.flux *= coated_emission(t.coat, glm::dot(ph.dir, ph.normal));
   return ph;
 }
 
@@ -345,6 +347,7 @@ bool Lights::sample_direct(const vec3& receiver, const vec3& normal, Rng& rng,
       le = radiance_at(t, c1, c2);
     }
     out.li = le * (solid_angle / p_pick);
+    if (t.coat > 0.0f) out.li *= coated_emission(t.coat, glm::dot(dir, t.normal));
     out.margin = shadow_margin(t, receiver, std::fabs(glm::dot(dir, t.normal)));
     return max_component(out.li) > 0.0f;
   }
@@ -362,6 +365,7 @@ bool Lights::sample_direct(const vec3& receiver, const vec3& normal, Rng& rng,
   // Area sampling converted to solid angle: Le cos_l A / (d^2 p_pick).
   const vec3 le = t.source < 0 ? t.radiance : radiance_at(t, 1.0f - s, u2 * s);
   out.li = le * (cos_light * t.area / (dist2 * p_pick));
+  if (t.coat > 0.0f) out.li *= coated_emission(t.coat, cos_light);
   out.margin = shadow_margin(t, receiver, cos_light);
   return t.source < 0 || max_component(out.li) > 0.0f;
 }

@@ -290,6 +290,43 @@ TEST(TexturedEmitter, NextEventEstimateMatchesTheIrradianceIntegral) {
   EXPECT_NEAR(e.mean(), want, 4.0 * e.se() + 1e-3 * want);
 }
 
+TEST(CoatedEmitter, TheClearCoatDarkensEveryEmissionByItsFresnel) {
+  // KHR_materials_clearcoat puts the coat over the emission: 1 - c (0.04 + 0.96 (1 - cos)^5) of
+  // it leaves at cosine cos with the normal. With the same random numbers, every photon and
+  // every next-event sample of a coated emitter is the uncoated one's times that share at its
+  // own direction (relative 1e-5), near the quad (solid-angle sampling) and far from it (area
+  // sampling); the photons' mean flux is the coated emitter's power, pi A Le (1 - c x the
+  // cosine-weighted mean of Schlick's term: 0.04 + 0.96 x 2 / 42 for the cosine-weighted mean
+  // of (1 - cos)^5, which is 2 B(2, 6) = 1/21).
+  Material bare = Material::lambertian(vec3(0.0f));
+  bare.emission = vec3(1.5f);
+  Material coated = bare;
+  coated.clearcoat = 0.6f;
+  const Scene a = emissive_quad(bare), b = emissive_quad(coated);
+  const Lights plain(a), coat(b);
+  Mean flux;
+  for (int i = 0; i < 100000; ++i) {
+    Rng r1(18, 0, uint64_t(i), Stream::Test), r2(18, 0, uint64_t(i), Stream::Test);
+    const EmittedPhoton p = plain.sample_photon(r1), q = coat.sample_photon(r2);
+    ASSERT_EQ(p.dir, q.dir);
+    const float share = coated_emission(0.6f, p.dir.z);
+    EXPECT_NEAR(q.flux.x, p.flux.x * share, 1e-5f * p.flux.x);
+    flux.add(q.flux.x);
+  }
+  const double power = kPiD * 2 * 1.5 * (1.0 - 0.6 * (0.04 + 0.96 / 21.0));
+  EXPECT_NEAR(flux.mean(), power, 4.0 * flux.se());
+  for (const vec3& receiver : {vec3(0.7f, 0.4f, 0.5f), vec3(3.0f, -2.0f, 9.0f)})
+    for (int i = 0; i < 2000; ++i) {
+      Rng r1(19, 0, uint64_t(i), Stream::Test), r2(19, 0, uint64_t(i), Stream::Test);
+      DirectSample s, t;
+      const bool ok = plain.sample_direct(receiver, vec3(0, 0, -1), r1, s);
+      ASSERT_EQ(ok, coat.sample_direct(receiver, vec3(0, 0, -1), r2, t));
+      if (!ok) continue;
+      const float share = coated_emission(0.6f, s.wi.z);
+      EXPECT_NEAR(t.li.x, s.li.x * share, 1e-5f * s.li.x);
+    }
+}
+
 TEST(DoubleSidedEmitter, EmitsTwiceThePowerFromBothSides) {
   // A doubleSided emitter of radiance Le emits 2 pi A Le, half of its photons to each side, and
   // lights a receiver behind it as much as one in front (mirror-image receivers).

@@ -217,6 +217,22 @@ TEST(MaterialRender, ASmoothClearCoatOverBlackMirrorsByItsViewWeight) {
   }
 }
 
+TEST(MaterialRender, ACoatedEmitterIsSeenDarkenedByTheCoat) {
+  // The camera looks at a coated emitter (radiance 2, clearcoat 0.6, black base) head-on and
+  // at 1.2 rad: it sees 2 (1 - 0.6 (0.04 + 0.96 (1 - cos)^5)), exactly (PPM, 2e-6).
+  for (double theta : {0.0, 1.2}) {
+    SceneBuilder b;
+    Material m = emitter(vec3(2.0f));
+    m.clearcoat = 0.6f;
+    b.quad(vec3(0), vec3(5, 0, 0), vec3(0, 5, 0), b.material(m));  // front +z
+    const vec3 eye(0.0f, -2.0f * float(std::sin(theta)), 2.0f * float(std::cos(theta)));
+    b.camera(eye, -eye, glm::normalize(vec3(0.0f, float(std::cos(theta)), float(std::sin(theta)))),
+             0.01f);
+    const double want = 2.0 * (1.0 - 0.6 * (0.04 + 0.96 * std::pow(1.0 - std::cos(theta), 5.0)));
+    EXPECT_NEAR(render(b.done(), options(1))[0], want, 2e-6) << theta;
+  }
+}
+
 TEST(MaterialRender, ThinGlassTransmitsOnceStraightThrough) {
   // A thin-walled pane (no volume): the ray goes straight through once, T = b (1 - 0.04), and
   // no attenuation applies (a thin wall has no inside).

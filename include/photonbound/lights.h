@@ -100,6 +100,7 @@ class Lights {
     float peak = 0.0f;       // textured: the largest channel its radiance can reach
     bool two_sided = false;  // doubleSided: emits from both sides
     int32_t source = -1;     // textured: index into sources_
+    float coat = 0.0f;       // KHR_materials_clearcoat's clearcoatFactor: darkens the emission
   };
   // Where a textured piece lies in its mesh triangle: the triangle's barycentrics (b1, b2) of
   // the piece's vertex 0 and the steps along its two edges.

@@ -37,8 +37,9 @@ class World {
   vec3 emitted(const Surface& s, const vec3& wo) const {
     const Material& m = *s.material;
     if (!m.emits() || (!m.double_sided && glm::dot(wo, s.ng) <= 0.0f)) return vec3(0.0f);
-    if (!m.emissive_texture.present() && !m.masked()) return m.emission;
-    return emission_at(scene_.images, m, s.uv);
+    const float coat = m.coat_emission(glm::dot(wo, s.ng));
+    if (!m.emissive_texture.present() && !m.masked()) return coat * m.emission;
+    return coat * emission_at(scene_.images, m, s.uv);
   }
 
   // Beer-Lambert transmittance exp(-sigma d) of the segment from `from` (the surface point it
