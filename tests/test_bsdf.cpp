@@ -6,6 +6,8 @@
 #include "photonbound/scene.h"
 #include "photonbound/surface.h"
 
+#include "bsdf_test_util.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -15,6 +17,8 @@
 
 namespace pb {
 namespace {
+
+using test::random_unit;
 
 constexpr double kPi_ = std::numbers::pi;
 
@@ -31,15 +35,6 @@ double fresnel_reference(double cos_i, double n1, double n2) {
 }
 
 vec3 unit(float x, float y, float z) { return glm::normalize(vec3(x, y, z)); }
-
-vec3 random_unit(Rng& rng) {
-  for (;;) {
-    const vec3 v(2.0f * rng.next_float() - 1.0f, 2.0f * rng.next_float() - 1.0f,
-                 2.0f * rng.next_float() - 1.0f);
-    const float l2 = glm::dot(v, v);
-    if (l2 > 1e-4f && l2 <= 1.0f) return v / std::sqrt(l2);
-  }
-}
 
 // Mean and standard error of a sample.
 struct Moments {

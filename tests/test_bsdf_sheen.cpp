@@ -6,9 +6,9 @@
 #include "photonbound/rng.h"
 #include "photonbound/sheen.h"
 
-#include <gtest/gtest.h>
+#include "bsdf_test_util.h"
 
-#include <boost/math/distributions/chi_squared.hpp>
+#include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
@@ -18,28 +18,13 @@
 namespace pb {
 namespace {
 
-vec3 random_unit(Rng& rng) {
-  for (;;) {
-    const vec3 v(2.0f * rng.next_float() - 1.0f, 2.0f * rng.next_float() - 1.0f,
-                 2.0f * rng.next_float() - 1.0f);
-    const float l2 = glm::dot(v, v);
-    if (l2 > 1e-4f && l2 <= 1.0f) return v / std::sqrt(l2);
-  }
-}
-
-struct Basis {
-  vec3 t, b, n;
-  explicit Basis(const vec3& normal) : n(normal) {
-    const vec3 a = std::fabs(n.x) < 0.6f ? vec3(1, 0, 0) : vec3(0, 1, 0);
-    t = glm::normalize(a - glm::dot(a, n) * n);
-    b = glm::cross(n, t);
-  }
-  vec3 local(const vec3& w) const { return {glm::dot(w, t), glm::dot(w, b), glm::dot(w, n)}; }
-  vec3 world(double theta, double phi) const {
-    return glm::normalize(float(std::sin(theta) * std::cos(phi)) * t +
-                          float(std::sin(theta) * std::sin(phi)) * b + float(std::cos(theta)) * n);
-  }
-};
+using test::Basis;
+using test::brdf_of;
+using test::chi_square;
+using test::expect_draws_follow_the_pdf;
+using test::expect_sample_matches_eval;
+using test::leaves_along_a_branch;
+using test::random_unit;
 
 // The extension's formulas, written out from its text in double.
 double spec_d(double cos_h, double alpha) {
@@ -94,17 +79,6 @@ BsdfParams sheened(vec3 base, float metallic, float roughness, vec3 sheen, float
   p.sheen_color = sheen;
   p.sheen_roughness = sheen_rough;
   return p;
-}
-
-MetalRoughBrdf brdf_of(const BsdfParams& p) {
-  MetalRoughBrdf m;
-  m.base_color = p.base_color;
-  m.metallic = p.metallic;
-  m.roughness = p.roughness;
-  m.ior = p.ior;
-  m.specular = p.specular;
-  m.specular_color = p.specular_color;
-  return m;
 }
 
 TEST(Sheen, CharlieTermsAreTheExtensions) {
@@ -241,81 +215,14 @@ TEST(Sheen, SampleWeightIsEvalCosOverPdf) {
       if (!bsdf.sample(wo, rng, mode, s)) continue;
       ASSERT_TRUE(is_finite(s.weight)) << c.name;
       if (s.delta) {
-        SpecularBranch b[kMaxDeltaBranches];
-        const int nb = bsdf.delta_branches(wo, mode, b);
-        bool found = false;
-        for (int i = 0; i < nb; ++i) found |= glm::length(b[i].dir - s.wi) < 1e-6f;
-        EXPECT_TRUE(found) << c.name;
+        EXPECT_TRUE(leaves_along_a_branch(bsdf, wo, mode, s)) << c.name;
         continue;
       }
-      const float pdf = bsdf.pdf(wo, s.wi);
-      const vec3 f = mode == Transport::Radiance ? bsdf.eval(wo, s.wi) : bsdf.eval(s.wi, wo);
-      const float cos = std::fabs(glm::dot(s.wi, ns));
-      EXPECT_NEAR(s.pdf, pdf, 2e-3f * pdf) << c.name;
-      for (int ch = 0; ch < 3; ++ch)
-        EXPECT_NEAR(s.weight[ch], f[ch] * cos / pdf, 2e-3f * s.weight[ch] + 1e-6f) << c.name;
+      expect_sample_matches_eval(bsdf, wo, s, ns, c.name, mode);
       ++continuous;
     }
     EXPECT_GT(continuous, 1000) << c.name;
   }
-}
-
-// Chi-square of sample()'s directions against pdf() (cos theta in 16 bins, phi in 32, a delta
-// cell and an absorbed cell; cells expecting fewer than 5 pooled).
-double chi_square_p(const Bsdf& bsdf, const vec3& wo, const vec3& ns, int n, Rng& rng) {
-  constexpr int kTheta = 16, kPhi = 32, kSub = 12;
-  const Basis f(ns);
-  std::vector<double> observed(kTheta * kPhi + 2, 0.0), expected(kTheta * kPhi + 2, 0.0);
-  for (int i = 0; i < n; ++i) {
-    BsdfSample s;
-    if (!bsdf.sample(wo, rng, Transport::Importance, s)) {
-      observed[kTheta * kPhi + 1] += 1;
-      continue;
-    }
-    if (s.delta) {
-      observed[kTheta * kPhi] += 1;
-      continue;
-    }
-    const vec3 l = f.local(s.wi);
-    const double mu = std::clamp(double(l.z), 0.0, 1.0 - 1e-12);
-    const double phi = std::atan2(double(l.y), double(l.x)) + kPiD;
-    observed[std::min(kTheta - 1, int((1.0 - mu) * kTheta)) * kPhi +
-             std::min(kPhi - 1, int(phi / (2 * kPiD) * kPhi))] += 1;
-  }
-  double total = 0.0;
-  for (int a = 0; a < kTheta; ++a)
-    for (int b = 0; b < kPhi; ++b) {
-      double sum = 0.0;
-      for (int i = 0; i < kSub; ++i)
-        for (int j = 0; j < kSub; ++j)
-          sum += bsdf.pdf(wo, f.world(std::acos(1.0 - (a + (i + 0.5) / kSub) / kTheta),
-                                      (b + (j + 0.5) / kSub) / kPhi * 2 * kPiD - kPiD));
-      const double cell = (1.0 / kTheta) * (2 * kPiD / kPhi) / (kSub * kSub);
-      expected[a * kPhi + b] = n * sum * cell;
-      total += sum * cell;
-    }
-  const double pd = bsdf.delta_probability(wo);
-  expected[kTheta * kPhi] = n * pd;
-  expected[kTheta * kPhi + 1] = std::max(0.0, n * (1.0 - pd - total));
-  double stat = 0.0, po = 0.0, pe = 0.0;
-  int cells = 0;
-  for (size_t k = 0; k < expected.size(); ++k) {
-    if (expected[k] < 5.0) {
-      po += observed[k];
-      pe += expected[k];
-      continue;
-    }
-    stat += (observed[k] - expected[k]) * (observed[k] - expected[k]) / expected[k];
-    ++cells;
-  }
-  if (pe >= 5.0) {
-    stat += (po - pe) * (po - pe) / pe;
-    ++cells;
-  } else if (po > 5.0 + 10.0 * pe) {
-    stat += 1e9;
-  }
-  return boost::math::cdf(boost::math::complement(
-      boost::math::chi_squared_distribution<double>(std::max(1, cells - 1)), stat));
 }
 
 TEST(Sheen, ChiSquareSampledDirectionsFollowThePdf) {
@@ -325,13 +232,7 @@ TEST(Sheen, ChiSquareSampledDirectionsFollowThePdf) {
   const vec3 ns = glm::normalize(vec3(0.25f, -0.1f, 1.0f));
   for (const Case& c : cases()) {
     const Bsdf bsdf(c.p, ng, ns);
-    const Basis f(ns);
-    for (double theta : {0.4, 1.3}) {
-      Rng rng(505, uint64_t(theta * 10), 0, Stream::Test);
-      const double pv = chi_square_p(bsdf, f.world(theta, 0.7), ns, 200000, rng);
-      std::printf("%-34s theta %.1f: p = %.3g\n", c.name, theta, pv);
-      EXPECT_GT(pv, 1e-4) << c.name << " theta " << theta;
-    }
+    expect_draws_follow_the_pdf(bsdf, ns, {0.4, 1.3}, 505, c.name);
   }
 }
 
