@@ -322,7 +322,17 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
     segments_.shrink_to_fit();
   }
   if (std::getenv("PB_BOUNDARY_DEBUG")) std::fprintf(stderr, "boundary: %zu pairs\n", pairs.size());
-  std::sort(pairs.begin(), pairs.end());
+  // Sorted by (triangle, segment): the runs were concatenated in segment order, so a stable
+  // counting sort by triangle gives std::sort's order in O(pairs + triangles) (at a 4x4 preview,
+  // whose radius spans the scene, scenes/unlit.gltf lists 10.7M pairs: 1 s of std::sort).
+  {
+    std::vector<uint32_t> at(size_t(n) + 1, 0u);
+    for (const auto& pr : pairs) ++at[size_t(pr.first) + 1];
+    for (uint32_t t = 0; t < n; ++t) at[t + 1] += at[t];
+    std::vector<std::pair<uint32_t, uint32_t>> sorted(pairs.size());
+    for (const auto& pr : pairs) sorted[at[pr.first]++] = pr;
+    pairs.swap(sorted);
+  }
   pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
   start_.assign(size_t(n) + 1, 0);
   for (const auto& [t, s] : pairs) ++start_[t + 1];

@@ -5,8 +5,8 @@
 #include "photonbound/bsdf.h"
 #include "photonbound/rng.h"
 
-#include <boost/math/distributions/chi_squared.hpp>
 #include <gtest/gtest.h>
+#include <boost/math/distributions/chi_squared.hpp>
 
 #include <algorithm>
 #include <cmath>
