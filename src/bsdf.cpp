@@ -184,9 +184,7 @@ vec3 Bsdf::eval(const vec3& wo, const vec3& wi) const {
 }
 
 float Bsdf::coat_weight(const vec3& v) const {
-  if (coat_ == 0.0f) return 0.0f;
-  // fresnel_coat: f0 = ((1 - 1.5) / (1 + 1.5))^2 = 0.04, Schlick at |v.n_c|.
-  return coat_ * schlick_fresnel(0.04f, std::min(1.0f, std::fabs(glm::dot(v, nc_))));
+  return clearcoat_fresnel(coat_, glm::dot(v, nc_));  // fresnel_coat at |v.n_c|
 }
 
 float Bsdf::coat_dv(const vec3& wo, const vec3& wi, float* pdf) const {

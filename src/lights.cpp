@@ -1,5 +1,7 @@
 #include "photonbound/lights.h"
 
+#include "photonbound/microfacet.h"
+
 #include "photonbound/bsdf.h"
 #include "photonbound/ray_offset.h"
 
@@ -204,7 +206,7 @@ EmittedPhoton Lights::sample_photon(Rng& rng) const {
   // Cosine-weighted direction and uniform area: flux = Le cos / (pdf_A pdf_w) = pi A Le.
   const vec3 le = t.source < 0 ? t.radiance : radiance_at(t, b1, b2);
   ph.flux = le * (kPi * t.area * sides) / p_pick;
-  if (t.coat > 0.0f) ph.flux *= coated_emission(t.coat, glm::dot(ph.dir, ph.normal));
+  if (t.coat > 0.0f) ph.flux *= 1.0f - clearcoat_fresnel(t.coat, glm::dot(ph.dir, ph.normal));
   return ph;
 }
 
@@ -347,7 +349,7 @@ bool Lights::sample_direct(const vec3& receiver, const vec3& normal, Rng& rng,
       le = radiance_at(t, c1, c2);
     }
     out.li = le * (solid_angle / p_pick);
-    if (t.coat > 0.0f) out.li *= coated_emission(t.coat, glm::dot(dir, t.normal));
+    if (t.coat > 0.0f) out.li *= 1.0f - clearcoat_fresnel(t.coat, glm::dot(dir, t.normal));
     out.margin = shadow_margin(t, receiver, std::fabs(glm::dot(dir, t.normal)));
     return max_component(out.li) > 0.0f;
   }
@@ -365,7 +367,7 @@ bool Lights::sample_direct(const vec3& receiver, const vec3& normal, Rng& rng,
   // Area sampling converted to solid angle: Le cos_l A / (d^2 p_pick).
   const vec3 le = t.source < 0 ? t.radiance : radiance_at(t, 1.0f - s, u2 * s);
   out.li = le * (cos_light * t.area / (dist2 * p_pick));
-  if (t.coat > 0.0f) out.li *= coated_emission(t.coat, cos_light);
+  if (t.coat > 0.0f) out.li *= 1.0f - clearcoat_fresnel(t.coat, cos_light);
   out.margin = shadow_margin(t, receiver, cos_light);
   return t.source < 0 || max_component(out.li) > 0.0f;
 }

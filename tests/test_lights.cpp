@@ -1,6 +1,7 @@
 // Light sampling: spherical-triangle directions and next-event estimates against exact answers;
 // textured emitters (power, where photons start, next-event estimates) and double-sided ones.
 #include "photonbound/lights.h"
+#include "photonbound/microfacet.h"
 #include "photonbound/rng.h"
 
 #include <gtest/gtest.h>
@@ -309,7 +310,7 @@ TEST(CoatedEmitter, TheClearCoatDarkensEveryEmissionByItsFresnel) {
     Rng r1(18, 0, uint64_t(i), Stream::Test), r2(18, 0, uint64_t(i), Stream::Test);
     const EmittedPhoton p = plain.sample_photon(r1), q = coat.sample_photon(r2);
     ASSERT_EQ(p.dir, q.dir);
-    const float share = coated_emission(0.6f, p.dir.z);
+    const float share = 1.0f - clearcoat_fresnel(0.6f, p.dir.z);
     EXPECT_NEAR(q.flux.x, p.flux.x * share, 1e-5f * p.flux.x);
     flux.add(q.flux.x);
   }
@@ -322,7 +323,7 @@ TEST(CoatedEmitter, TheClearCoatDarkensEveryEmissionByItsFresnel) {
       const bool ok = plain.sample_direct(receiver, vec3(0, 0, -1), r1, s);
       ASSERT_EQ(ok, coat.sample_direct(receiver, vec3(0, 0, -1), r2, t));
       if (!ok) continue;
-      const float share = coated_emission(0.6f, s.wi.z);
+      const float share = 1.0f - clearcoat_fresnel(0.6f, s.wi.z);
       EXPECT_NEAR(t.li.x, s.li.x * share, 1e-5f * s.li.x);
     }
 }

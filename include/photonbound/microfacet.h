@@ -84,6 +84,13 @@ inline vec3 schlick_fresnel(const vec3& f0, float cos_theta) {
   return f0 + (vec3(1.0f) - f0) * schlick_weight(cos_theta);
 }
 
+// KHR_materials_clearcoat's layer weight k = clearcoat x Schlick's Fresnel of ior 1.5 (f0 =
+// 0.04) at |cos| with the coat's normal: what the coat reflects of the view (Bsdf), and 1 - k
+// what it lets through of the emission below it (the extension's "Emission").
+inline float clearcoat_fresnel(float coat, float cos_theta) {
+  return coat == 0.0f ? 0.0f : coat * schlick_fresnel(0.04f, cos_theta);
+}
+
 // Normal-incidence reflectance of a dielectric: ((ior - 1) / (ior + 1))^2 (glTF appendix B
 // "Fresnel", fresnel_mix); 0.04 at ior 1.5.
 float dielectric_f0(float ior);

@@ -4,9 +4,6 @@
 
 #include "photonbound/math.h"
 
-#include <algorithm>
-#include <cmath>
-
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -43,14 +40,6 @@ enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
 // glTF 2.0's metallic-roughness material with the extensions photonbound reads, as the file
 // gives it (factors with glTF's defaults; each texture multiplies its factor). World::surface()
 // evaluates the textures at a hit and makes the Bsdf from the result (README "Materials").
-// The share of emission a clear coat of weight `coat` lets through at cosine `cos` with its
-// normal: 1 - coat (0.04 + 0.96 (1 - |cos|)^5) (KHR_materials_clearcoat, "Emission").
-inline float coated_emission(float coat, float cos) {
-  if (coat == 0.0f) return 1.0f;
-  const float c = 1.0f - std::min(1.0f, std::fabs(cos));
-  return 1.0f - coat * (0.04f + 0.96f * (c * c) * (c * c) * c);
-}
-
 struct Material {
   std::string name;
   vec3 base_color{1.0f};  // baseColorFactor.rgb, linear
@@ -85,10 +74,6 @@ struct Material {
   TextureRef sheen_color_texture;          // sRGB
   TextureRef sheen_roughness_texture;      // A (linear)
 
-  // KHR_materials_clearcoat: "the emission is darkened by the Fresnel term", 1 - clearcoat
-  // (0.04 + 0.96 (1 - |cos|)^5), here at the geometric normal and with clearcoatFactor alone
-  // (lights, next-event estimation and what a path sees agree on it).
-  float coat_emission(float cos) const { return coated_emission(clearcoat, cos); }
   // Emits somewhere: the factor is positive (an emissive texture may still be black in places).
   bool emits() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
   // Rays pass through where the base colour's alpha is below the cutoff (alphaMode MASK).

@@ -37,7 +37,9 @@ class World {
   vec3 emitted(const Surface& s, const vec3& wo) const {
     const Material& m = *s.material;
     if (!m.emits() || (!m.double_sided && glm::dot(wo, s.ng) <= 0.0f)) return vec3(0.0f);
-    const float coat = m.coat_emission(glm::dot(wo, s.ng));
+    // KHR_materials_clearcoat darkens the emission: 1 - k at the geometric normal, with
+    // clearcoatFactor alone (Lights does the same for next-event samples and photons).
+    const float coat = 1.0f - clearcoat_fresnel(m.clearcoat, glm::dot(wo, s.ng));
     if (!m.emissive_texture.present() && !m.masked()) return coat * m.emission;
     return coat * emission_at(scene_.images, m, s.uv);
   }
