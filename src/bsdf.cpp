@@ -84,6 +84,7 @@ BsdfParams BsdfParams::of(const Material& m) {
   p.clearcoat_roughness = m.clearcoat_roughness;
   p.sheen_color = m.sheen_color;
   p.sheen_roughness = m.sheen_roughness;
+  p.anisotropy = m.anisotropy;
   return p;
 }
 
@@ -107,7 +108,17 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
   glass_ = (1.0f - m) * t;
   reflect_ = m + (1.0f - m) * (1.0f - t);
   brdf_.metallic = reflect_ > 0.0f ? m / reflect_ : 0.0f;
-  smooth_ = p.roughness < mirror_roughness;
+  if (p.anisotropy > 0.0f) {  // KHR_materials_anisotropy: the direction in ns's tangent plane
+    const vec3 d = p.anisotropy_direction - glm::dot(p.anisotropy_direction, ns) * ns;
+    const float len = glm::length(d);
+    if (len > 1e-6f && std::isfinite(len)) {
+      tangent_ = d / len;
+      brdf_.anisotropy = std::min(p.anisotropy, 1.0f);
+    }
+  }
+  // A mirror only when the lobe is narrow in every direction (the anisotropic alpha_x).
+  smooth_ = brdf_.anisotropy > 0.0f ? std::sqrt(brdf_.alpha_x()) < mirror_roughness
+                                    : p.roughness < mirror_roughness;
   // A Lambertian under a coat or a sheen: its layer reflects nothing, so it has no mirror either.
   if ((coat > 0.0f || sheen > 0.0f) && m == 0.0f && p.specular == 0.0f) smooth_ = false;
   const float opaque = (1.0f - m) * (1.0f - t);
@@ -135,10 +146,19 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
 
 namespace {
 
-// Directions in the shading frame (t, b, n) and back.
+// Directions in the shading frame (t, b, n) and back. With a tangent (unit, orthogonal to n:
+// KHR_materials_anisotropy's direction) t is it; without, any basis (isotropic lobes).
 struct Frame {
   vec3 t, b, n;
   explicit Frame(const vec3& normal) : n(normal) { orthonormal_basis(n, t, b); }
+  Frame(const vec3& normal, const vec3& tangent) : n(normal) {
+    if (tangent == vec3(0.0f)) {
+      orthonormal_basis(n, t, b);
+    } else {
+      t = tangent;
+      b = glm::cross(n, t);
+    }
+  }
   vec3 local(const vec3& w) const { return vec3(glm::dot(w, t), glm::dot(w, b), glm::dot(w, n)); }
   vec3 world(const vec3& w) const { return glm::normalize(w.x * t + w.y * b + w.z * n); }
 };
@@ -153,7 +173,7 @@ vec3 Bsdf::eval_local(const vec3& wo, const vec3& wi, float* pdf) const {
     return reflect_ * brdf_.eval(wo, wi);
   }
   if (part_ == Part::Lobe) {
-    if (pdf) *pdf = ggx_reflection_pdf(wo, wi, ggx_alpha(brdf_.roughness));
+    if (pdf) *pdf = brdf_.specular_pdf(wo, wi);
     return reflect_ * brdf_.eval_specular(wo, wi);
   }
   if (pdf) *pdf = wi.z / kPi;
@@ -179,7 +199,7 @@ vec3 Bsdf::eval(const vec3& wo, const vec3& wi) const {
   if (glm::dot(wo, ng_) * glm::dot(wi, ng_) <= 0.0f) return vec3(0.0f);
   if (kind_ == Kind::Lambertian) return diffuse_f();
   if (layered()) return eval_with_view(wo, wi, wo, nullptr);
-  const Frame f(glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_);
+  const Frame f(glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_, tangent_);
   return eval_local(f.local(wo), f.local(wi), nullptr);
 }
 
@@ -244,7 +264,7 @@ void Bsdf::term_albedos(const vec3& wo, float a[kTerms]) const {
 }
 
 vec3 Bsdf::eval_with_view(const vec3& wo, const vec3& wi, const vec3& v, float* pdf) const {
-  const Frame f(glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_);
+  const Frame f(glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_, tangent_);
   const vec3 lo = f.local(wo), li = f.local(wi);
   const Terms t = terms();
   vec3 under(0.0f);  // everything below the coat
@@ -257,7 +277,7 @@ vec3 Bsdf::eval_with_view(const vec3& wo, const vec3& wi, const vec3& v, float* 
     }
     if (t.lobe) {
       base += reflect_ * brdf_.eval_specular(lo, li);
-      p[1] = ggx_reflection_pdf(lo, li, ggx_alpha(brdf_.roughness));
+      p[1] = brdf_.specular_pdf(lo, li);
     }
     under = sheen_scaling(lo.z, li.z) * base;
     if (t.sheen) {  // f_sheen + scaling x f_material (KHR_materials_sheen, "albedo scaling")
@@ -291,8 +311,15 @@ namespace {
 // sin_i) / 2), which rises with zi, and Schlick's F falls with v.h. So on each of 64 intervals
 // [z0, z1] of zi the product is at most fresnel(v.h at z0) D(c_max at the end nearer zo, or 1 when
 // the interval holds zo) V(zo, z0): within a few percent of the peak.
+//
+// For an anisotropic lobe (alpha_x >= alpha_y, microfacet.h) the same bound holds with D at
+// alpha_x times alpha_x / alpha_y and V at alpha_y: hx^2/ax^2 + hy^2/ay^2 >= (hx^2 + hy^2)/ax^2
+// gives D_aniso(h) <= (ax / ay) D(h; ax), equal at the peak h = n, and |(ax w.x, ay w.y, w.z)|
+// >= smith_root(w; ay) gives V_aniso <= V(ay). alpha_v = alpha (scale 1) is the isotropic bound.
 template <class Fresnel>
-float ggx_term_bound(float zo, float alpha, Fresnel&& fresnel) {
+float ggx_term_bound(float zo, float alpha, Fresnel&& fresnel, float alpha_v = 0.0f,
+                     float scale = 1.0f) {
+  if (!(alpha_v > 0.0f)) alpha_v = alpha;
   constexpr int kIntervals = 64;
   const float so = std::sqrt(std::max(0.0f, 1.0f - zo * zo));
   auto sin_of = [](float z) { return std::sqrt(std::max(0.0f, 1.0f - z * z)); };
@@ -306,9 +333,9 @@ float ggx_term_bound(float zo, float alpha, Fresnel&& fresnel) {
     const float c = zo >= z0 && zo <= z1 ? 1.0f : c_max(zo < z0 ? z0 : z1);
     const vec3 h(sin_of(c), 0.0f, c);
     const float v_h = std::sqrt(std::max(0.0f, 0.5f * (1.0f + zo * z0 - so * sin_of(z0))));
-    best = std::max(best, fresnel(v_h) * ggx_d(h, alpha) * ggx_visibility(zo, z0, alpha));
+    best = std::max(best, fresnel(v_h) * ggx_d(h, alpha) * ggx_visibility(zo, z0, alpha_v));
   }
-  return best * (1.0f + 1e-4f);  // float rounding of the pieces
+  return scale * best * (1.0f + 1e-4f);  // float rounding of the pieces
 }
 
 }  // namespace
@@ -318,11 +345,16 @@ float Bsdf::lobe_bound(const vec3& wo) const {
   const float zo = std::max(std::fabs(glm::dot(wo, ns_)), kMinCosine);
   const vec3 f0 = brdf_.dielectric_f0();
   const float f90 = brdf_.dielectric_f90();
-  return ggx_term_bound(zo, ggx_alpha(brdf_.roughness), [&](float v_h) {
+  const auto fresnel = [&](float v_h) {
     const float w = schlick_weight(v_h);
     return (1.0f - mu) * max_component(f0 + (vec3(f90) - f0) * w) +
            mu * max_component(schlick_fresnel(brdf_.base_color, v_h));
-  });
+  };
+  if (brdf_.anisotropy > 0.0f) {
+    const float ax = brdf_.alpha_x(), ay = brdf_.alpha_y();
+    return ggx_term_bound(zo, ax, fresnel, ay, ax / ay);
+  }
+  return ggx_term_bound(zo, ggx_alpha(brdf_.roughness), fresnel);
 }
 
 vec3 Bsdf::max_f(const vec3& wo) const {
@@ -357,7 +389,7 @@ float Bsdf::pdf(const vec3& wo, const vec3& wi) const {
   if (glm::dot(wo, ng_) * glm::dot(wi, ng_) <= 0.0f) return 0.0f;
   if (kind_ == Kind::Lambertian)
     return std::max(0.0f, glm::dot(wi, ns)) / kPi;  // cosine-weighted about the shading normal
-  const Frame f(ns);
+  const Frame f(ns, tangent_);
   float p = 0.0f;
   if (layered())
     eval_with_view(wo, wi, wo, &p);
@@ -476,11 +508,11 @@ bool Bsdf::sample_non_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample
     orthonormal_basis(ns, t, b);
     wi = glm::normalize(r * std::cos(phi) * t + r * std::sin(phi) * b + z * ns);
   } else {
-    const Frame f(pick == 1 ? ns : front ? nc_ : -nc_);
+    const Frame f = pick == 1 ? Frame(ns, tangent_) : Frame(front ? nc_ : -nc_);
     const vec3 lo = f.local(wo);
     if (lo.z <= 0.0f) return false;
-    const float alpha = pick == 1 ? ggx_alpha(brdf_.roughness) : ggx_alpha(coat_roughness_);
-    const vec3 h = sample_ggx_vndf(lo, alpha, u1, u2);
+    const vec3 h = pick == 1 ? brdf_.sample_specular_normal(lo, u1, u2)
+                             : sample_ggx_vndf(lo, ggx_alpha(coat_roughness_), u1, u2);
     const vec3 li = 2.0f * glm::dot(lo, h) * h - lo;
     if (li.z <= 0.0f) return false;
     wi = f.world(li);
@@ -500,7 +532,7 @@ bool Bsdf::sample_non_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample
 bool Bsdf::sample_base(const vec3& wo, Rng& rng, BsdfSample& out) const {
   const bool front = glm::dot(wo, ng_) > 0.0f;
   const vec3 ng = front ? ng_ : -ng_;
-  const Frame f(front ? ns_ : -ns_);
+  const Frame f(front ? ns_ : -ns_, tangent_);
   const vec3 wo_l = f.local(wo);
   if (wo_l.z <= 0.0f) return false;  // seen from below the shading hemisphere
   if (part_ == Part::Lobe) {
@@ -636,14 +668,21 @@ bool Bsdf::has_lobe_below(float below) const {
   if (layered())
     return kind_ == Kind::Layered && part_ == Part::All &&
            (follows_lobe(below) || follows_coat(below));
-  if (kind_ != Kind::Layered || smooth_ || part_ != Part::All || !(brdf_.roughness < below))
+  if (kind_ != Kind::Layered || smooth_ || part_ != Part::All || !(lobe_roughness() < below))
     return false;
   return brdf_.metallic > 0.0f || brdf_.specular > 0.0f;
 }
 
 bool Bsdf::follows_lobe(float below) const {
-  return base_non_delta_ && !smooth_ && brdf_.roughness < below &&
+  return base_non_delta_ && !smooth_ && lobe_roughness() < below &&
          (brdf_.metallic > 0.0f || brdf_.specular > 0.0f);
+}
+
+float Bsdf::lobe_roughness() const {
+  // An anisotropic lobe is followed or gathered as the isotropic one of the same peak D,
+  // 1 / (pi ax ay): roughness (ax ay)^(1/4).
+  if (!(brdf_.anisotropy > 0.0f)) return brdf_.roughness;
+  return std::sqrt(std::sqrt(brdf_.alpha_x() * brdf_.alpha_y()));
 }
 
 bool Bsdf::follows_coat(float below) const { return coat_lobe() && coat_roughness_ < below; }

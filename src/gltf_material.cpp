@@ -162,6 +162,18 @@ Material Loader::convert_material(size_t index) {  // the rules are in the comme
       ext_texture(ext, ml, "KHR_materials_sheen", "sheenRoughnessTexture");
   if (max_component(out.sheen_color) == 0.0f)  // "If sheenColorFactor is zero, the whole sheen
     out.sheen_color_texture = out.sheen_roughness_texture = TextureRef{};  // layer is disabled"
+  // KHR_materials_anisotropy: the base lobe's alpha along a direction in the tangent frame
+  // (the tangent rotated by anisotropyRotation, or the texture's RG so rotated) becomes
+  // mix(alpha, 1, strength^2); the strength is anisotropyStrength x the texture's B (Bsdf).
+  out.anisotropy = unit(ext_number(ext, ml, "KHR_materials_anisotropy", "anisotropyStrength", 0.0),
+                        "anisotropyStrength");
+  const double rotation =
+      ext_number(ext, ml, "KHR_materials_anisotropy", "anisotropyRotation", 0.0);
+  if (!fits_float(rotation))
+    fail(ml + ": anisotropyRotation " + num(rotation) + " is not a finite angle");
+  out.anisotropy_rotation = float(std::remainder(rotation, 2.0 * M_PI));
+  out.anisotropy_texture = ext_texture(ext, ml, "KHR_materials_anisotropy", "anisotropyTexture");
+  if (out.anisotropy == 0.0f) out.anisotropy_texture = TextureRef{};  // strength 0: isotropic
   if (out.clearcoat == 0.0f) {  // the extension: clearcoatFactor 0 disables the whole layer
     out.clearcoat_texture = out.clearcoat_roughness_texture = out.clearcoat_normal_texture =
         TextureRef{};

@@ -157,9 +157,16 @@ TextureRef Loader::ext_texture(const tinygltf::ExtensionMap& ext, const std::str
 void Loader::add_tangents(Mesh& out, const tinygltf::Primitive& prim, const DracoPrimitive* dp,
                           const Xform& xf, const std::string& where) {
   const Material& mat = scene_.materials[out.material];
-  // One tangent space for both normal textures (KHR_materials_clearcoat asks them to share it).
-  const TextureRef& normal =
+  // One tangent space for both normal textures (KHR_materials_clearcoat asks them to share it)
+  // and the anisotropy direction (KHR_materials_anisotropy: TANGENT, or made as for the normal
+  // texture; without one, from the anisotropy texture's coordinates or TEXCOORD_0).
+  TextureRef normal =
       mat.normal_texture.present() ? mat.normal_texture : mat.clearcoat_normal_texture;
+  const bool aniso = mat.anisotropy > 0.0f;
+  if (!normal.present() && aniso) {
+    normal = mat.anisotropy_texture.present() ? mat.anisotropy_texture : TextureRef{};
+    if (!normal.present()) normal.image = 0;  // only its coordinate set and transform are read
+  }
   if (!normal.present()) return;
   if (const std::optional<View> tan = attribute(prim, dp, "TANGENT", where)) {
     if (tan->count != out.positions.size())
@@ -180,7 +187,13 @@ void Loader::add_tangents(Mesh& out, const tinygltf::Primitive& prim, const Drac
     if (!out.tangents.empty()) return;
   }
   const std::vector<vec2>& uv = out.texcoords[normal.texcoord];
-  if (uv.empty()) return;  // no coordinates: the normal texture reads one texel (warned)
+  if (uv.empty()) {  // no coordinates: the normal texture reads one texel (warned)
+    if (aniso)
+      warn(where +
+           ": anisotropy without TANGENT or texture coordinates has no direction; "
+           "rendered isotropic");
+    return;
+  }
   std::vector<vec2> st(uv.size());
   for (size_t i = 0; i < uv.size(); ++i) {
     const vec2 both[2] = {uv[i], uv[i]};

@@ -110,6 +110,68 @@ float ggx_reflection_pdf(const vec3& wo, const vec3& wi, float alpha) {
   return ggx_d(h, a) / (2.0f * (wo.z + smith_root(wo, a)));
 }
 
+namespace {
+
+// |(ax w.x, ay w.y, w.z)|: the anisotropic smith_root, z sqrt(1 + alpha(phi)^2 tan^2) with
+// alpha(phi)^2 = (ax^2 cos^2 phi + ay^2 sin^2 phi) (Heitz 2014, eq. 80).
+float smith_root(const vec3& w, float ax, float ay) {
+  return std::sqrt(w.z * w.z + ax * ax * w.x * w.x + ay * ay * w.y * w.y);
+}
+
+}  // namespace
+
+float ggx_d(const vec3& h, float alpha_x, float alpha_y) {
+  if (h.z <= 0.0f) return 0.0f;
+  const float ax = clamp_alpha(alpha_x), ay = clamp_alpha(alpha_y);
+  const float x = h.x / ax, y = h.y / ay;
+  const float s = x * x + y * y + h.z * h.z;
+  return 1.0f / (kPi * ax * ay * s * s);
+}
+
+float smith_g1(const vec3& w, float alpha_x, float alpha_y) {
+  if (w.z <= 0.0f) return 0.0f;
+  return 2.0f * w.z / (w.z + smith_root(w, clamp_alpha(alpha_x), clamp_alpha(alpha_y)));
+}
+
+float ggx_visibility(const vec3& wo, const vec3& wi, float alpha_x, float alpha_y) {
+  const float ax = clamp_alpha(alpha_x), ay = clamp_alpha(alpha_y);
+  const vec3 o(wo.x, wo.y, std::max(std::fabs(wo.z), kMinCosine));
+  const vec3 i(wi.x, wi.y, std::max(std::fabs(wi.z), kMinCosine));
+  // Written so that swapping wo and wi swaps the two terms (reciprocal bit for bit).
+  return 0.5f / (i.z * smith_root(o, ax, ay) + o.z * smith_root(i, ax, ay));
+}
+
+float ggx_vndf(const vec3& wo, const vec3& h, float alpha_x, float alpha_y) {
+  if (wo.z <= 0.0f) return 0.0f;
+  const float wo_h = glm::dot(wo, h);
+  if (wo_h <= 0.0f) return 0.0f;
+  const float ax = clamp_alpha(alpha_x), ay = clamp_alpha(alpha_y);
+  return 2.0f * wo_h * ggx_d(h, ax, ay) / (wo.z + smith_root(wo, ax, ay));
+}
+
+vec3 sample_ggx_vndf(const vec3& wo, float alpha_x, float alpha_y, float u1, float u2) {
+  const float ax = clamp_alpha(alpha_x), ay = clamp_alpha(alpha_y);
+  // Heitz 2018, listing 1, as the isotropic one with the stretch (ax, ay).
+  const vec3 vh = glm::normalize(vec3(ax * wo.x, ay * wo.y, wo.z));
+  const float len2 = vh.x * vh.x + vh.y * vh.y;
+  const vec3 t1 = len2 > 0.0f ? vec3(-vh.y, vh.x, 0.0f) / std::sqrt(len2) : vec3(1, 0, 0);
+  const vec3 t2 = glm::cross(vh, t1);
+  const float r = std::sqrt(u1);
+  const float phi = 2.0f * kPi * u2;
+  const float p1 = r * std::cos(phi);
+  const float s = 0.5f * (1.0f + vh.z);
+  const float p2 = (1.0f - s) * std::sqrt(std::max(0.0f, 1.0f - p1 * p1)) + s * r * std::sin(phi);
+  const vec3 nh = p1 * t1 + p2 * t2 + std::sqrt(std::max(0.0f, 1.0f - p1 * p1 - p2 * p2)) * vh;
+  return glm::normalize(vec3(ax * nh.x, ay * nh.y, std::max(0.0f, nh.z)));
+}
+
+float ggx_reflection_pdf(const vec3& wo, const vec3& wi, float alpha_x, float alpha_y) {
+  if (wo.z <= 0.0f || wi.z <= 0.0f) return 0.0f;
+  const vec3 h = glm::normalize(wo + wi);
+  const float ax = clamp_alpha(alpha_x), ay = clamp_alpha(alpha_y);
+  return ggx_d(h, ax, ay) / (2.0f * (wo.z + smith_root(wo, ax, ay)));
+}
+
 float schlick_weight(float cos_theta) {
   const float x = std::clamp(1.0f - std::fabs(cos_theta), 0.0f, 1.0f);
   const float x2 = x * x;
@@ -136,8 +198,12 @@ vec3 eval_and_pdf(const MetalRoughBrdf& m, const vec3& wo, const vec3& wi, float
   // (wo, wi) and (wi, wo): reciprocity holds exactly (barring FMA contraction, see the header).
   const vec3 h = glm::normalize(wo + wi);
   const float v_h = 0.5f * (glm::dot(wo, h) + glm::dot(wi, h));
-  const float d = ggx_d(h, a);
-  const float specular = ggx_visibility(wo.z, wi.z, a) * d;  // glTF specular_brdf
+  const bool aniso = m.anisotropy > 0.0f;
+  const float ax = aniso ? m.alpha_x() : a;
+  const float d = aniso ? ggx_d(h, ax, a) : ggx_d(h, a);
+  // glTF specular_brdf (KHR_materials_anisotropy's BRDF_specularAnisotropicGGX)
+  const float specular =
+      (aniso ? ggx_visibility(wo, wi, ax, a) : ggx_visibility(wo.z, wi.z, a)) * d;
   const float fw = schlick_weight(v_h);
   const vec3 f0 = m.dielectric_f0();
   const vec3 fr = f0 + (vec3(m.dielectric_f90()) - f0) * fw;
@@ -148,7 +214,8 @@ vec3 eval_and_pdf(const MetalRoughBrdf& m, const vec3& wo, const vec3& wi, float
   if (pdf) {
     const float ps = m.specular_probability(wo);
     // ggx_reflection_pdf with the half vector already at hand.
-    const float spec_pdf = d / (2.0f * (wo.z + smith_root(wo, a)));
+    const float spec_pdf =
+        d / (2.0f * (wo.z + (aniso ? smith_root(wo, ax, a) : smith_root(wo, a))));
     *pdf = ps * spec_pdf + (1.0f - ps) * wi.z / kPi;
   }
   if (parts) {
@@ -179,11 +246,10 @@ vec3 MetalRoughBrdf::eval_specular(const vec3& wo, const vec3& wi) const {
 bool MetalRoughBrdf::sample_specular(const vec3& wo, float u1, float u2, vec3& wi, vec3& weight,
                                      float& pdf_out) const {
   if (wo.z <= 0.0f) return false;
-  const float a = ggx_alpha(roughness);
-  const vec3 h = sample_ggx_vndf(wo, a, u1, u2);
+  const vec3 h = sample_specular_normal(wo, u1, u2);
   wi = glm::normalize(2.0f * glm::dot(wo, h) * h - wo);
   if (wi.z <= 0.0f) return false;
-  pdf_out = ggx_reflection_pdf(wo, wi, a);
+  pdf_out = specular_pdf(wo, wi);
   if (!(pdf_out > 0.0f)) return false;
   weight = eval_specular(wo, wi) * (wi.z / pdf_out);
   return true;
@@ -193,6 +259,22 @@ float MetalRoughBrdf::pdf(const vec3& wo, const vec3& wi) const {
   float p;
   eval_and_pdf(*this, wo, wi, &p);
   return p;
+}
+
+float MetalRoughBrdf::alpha_x() const {
+  // KHR_materials_anisotropy: directionAlphaRoughness = mix(alpha, 1, strength^2).
+  const float a = ggx_alpha(roughness), s = std::clamp(anisotropy, 0.0f, 1.0f);
+  return s > 0.0f ? a + (1.0f - a) * (s * s) : a;
+}
+
+float MetalRoughBrdf::specular_pdf(const vec3& wo, const vec3& wi) const {
+  return anisotropy > 0.0f ? ggx_reflection_pdf(wo, wi, alpha_x(), alpha_y())
+                           : ggx_reflection_pdf(wo, wi, ggx_alpha(roughness));
+}
+
+vec3 MetalRoughBrdf::sample_specular_normal(const vec3& wo, float u1, float u2) const {
+  return anisotropy > 0.0f ? sample_ggx_vndf(wo, alpha_x(), alpha_y(), u1, u2)
+                           : sample_ggx_vndf(wo, ggx_alpha(roughness), u1, u2);
 }
 
 vec3 MetalRoughBrdf::dielectric_f0() const {
@@ -212,7 +294,7 @@ bool MetalRoughBrdf::sample(const vec3& wo, float u_lobe, float u1, float u2, ve
                             vec3& weight, float& pdf_out) const {
   if (wo.z <= 0.0f) return false;
   if (u_lobe < specular_probability(wo)) {
-    const vec3 h = sample_ggx_vndf(wo, ggx_alpha(roughness), u1, u2);
+    const vec3 h = sample_specular_normal(wo, u1, u2);
     wi = glm::normalize(2.0f * glm::dot(wo, h) * h - wo);
   } else {
     // Cosine-weighted hemisphere (Malley's method): a uniform disk point lifted to the

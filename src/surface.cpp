@@ -27,6 +27,31 @@ vec3 mapped_normal(const vec3& ns, const vec3& ng, const glm::vec4& tangent, con
   return glm::dot(unit, ng) > 1e-3f ? unit : ns;
 }
 
+// KHR_materials_anisotropy's direction in world space, in the tangent frame (t, b, ns) of the
+// interpolated normal (before normal mapping, as the extension's TBN): (1, 0), or the texture's
+// RG mapped to [-1, 1] and normalised, rotated by anisotropyRotation toward b; the texture's B
+// multiplies the strength. Zero (isotropic) where the frame or the texel's direction vanishes.
+vec3 anisotropy_direction(const Material& m, const vec3& ns, const glm::vec4& tangent,
+                          std::span<const Image> images, const vec2 uv[2], float& strength) {
+  vec3 t = vec3(tangent) - glm::dot(vec3(tangent), ns) * ns;
+  const float len = glm::length(t);
+  if (!(len > 1e-6f)) return vec3(0.0f);
+  t /= len;
+  const vec3 b = glm::cross(ns, t) * (tangent.w < 0.0f ? -1.0f : 1.0f);
+  vec2 d(1.0f, 0.0f);
+  if (m.anisotropy_texture.present()) {
+    const glm::vec4 tex = lookup(images, m.anisotropy_texture, uv, false);
+    d = 2.0f * vec2(tex.x, tex.y) - 1.0f;
+    const float dl = glm::length(d);
+    if (!(dl > 1e-6f)) return vec3(0.0f);
+    d /= dl;
+    strength *= std::clamp(tex.z, 0.0f, 1.0f);
+  }
+  const float c = std::cos(m.anisotropy_rotation), sn = std::sin(m.anisotropy_rotation);
+  const vec2 r(c * d.x - sn * d.y, sn * d.x + c * d.y);  // counter-clockwise, t toward b
+  return r.x * t + r.y * b;
+}
+
 }  // namespace
 
 Surface World::surface(const Hit& hit) const {
@@ -77,9 +102,12 @@ Surface World::surface(const Hit& hit) const {
     p.sheen_color *= vec3(lookup(images, m.sheen_color_texture, s.uv, true));
     p.sheen_roughness *= lookup(images, m.sheen_roughness_texture, s.uv, false).w;
   }
-  if (mesh.tangents && (m.normal_texture.present() || m.clearcoat_normal_texture.present())) {
+  if (mesh.tangents &&
+      (m.normal_texture.present() || m.clearcoat_normal_texture.present() || p.anisotropy > 0.0f)) {
     const glm::vec4 t =
         w * mesh.tangents[i0] + hit.u * mesh.tangents[i1] + hit.v * mesh.tangents[i2];
+    if (p.anisotropy > 0.0f)
+      p.anisotropy_direction = anisotropy_direction(m, s.ns, t, images, s.uv, p.anisotropy);
     // The coat's normal: its own texture, or the interpolated normal ("no normal mapping is
     // applied to the clear coat layer, even if normal mapping is applied to the base").
     if (p.clearcoat > 0.0f && m.clearcoat_normal_texture.present())
@@ -99,6 +127,7 @@ Surface World::surface(const Hit& hit) const {
 
 bool World::may_hold_points(const Material& m) const {
   if (m.metallic_roughness_texture.present() || m.transmission_texture.present()) return true;
+  if (m.anisotropy > 0.0f) return true;  // a mirror's roughness with anisotropy is a lobe
   const vec3 n(0.0f, 0.0f, 1.0f);
   return !Bsdf(m, n, n, mirror_roughness_).is_delta();
 }
@@ -115,6 +144,13 @@ std::string World::mirror_note() const {
       for (int y = 0; y < im.height; ++y)
         for (int x = 0; x < im.width; ++x) g = std::min(g, texel(im, x, y, false).y);
       lowest *= g;
+    }
+    if (m.anisotropy > 0.0f && !m.anisotropy_texture.present()) {
+      // KHR_materials_anisotropy: a mirror only when narrow along its direction too (Bsdf).
+      MetalRoughBrdf b;
+      b.roughness = lowest;
+      b.anisotropy = m.anisotropy;
+      lowest = std::sqrt(b.alpha_x());
     }
     // A GGX lobe that reflects: the metal, or the specular layer of the opaque dielectric
     // (glass transmits through smooth branches at any roughness; Lambertians have no layer).

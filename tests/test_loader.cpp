@@ -384,6 +384,10 @@ TEST_F(LoaderTest, MaterialFactorsOutOfRangeAreRefused) {
        "sheenColorFactor must be 3 numbers in [0, 1]"},
       {"\"extensions\":{\"KHR_materials_sheen\":{\"sheenRoughnessFactor\":1.5}}",
        "sheenRoughnessFactor 1.5"},
+      {"\"extensions\":{\"KHR_materials_anisotropy\":{\"anisotropyStrength\":1.25}}",
+       "anisotropyStrength 1.25"},
+      {"\"extensions\":{\"KHR_materials_anisotropy\":{\"anisotropyRotation\":\"up\"}}",
+       "anisotropyRotation is not a number"},
       {"\"alphaMode\":\"SOMETIMES\"", "unknown alphaMode 'SOMETIMES'"},
       {"\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":3}}",
        "texture 3, which does not"},
@@ -504,6 +508,42 @@ TEST_F(LoaderTest, ClearcoatIsReadWithItsTexturesAndTangents) {
   EXPECT_EQ(o.clearcoat, 0.0f);
   EXPECT_FALSE(o.clearcoat_texture.present() || o.clearcoat_normal_texture.present());
   EXPECT_TRUE(off.meshes[0].tangents.empty());
+}
+
+TEST_F(LoaderTest, AnisotropyIsReadWithItsTextureAndMakesTangents) {
+  // KHR_materials_anisotropy: anisotropyStrength, anisotropyRotation (kept in (-pi, pi]) and
+  // anisotropyTexture; tangents are made from the texture's coordinates without a TANGENT or a
+  // normal texture (the direction needs them); not warned about. Strength 0 disables it, and
+  // then no tangents are made; without texture coordinates or TANGENT it warns "isotropic".
+  const std::vector<unsigned char> png = png_bytes(2, 2, dir_);
+  const std::string images =
+      "\"extensionsUsed\":[\"KHR_materials_anisotropy\"],"
+      "\"images\":[{\"uri\":\"data:image/png;base64," +
+      base64(png) + "\"}],\"textures\":[{\"source\":0}],";
+  const std::string aniso =
+      "\"extensions\":{\"KHR_materials_anisotropy\":{\"anisotropyStrength\":0.6,"
+      "\"anisotropyRotation\":7.0,\"anisotropyTexture\":{\"index\":0,\"texCoord\":1}}}";
+  const Scene s = load(textured(images, aniso));
+  const pb::Material& m = s.materials[s.meshes[0].material];
+  EXPECT_NEAR(m.anisotropy, 0.6f, 1e-7f);
+  EXPECT_NEAR(m.anisotropy_rotation, 7.0 - 2.0 * M_PI, 1e-6);
+  EXPECT_TRUE(m.anisotropy_texture.present());
+  EXPECT_EQ(m.anisotropy_texture.texcoord, 1);
+  ASSERT_EQ(s.meshes[0].tangents.size(), 3u);
+  for (const glm::vec4& t : s.meshes[0].tangents) EXPECT_NEAR(t.x, 1.0f, 1e-5f);  // u along +x
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  const Scene off = load(textured(images, std::string(aniso).replace(aniso.find("0.6"), 3, "0")));
+  const pb::Material& o = off.materials[off.meshes[0].material];
+  EXPECT_EQ(o.anisotropy, 0.0f);
+  EXPECT_FALSE(o.anisotropy_texture.present());
+  EXPECT_TRUE(off.meshes[0].tangents.empty());
+  Gltf bare = basic();  // no texture coordinates, no TANGENT
+  bare.materials[0] =
+      "{\"name\":\"brushed\",\"extensions\":{\"KHR_materials_anisotropy\":{"
+      "\"anisotropyStrength\":1}}}";
+  const Scene b = load(bare);
+  EXPECT_TRUE(b.meshes[0].tangents.empty());
+  EXPECT_TRUE(has_warning(b, "anisotropy without TANGENT or texture coordinates")) << b.warnings[0];
 }
 
 TEST_F(LoaderTest, SheenIsReadWithItsTextures) {

@@ -72,6 +72,10 @@ struct BsdfParams {
   vec3 coat_normal{0.0f};  // the coat's shading normal; zero: ns (no clearcoatNormalTexture)
   vec3 sheen_color{0.0f};  // KHR_materials_sheen (black: no sheen)
   float sheen_roughness = 0.0f;
+  // KHR_materials_anisotropy: the strength in [0, 1] and the direction of increased roughness
+  // (world space; projected into ns's tangent plane). 0 or a direction along ns: isotropic.
+  float anisotropy = 0.0f;
+  vec3 anisotropy_direction{0.0f};
   static BsdfParams of(const Material& m);  // the factors alone (no textures)
 };
 
@@ -96,6 +100,10 @@ struct BsdfParams {
 // (Transport::Importance) the direction they leave in (the adjoint f*(wo, wi) = f(wi, wo), Veach
 // thesis 3.7.6). A coat below the mirror roughness is a delta branch (the mirror limit of D V is
 // a mirror of weight 1: k reflects).
+//
+// KHR_materials_anisotropy stretches the base's GGX lobe (metal and dielectric layer) along a
+// direction in the tangent plane: the shading frame's x is that direction, and MetalRoughBrdf
+// takes alpha mix(alpha, 1, strength^2) along it (microfacet.h).
 //
 // KHR_materials_sheen lies between the material and the coat: f_sheen + s f_material, f_sheen =
 // sheen colour x D V (sheen.h), s = min(1 - max(sheen) E(wo), 1 - max(sheen) E(wi)) (its
@@ -201,6 +209,7 @@ class Bsdf {
   float sheen_scaling(float cos_o, float cos_i) const;       // 1 without a sheen
   bool follows_lobe(float below) const;
   bool follows_coat(float below) const;
+  float lobe_roughness() const;  // the base lobe's roughness for --follow-roughness
   vec3 diffuse_term(const vec3& wo, const vec3& wi) const;  // local frame, both above
   float lobe_bound(const vec3& wo) const;                   // of F D V of the base's lobe (max_f)
 
@@ -222,7 +231,8 @@ class Bsdf {
   vec3 sheen_{0.0f};              // sheen colour (black: none)
   float sheen_roughness_ = 0.0f;  // sheenRoughness (alpha: sheen_alpha of it)
   vec3 ng_{0.0f}, ns_{0.0f};
-  vec3 nc_{0.0f};  // the coat's normal, on ng's side
+  vec3 nc_{0.0f};       // the coat's normal, on ng's side
+  vec3 tangent_{0.0f};  // KHR_materials_anisotropy's direction (unit, _|_ ns); 0: isotropic
 };
 
 }  // namespace pb

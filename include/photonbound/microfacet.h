@@ -74,6 +74,27 @@ vec3 sample_ggx_vndf(const vec3& wo, float alpha, float u1, float u2);
 // reflections below the surface are rejected by the caller).
 float ggx_reflection_pdf(const vec3& wo, const vec3& wi, float alpha);
 
+// Anisotropic GGX (KHR_materials_anisotropy; Heitz 2014, section 5.4; Burley 2012): the
+// same functions with the roughness alpha_x along the local frame's x (the anisotropy
+// direction) and alpha_y along y. With alpha_x = alpha_y they equal the isotropic ones above to
+// float rounding (tests/test_microfacet_aniso.cpp); the isotropic ones stay what isotropic
+// materials use, bit for bit.
+// D(h) = 1 / (pi ax ay (hx^2/ax^2 + hy^2/ay^2 + hz^2)^2), normalised over projected area.
+float ggx_d(const vec3& h, float alpha_x, float alpha_y);
+// Smith's G1 with Lambda(w) = (-1 + sqrt(1 + (ax^2 wx^2 + ay^2 wy^2) / wz^2)) / 2.
+float smith_g1(const vec3& w, float alpha_x, float alpha_y);
+// V = G2 / (4 |n.l| |n.v|) = 1 / (2 (zi |(ax wo.x, ay wo.y, zo)| + zo |(ax wi.x, ay wi.y, zi)|))
+// (the extension's V_GGX_anisotropic without its clamp to 1, which the isotropic V of glTF's
+// core BRDF does not have either: the two agree as the strength goes to 0). Symmetric in wo, wi.
+float ggx_visibility(const vec3& wo, const vec3& wi, float alpha_x, float alpha_y);
+// D_wo(h) = G1(wo) max(0, wo.h) D(h) / wo.z, and Heitz 2018's sampling of it (listing 1 with
+// the stretch (ax, ay)).
+float ggx_vndf(const vec3& wo, const vec3& h, float alpha_x, float alpha_y);
+vec3 sample_ggx_vndf(const vec3& wo, float alpha_x, float alpha_y, float u1, float u2);
+// Density of wi = reflect(wo, h), h by sample_ggx_vndf: D(h) / (2 (wo.z + |(ax wo.x, ay wo.y,
+// wo.z)|)).
+float ggx_reflection_pdf(const vec3& wo, const vec3& wi, float alpha_x, float alpha_y);
+
 // Schlick's weight (1 - |cos|)^5 and Fresnel f0 + (1 - f0)(1 - |cos|)^5 (Schlick 1994; glTF
 // appendix B "Fresnel"), with cos = v.h.
 float schlick_weight(float cos_theta);
@@ -117,6 +138,16 @@ struct MetalRoughBrdf {
   float ior = 1.5f;           // > 0, index of refraction of the dielectric's specular layer
   vec3 specular_color{1.0f};  // KHR_materials_specular specularColorFactor (>= 0)
   float specular = 1.0f;      // KHR_materials_specular specularFactor in [0, 1]; 0: no layer
+  // KHR_materials_anisotropy strength in [0, 1]: the lobe's alpha along the local x axis is
+  // mix(alpha, 1, anisotropy^2), along y alpha (the extension's at and ab). 0: isotropic.
+  float anisotropy = 0.0f;
+
+  // The lobe's alphas along x and y (equal without anisotropy).
+  float alpha_x() const;
+  float alpha_y() const { return ggx_alpha(roughness); }
+  // The lobe's own density of wi = reflect(wo, h), h by its visible normals, and a draw of h.
+  float specular_pdf(const vec3& wo, const vec3& wi) const;
+  vec3 sample_specular_normal(const vec3& wo, float u1, float u2) const;
 
   // The dielectric layer's Fresnel terms at normal and grazing incidence (above).
   vec3 dielectric_f0() const;

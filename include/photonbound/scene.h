@@ -55,6 +55,8 @@ struct Material {
   float clearcoat_normal_scale = 1.0f;  // clearcoatNormalTexture.scale
   vec3 sheen_color{0.0f};               // KHR_materials_sheen sheenColorFactor (black: none)
   float sheen_roughness = 0.0f;         // sheenRoughnessFactor
+  float anisotropy = 0.0f;              // KHR_materials_anisotropy anisotropyStrength (0: none)
+  float anisotropy_rotation = 0.0f;     // anisotropyRotation, radians from the tangent to b
   vec3 attenuation{0.0f};               // KHR_materials_volume: Beer-Lambert coefficient, 1/length
   vec3 emission{0.0f};                  // emissiveFactor x KHR_materials_emissive_strength
   bool double_sided = false;            // doubleSided: an emitter emits from both sides
@@ -73,6 +75,7 @@ struct Material {
   TextureRef clearcoat_normal_texture;     // tangent-space normal of the coat (linear)
   TextureRef sheen_color_texture;          // sRGB
   TextureRef sheen_roughness_texture;      // A (linear)
+  TextureRef anisotropy_texture;           // RG direction in [-1, 1], B strength (linear)
 
   // Emits somewhere: the factor is positive (an emissive texture may still be black in places).
   bool emits() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
@@ -116,9 +119,10 @@ struct Mesh {
   // TEXCOORD_0 and TEXCOORD_1 as the file gives them (dequantised), one per position; empty
   // when absent.
   std::vector<vec2> texcoords[2];
-  // Tangent frames for the normal texture, one per position: xyz unit (world space), w = +-1 the
-  // bitangent's sign (glTF TANGENT: bitangent = cross(normal, xyz) w). The file's TANGENT, or
-  // made from the normal texture's coordinates; empty when the material has no normal texture.
+  // Tangent frames for the normal texture and the anisotropy direction, one per position: xyz
+  // unit (world space), w = +-1 the bitangent's sign (glTF TANGENT: bitangent = cross(normal,
+  // xyz) w). The file's TANGENT, or made from the normal (or anisotropy) texture's coordinates;
+  // empty when the material has neither a normal texture nor anisotropy.
   std::vector<glm::vec4> tangents;
   std::vector<uint32_t> indices;  // three per triangle, degenerate triangles already removed
   uint32_t material = 0;          // index into Scene::materials
