@@ -1,6 +1,7 @@
 #include "photonbound/bsdf.h"
 
 #include "photonbound/sheen.h"
+#include "photonbound/thin_film.h"
 
 #include <algorithm>
 
@@ -85,6 +86,9 @@ BsdfParams BsdfParams::of(const Material& m) {
   p.sheen_color = m.sheen_color;
   p.sheen_roughness = m.sheen_roughness;
   p.anisotropy = m.anisotropy;
+  p.iridescence = m.iridescence;
+  p.iridescence_ior = m.iridescence_ior;
+  p.iridescence_thickness = m.iridescence_thickness_maximum;  // the texture's 1 (none: 1)
   return p;
 }
 
@@ -95,10 +99,16 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
   brdf_.ior = p.ior;
   brdf_.specular = p.specular;
   brdf_.specular_color = p.specular_color;
+  if (p.iridescence > 0.0f) {
+    brdf_.iridescence = std::min(p.iridescence, 1.0f);
+    brdf_.iridescence_ior = p.iridescence_ior;
+    brdf_.iridescence_thickness = p.iridescence_thickness;
+  }
   const float m = std::clamp(p.metallic, 0.0f, 1.0f), t = std::clamp(p.transmission, 0.0f, 1.0f);
   const float coat = std::clamp(p.clearcoat, 0.0f, 1.0f);
   const float sheen = max_component(p.sheen_color);
-  if (m == 0.0f && t == 0.0f && p.specular == 0.0f && coat == 0.0f && !(sheen > 0.0f)) {
+  if (m == 0.0f && t == 0.0f && p.specular == 0.0f && coat == 0.0f && !(sheen > 0.0f) &&
+      brdf_.iridescence == 0.0f) {
     brdf_.metallic = 0.0f;
     reflect_ = 1.0f;
     return;  // kind_ Lambertian
@@ -187,8 +197,7 @@ vec3 Bsdf::diffuse_term(const vec3& wo, const vec3& wi) const {
   // rough lobe (MetalRoughBrdf::eval_diffuse computes it the same way).
   const vec3 h = glm::normalize(wo + wi);
   const float v_h = 0.5f * (glm::dot(wo, h) + glm::dot(wi, h));
-  const vec3 f0 = brdf_.dielectric_f0();
-  const vec3 fr = f0 + (vec3(brdf_.dielectric_f90()) - f0) * schlick_weight(v_h);
+  const vec3 fr = brdf_.layer_fresnel(v_h);
   const float opaque = reflect_ * (1.0f - brdf_.metallic);
   return (opaque * (1.0f - max_component(fr)) / kPi) * brdf_.base_color;
 }
@@ -345,10 +354,13 @@ float Bsdf::lobe_bound(const vec3& wo) const {
   const float zo = std::max(std::fabs(glm::dot(wo, ns_)), kMinCosine);
   const vec3 f0 = brdf_.dielectric_f0();
   const float f90 = brdf_.dielectric_f90();
+  // Schlick's terms fall with v.h; the iridescent Fresnel does not, but it is at most 1.
+  const float irid = brdf_.iridescence;
   const auto fresnel = [&](float v_h) {
     const float w = schlick_weight(v_h);
-    return (1.0f - mu) * max_component(f0 + (vec3(f90) - f0) * w) +
-           mu * max_component(schlick_fresnel(brdf_.base_color, v_h));
+    const float schlick = (1.0f - mu) * max_component(f0 + (vec3(f90) - f0) * w) +
+                          mu * max_component(schlick_fresnel(brdf_.base_color, v_h));
+    return irid > 0.0f ? (1.0f - irid) * schlick + irid : schlick;
   };
   if (brdf_.anisotropy > 0.0f) {
     const float ax = brdf_.alpha_x(), ay = brdf_.alpha_y();
@@ -627,9 +639,8 @@ int Bsdf::base_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) c
   if (smooth_ && reflect_ > 0.0f) {
     // The mirror limit of the GGX lobes (h = n): appendix B's Fresnel terms at cos_i.
     const float mu = brdf_.metallic;
-    const vec3 f0 = brdf_.dielectric_f0();
-    const vec3 fd = f0 + (vec3(brdf_.dielectric_f90()) - f0) * schlick_weight(cos_i);
-    mirror = reflect_ * ((1.0f - mu) * fd + mu * schlick_fresnel(brdf_.base_color, cos_i));
+    mirror =
+        reflect_ * ((1.0f - mu) * brdf_.layer_fresnel(cos_i) + mu * brdf_.metal_fresnel(cos_i));
   }
   if (glass_ <= 0.0f) {
     if (!(max_component(mirror) > 0.0f)) return 0;
@@ -639,8 +650,7 @@ int Bsdf::base_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) c
   if (thin_) {
     // Thin-walled (KHR_materials_transmission without a volume): no refraction; Schlick's
     // Fresnel of the layer reflects, the rest goes straight through, tinted by base colour.
-    const vec3 f0 = brdf_.dielectric_f0();
-    const vec3 fr = f0 + (vec3(brdf_.dielectric_f90()) - f0) * schlick_weight(cos_i);
+    const vec3 fr = brdf_.layer_fresnel(cos_i);
     out[0] = {reflect_checked(wo, ns, ng), mirror + glass_ * fr};
     out[1] = {-wo, brdf_.base_color * (glass_ * (1.0f - max_component(fr)))};
     return 2;
@@ -649,7 +659,16 @@ int Bsdf::base_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) c
   // term has none from the dense side; KHR_materials_volume, "Implementation").
   const float eta = front ? brdf_.ior : 1.0f / brdf_.ior;  // eta_t / eta_i
   const float f = fresnel_dielectric(cos_i, eta);
-  out[0] = {reflect_checked(wo, ns, ng), mirror + glass_ * f};
+  // KHR_materials_iridescence on a volume: the film's Fresnel (of the volume's f0) mixed into
+  // the exact one on the side the film faces, the outside; the refraction keeps 1 - its largest
+  // channel (the extension's rgb_mix). From inside, the exact Fresnel alone.
+  vec3 fr(f);
+  if (brdf_.iridescence > 0.0f && front)
+    fr = glm::mix(fr,
+                  iridescent_fresnel(1.0f, brdf_.iridescence_ior, vec3(dielectric_f0(brdf_.ior)),
+                                     brdf_.iridescence_thickness, cos_i),
+                  brdf_.iridescence);
+  out[0] = {reflect_checked(wo, ns, ng), mirror + glass_ * fr};
   if (f >= 1.0f) return 1;
   vec3 wt;
   if (!refract(wo, ns, eta, wt) || glm::dot(wt, ng) >= 0.0f) {
@@ -660,7 +679,7 @@ int Bsdf::base_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) c
     }
   }
   const float scale = mode == Transport::Radiance ? 1.0f / (eta * eta) : 1.0f;
-  out[1] = {wt, glass_ * brdf_.base_color * ((1.0f - f) * scale)};
+  out[1] = {wt, glass_ * brdf_.base_color * ((1.0f - max_component(fr)) * scale)};
   return 2;
 }
 

@@ -174,6 +174,27 @@ Material Loader::convert_material(size_t index) {  // the rules are in the comme
   out.anisotropy_rotation = float(std::remainder(rotation, 2.0 * M_PI));
   out.anisotropy_texture = ext_texture(ext, ml, "KHR_materials_anisotropy", "anisotropyTexture");
   if (out.anisotropy == 0.0f) out.anisotropy_texture = TextureRef{};  // strength 0: isotropic
+  // KHR_materials_iridescence: a thin film whose Fresnel term (thin_film.h) is mixed into the
+  // layers' by iridescenceFactor x the texture's R, of thickness mix(minimum, maximum, the
+  // thickness texture's G) nanometres (the maximum without the texture).
+  const char* irid = "KHR_materials_iridescence";
+  out.iridescence = unit(ext_number(ext, ml, irid, "iridescenceFactor", 0.0), "iridescenceFactor");
+  const double film_ior = ext_number(ext, ml, irid, "iridescenceIor", 1.3);
+  if (!(film_ior >= 1.0 && fits_float(film_ior)))
+    fail(ml + ": iridescenceIor " + num(film_ior) + " must be finite and at least 1");
+  out.iridescence_ior = float(film_ior);
+  const double thin = ext_number(ext, ml, irid, "iridescenceThicknessMinimum", 100.0);
+  const double thick = ext_number(ext, ml, irid, "iridescenceThicknessMaximum", 400.0);
+  for (const auto& [v, what] : {std::pair(thin, "iridescenceThicknessMinimum"),
+                                std::pair(thick, "iridescenceThicknessMaximum")})
+    if (!(v >= 0.0 && fits_float(v)))
+      fail(ml + ": " + what + " " + num(v) + " must be finite and at least 0 (nanometres)");
+  out.iridescence_thickness_minimum = float(thin);
+  out.iridescence_thickness_maximum = float(thick);
+  out.iridescence_texture = ext_texture(ext, ml, irid, "iridescenceTexture");
+  out.iridescence_thickness_texture = ext_texture(ext, ml, irid, "iridescenceThicknessTexture");
+  if (out.iridescence == 0.0f)  // "If iridescenceFactor is zero, the extension has no effect"
+    out.iridescence_texture = out.iridescence_thickness_texture = TextureRef{};
   if (out.clearcoat == 0.0f) {  // the extension: clearcoatFactor 0 disables the whole layer
     out.clearcoat_texture = out.clearcoat_roughness_texture = out.clearcoat_normal_texture =
         TextureRef{};

@@ -1,5 +1,7 @@
 #include "photonbound/microfacet.h"
 
+#include "photonbound/thin_film.h"
+
 #include <algorithm>
 
 namespace pb {
@@ -206,11 +208,16 @@ vec3 eval_and_pdf(const MetalRoughBrdf& m, const vec3& wo, const vec3& wi, float
       (aniso ? ggx_visibility(wo, wi, ax, a) : ggx_visibility(wo.z, wi.z, a)) * d;
   const float fw = schlick_weight(v_h);
   const vec3 f0 = m.dielectric_f0();
-  const vec3 fr = f0 + (vec3(m.dielectric_f90()) - f0) * fw;
+  vec3 fr = f0 + (vec3(m.dielectric_f90()) - f0) * fw;
+  vec3 fm = m.base_color + (vec3(1.0f) - m.base_color) * fw;
+  if (m.iridescence > 0.0f) {  // KHR_materials_iridescence: the film's Fresnel mixed in
+    if (m.metallic < 1.0f) fr = m.layer_fresnel(v_h);
+    if (m.metallic > 0.0f) fm = m.metal_fresnel(v_h);
+  }
   // glTF appendix B "Metal BRDF and Dielectric BRDF", the full code, with KHR_materials_specular's
   // RGB Fresnel term (the diffuse base keeps 1 - its largest channel).
   const vec3 dielectric = (1.0f - max_component(fr)) * m.base_color / kPi + fr * specular;
-  const vec3 metal = (m.base_color + (vec3(1.0f) - m.base_color) * fw) * specular;
+  const vec3 metal = fm * specular;
   if (pdf) {
     const float ps = m.specular_probability(wo);
     // ggx_reflection_pdf with the half vector already at hand.
@@ -275,6 +282,23 @@ float MetalRoughBrdf::specular_pdf(const vec3& wo, const vec3& wi) const {
 vec3 MetalRoughBrdf::sample_specular_normal(const vec3& wo, float u1, float u2) const {
   return anisotropy > 0.0f ? sample_ggx_vndf(wo, alpha_x(), alpha_y(), u1, u2)
                            : sample_ggx_vndf(wo, ggx_alpha(roughness), u1, u2);
+}
+
+vec3 MetalRoughBrdf::layer_fresnel(float cos_theta) const {
+  const vec3 f0 = dielectric_f0();
+  const vec3 fr = f0 + (vec3(dielectric_f90()) - f0) * schlick_weight(cos_theta);
+  if (!(iridescence > 0.0f)) return fr;
+  return glm::mix(fr,
+                  iridescent_fresnel(1.0f, iridescence_ior, f0, iridescence_thickness, cos_theta),
+                  iridescence);
+}
+
+vec3 MetalRoughBrdf::metal_fresnel(float cos_theta) const {
+  const vec3 fm = schlick_fresnel(base_color, cos_theta);
+  if (!(iridescence > 0.0f)) return fm;
+  return glm::mix(
+      fm, iridescent_fresnel(1.0f, iridescence_ior, base_color, iridescence_thickness, cos_theta),
+      iridescence);
 }
 
 vec3 MetalRoughBrdf::dielectric_f0() const {

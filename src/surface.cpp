@@ -102,6 +102,13 @@ Surface World::surface(const Hit& hit) const {
     p.sheen_color *= vec3(lookup(images, m.sheen_color_texture, s.uv, true));
     p.sheen_roughness *= lookup(images, m.sheen_roughness_texture, s.uv, false).w;
   }
+  if (p.iridescence > 0.0f) {  // KHR_materials_iridescence: factor x R; thickness mixed by G
+    p.iridescence *= lookup(images, m.iridescence_texture, s.uv, false).x;
+    if (m.iridescence_thickness_texture.present())
+      p.iridescence_thickness =
+          glm::mix(m.iridescence_thickness_minimum, m.iridescence_thickness_maximum,
+                   lookup(images, m.iridescence_thickness_texture, s.uv, false).y);
+  }
   if (mesh.tangents &&
       (m.normal_texture.present() || m.clearcoat_normal_texture.present() || p.anisotropy > 0.0f)) {
     const glm::vec4 t =

@@ -49,15 +49,13 @@ TEST(AnisotropicGgx, DistributionAndVisibleNormalsIntegrateToOne) {
   // 400 x 400 cells: the midpoint rule's error on these smooth integrands is below 1e-4.
   const float alphas[][2] = {{0.5f, 0.5f}, {1.0f, 0.09f}, {0.3f, 0.01f}, {0.05f, 0.6f}};
   for (const auto& a : alphas) {
-    const double d = over_normals(a[0], a[1], 400, [&](const vec3& h) {
-      return double(ggx_d(h, a[0], a[1])) * h.z;
-    });
+    const double d = over_normals(
+        a[0], a[1], 400, [&](const vec3& h) { return double(ggx_d(h, a[0], a[1])) * h.z; });
     EXPECT_NEAR(d, 1.0, 2e-4) << a[0] << " " << a[1];
     for (const vec3 wo : {vec3(0, 0, 1), glm::normalize(vec3(0.8f, 0.3f, 0.5f)),
                           glm::normalize(vec3(-0.2f, 0.9f, 0.1f))}) {
-      const double v = over_normals(a[0], a[1], 400, [&](const vec3& h) {
-        return double(ggx_vndf(wo, h, a[0], a[1]));
-      });
+      const double v = over_normals(
+          a[0], a[1], 400, [&](const vec3& h) { return double(ggx_vndf(wo, h, a[0], a[1])); });
       EXPECT_NEAR(v, 1.0, 2e-3) << a[0] << " " << a[1] << " wo.z " << wo.z;
     }
   }
@@ -131,9 +129,9 @@ TEST(Anisotropy, EvalIsTheExtensionsBrdf) {
     const vec3 n = random_unit(rng);
     const vec3 dir = random_unit(rng);
     if (std::fabs(glm::dot(dir, n)) > 0.95f) continue;
-    const BsdfParams p = brushed(vec3(rng.next_float(), rng.next_float(), rng.next_float()),
-                                 k % 2 ? 1.0f : 0.0f, 0.1f + 0.9f * rng.next_float(),
-                                 rng.next_float(), dir);
+    const BsdfParams p =
+        brushed(vec3(rng.next_float(), rng.next_float(), rng.next_float()), k % 2 ? 1.0f : 0.0f,
+                0.1f + 0.9f * rng.next_float(), rng.next_float(), dir);
     const Bsdf bsdf(p, n, n);
     const vec3 wo = random_unit(rng), wi = random_unit(rng);
     if (glm::dot(wo, n) < 0.05f || glm::dot(wi, n) < 0.05f) continue;
@@ -244,9 +242,9 @@ TEST(Anisotropy, AlbedoOfTheDrawsMatchesQuadrature) {
   const vec3 n(0, 0, 1), dir(1, 0, 0);
   for (float r : {0.1f, 0.4f})
     for (float s : {0.5f, 1.0f})
-      for (const vec3 wo : {glm::normalize(vec3(0.6f, 0.0f, 0.8f)),
-                            glm::normalize(vec3(0.0f, 0.9f, 0.3f)),
-                            glm::normalize(vec3(0.7f, -0.6f, 0.4f))}) {
+      for (const vec3 wo :
+           {glm::normalize(vec3(0.6f, 0.0f, 0.8f)), glm::normalize(vec3(0.0f, 0.9f, 0.3f)),
+            glm::normalize(vec3(0.7f, -0.6f, 0.4f))}) {
         const BsdfParams p = brushed(vec3(1.0f), 1.0f, r, s, dir);
         const Bsdf bsdf(p, n, n);
         MetalRoughBrdf m;
@@ -313,7 +311,8 @@ TEST(Anisotropy, AMirrorOnlyWhenNarrowInEveryDirection) {
   EXPECT_TRUE(Bsdf(brushed(vec3(0.9f), 1.0f, 0.0f, 0.02f, dir), n, n).is_delta());
   const Bsdf along(brushed(vec3(0.9f), 1.0f, 0.5f, 1.0f, n), n, n);
   const Bsdf iso(brushed(vec3(0.9f), 1.0f, 0.5f, 0.0f, n), n, n);
-  const vec3 wo = glm::normalize(vec3(0.3f, 0.2f, 0.9f)), wi = glm::normalize(vec3(-0.5f, 0.1f, 0.8f));
+  const vec3 wo = glm::normalize(vec3(0.3f, 0.2f, 0.9f)),
+             wi = glm::normalize(vec3(-0.5f, 0.1f, 0.8f));
   EXPECT_EQ(along.eval(wo, wi), iso.eval(wo, wi));
 }
 

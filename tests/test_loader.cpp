@@ -388,6 +388,12 @@ TEST_F(LoaderTest, MaterialFactorsOutOfRangeAreRefused) {
        "anisotropyStrength 1.25"},
       {"\"extensions\":{\"KHR_materials_anisotropy\":{\"anisotropyRotation\":\"up\"}}",
        "anisotropyRotation is not a number"},
+      {"\"extensions\":{\"KHR_materials_iridescence\":{\"iridescenceFactor\":-0.5}}",
+       "iridescenceFactor -0.5"},
+      {"\"extensions\":{\"KHR_materials_iridescence\":{\"iridescenceIor\":0.8}}",
+       "iridescenceIor 0.8 must be finite and at least 1"},
+      {"\"extensions\":{\"KHR_materials_iridescence\":{\"iridescenceThicknessMaximum\":-1}}",
+       "iridescenceThicknessMaximum -1 must be finite and at least 0"},
       {"\"alphaMode\":\"SOMETIMES\"", "unknown alphaMode 'SOMETIMES'"},
       {"\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":3}}",
        "texture 3, which does not"},
@@ -544,6 +550,34 @@ TEST_F(LoaderTest, AnisotropyIsReadWithItsTextureAndMakesTangents) {
   const Scene b = load(bare);
   EXPECT_TRUE(b.meshes[0].tangents.empty());
   EXPECT_TRUE(has_warning(b, "anisotropy without TANGENT or texture coordinates")) << b.warnings[0];
+}
+
+TEST_F(LoaderTest, IridescenceIsReadWithItsTextures) {
+  // KHR_materials_iridescence: the factor, the film's index, the thickness range (the minimum
+  // may exceed the maximum) and both textures; iridescenceFactor 0 disables it, textures too.
+  const std::vector<unsigned char> png = png_bytes(2, 2, dir_);
+  const std::string images =
+      "\"extensionsUsed\":[\"KHR_materials_iridescence\"],"
+      "\"images\":[{\"uri\":\"data:image/png;base64," +
+      base64(png) + "\"}],\"textures\":[{\"source\":0}],";
+  const std::string film =
+      "\"extensions\":{\"KHR_materials_iridescence\":{\"iridescenceFactor\":0.7,"
+      "\"iridescenceIor\":1.8,\"iridescenceThicknessMinimum\":500,"
+      "\"iridescenceThicknessMaximum\":200,\"iridescenceTexture\":{\"index\":0},"
+      "\"iridescenceThicknessTexture\":{\"index\":0,\"texCoord\":1}}}";
+  const Scene s = load(textured(images, film));
+  const pb::Material& m = s.materials[s.meshes[0].material];
+  EXPECT_NEAR(m.iridescence, 0.7f, 1e-7f);
+  EXPECT_NEAR(m.iridescence_ior, 1.8f, 1e-7f);
+  EXPECT_EQ(m.iridescence_thickness_minimum, 500.0f);
+  EXPECT_EQ(m.iridescence_thickness_maximum, 200.0f);
+  EXPECT_TRUE(m.iridescence_texture.present());
+  EXPECT_EQ(m.iridescence_thickness_texture.texcoord, 1);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  const Scene off = load(textured(images, std::string(film).replace(film.find("0.7"), 3, "0")));
+  const pb::Material& o = off.materials[off.meshes[0].material];
+  EXPECT_EQ(o.iridescence, 0.0f);
+  EXPECT_FALSE(o.iridescence_texture.present() || o.iridescence_thickness_texture.present());
 }
 
 TEST_F(LoaderTest, SheenIsReadWithItsTextures) {
@@ -1274,14 +1308,14 @@ TEST_F(LoaderTest, NegativeEmission) {
 TEST_F(LoaderTest, UnsupportedRequiredExtension) {
   Gltf g = basic();
   g.top =
-      "\"extensionsUsed\":[\"EXT_mesh_gpu_instancing\",\"KHR_materials_iridescence\"],"
+      "\"extensionsUsed\":[\"EXT_mesh_gpu_instancing\",\"KHR_materials_dispersion\"],"
       "\"extensionsRequired\":[\"EXT_mesh_gpu_instancing\"],";
   const Scene s = load(g);
   ASSERT_EQ(s.warnings.size(), 2u);
   EXPECT_EQ(s.warnings[0],
             "extension 'EXT_mesh_gpu_instancing' is required but not implemented; rendered "
             "without it: each instanced mesh is drawn once, at its node");
-  EXPECT_EQ(s.warnings[1], "extension 'KHR_materials_iridescence' is ignored");
+  EXPECT_EQ(s.warnings[1], "extension 'KHR_materials_dispersion' is ignored");
 }
 
 TEST_F(LoaderTest, MorphTargetsAreIgnoredWithAWarning) {

@@ -76,6 +76,8 @@ struct BsdfParams {
   // (world space; projected into ns's tangent plane). 0 or a direction along ns: isotropic.
   float anisotropy = 0.0f;
   vec3 anisotropy_direction{0.0f};
+  // KHR_materials_iridescence: the film's weight (0: none), index and thickness in nm.
+  float iridescence = 0.0f, iridescence_ior = 1.3f, iridescence_thickness = 400.0f;
   static BsdfParams of(const Material& m);  // the factors alone (no textures)
 };
 

@@ -141,6 +141,18 @@ struct MetalRoughBrdf {
   // KHR_materials_anisotropy strength in [0, 1]: the lobe's alpha along the local x axis is
   // mix(alpha, 1, anisotropy^2), along y alpha (the extension's at and ab). 0: isotropic.
   float anisotropy = 0.0f;
+  // KHR_materials_iridescence: the film's weight in [0, 1] (0: none), index and thickness (nm).
+  // Its Fresnel term (thin_film.h) is mixed into both layers' by the weight (below).
+  float iridescence = 0.0f;
+  float iridescence_ior = 1.3f;
+  float iridescence_thickness = 400.0f;
+
+  // The Fresnel terms of the two layers at cos = v.h: the dielectric's F = f0 + (f90 - f0)
+  // (1 - cos)^5 and the metal's Schlick of base_color, each mixed with the iridescent Fresnel
+  // of its own f0 by `iridescence` (the extension's iridescent_dielectric_layer with
+  // KHR_materials_specular, and iridescent_conductor_layer). Without iridescence, Schlick's.
+  vec3 layer_fresnel(float cos_theta) const;
+  vec3 metal_fresnel(float cos_theta) const;
 
   // The lobe's alphas along x and y (equal without anisotropy).
   float alpha_x() const;

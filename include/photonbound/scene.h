@@ -57,25 +57,31 @@ struct Material {
   float sheen_roughness = 0.0f;         // sheenRoughnessFactor
   float anisotropy = 0.0f;              // KHR_materials_anisotropy anisotropyStrength (0: none)
   float anisotropy_rotation = 0.0f;     // anisotropyRotation, radians from the tangent to b
-  vec3 attenuation{0.0f};               // KHR_materials_volume: Beer-Lambert coefficient, 1/length
-  vec3 emission{0.0f};                  // emissiveFactor x KHR_materials_emissive_strength
-  bool double_sided = false;            // doubleSided: an emitter emits from both sides
+  float iridescence = 0.0f;             // KHR_materials_iridescence iridescenceFactor (0: none)
+  float iridescence_ior = 1.3f;         // iridescenceIor
+  float iridescence_thickness_minimum = 100.0f;  // nm, at the thickness texture's 0
+  float iridescence_thickness_maximum = 400.0f;  // nm, at its 1 (and without it)
+  vec3 attenuation{0.0f};     // KHR_materials_volume: Beer-Lambert coefficient, 1/length
+  vec3 emission{0.0f};        // emissiveFactor x KHR_materials_emissive_strength
+  bool double_sided = false;  // doubleSided: an emitter emits from both sides
   AlphaMode alpha_mode = AlphaMode::Opaque;
   float alpha_cutoff = 0.5f;
-  float normal_scale = 1.0f;               // normalTexture.scale
-  TextureRef base_color_texture;           // sRGB; alpha in A
-  TextureRef metallic_roughness_texture;   // B metal, G rough (linear)
-  TextureRef normal_texture;               // tangent-space normal (linear)
-  TextureRef emissive_texture;             // sRGB
-  TextureRef transmission_texture;         // R (linear)
-  TextureRef specular_texture;             // A (linear)
-  TextureRef specular_color_texture;       // sRGB
-  TextureRef clearcoat_texture;            // R (linear)
-  TextureRef clearcoat_roughness_texture;  // G (linear)
-  TextureRef clearcoat_normal_texture;     // tangent-space normal of the coat (linear)
-  TextureRef sheen_color_texture;          // sRGB
-  TextureRef sheen_roughness_texture;      // A (linear)
-  TextureRef anisotropy_texture;           // RG direction in [-1, 1], B strength (linear)
+  float normal_scale = 1.0f;                 // normalTexture.scale
+  TextureRef base_color_texture;             // sRGB; alpha in A
+  TextureRef metallic_roughness_texture;     // B metal, G rough (linear)
+  TextureRef normal_texture;                 // tangent-space normal (linear)
+  TextureRef emissive_texture;               // sRGB
+  TextureRef transmission_texture;           // R (linear)
+  TextureRef specular_texture;               // A (linear)
+  TextureRef specular_color_texture;         // sRGB
+  TextureRef clearcoat_texture;              // R (linear)
+  TextureRef clearcoat_roughness_texture;    // G (linear)
+  TextureRef clearcoat_normal_texture;       // tangent-space normal of the coat (linear)
+  TextureRef sheen_color_texture;            // sRGB
+  TextureRef sheen_roughness_texture;        // A (linear)
+  TextureRef anisotropy_texture;             // RG direction in [-1, 1], B strength (linear)
+  TextureRef iridescence_texture;            // R (linear)
+  TextureRef iridescence_thickness_texture;  // G (linear)
 
   // Emits somewhere: the factor is positive (an emissive texture may still be black in places).
   bool emits() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
