@@ -89,6 +89,7 @@ BsdfParams BsdfParams::of(const Material& m) {
   p.iridescence = m.iridescence;
   p.iridescence_ior = m.iridescence_ior;
   p.iridescence_thickness = m.iridescence_thickness_maximum;  // the texture's 1 (none: 1)
+  p.dispersion = m.dispersion;
   return p;
 }
 
@@ -116,6 +117,8 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
   // KHR_materials_transmission: dielectric = fresnel_mix(mix(diffuse, btdf, t), specular) is
   // (1 - t) fresnel_mix(diffuse, specular) + t fresnel_mix(btdf, specular): the parts split.
   glass_ = (1.0f - m) * t;
+  // KHR_materials_dispersion changes only a volume's refraction.
+  if (!p.thin && glass_ > 0.0f && p.dispersion > 0.0f) dispersion_ = p.dispersion;
   reflect_ = m + (1.0f - m) * (1.0f - t);
   brdf_.metallic = reflect_ > 0.0f ? m / reflect_ : 0.0f;
   if (p.anisotropy > 0.0f) {  // KHR_materials_anisotropy: the direction in ns's tangent plane
@@ -439,7 +442,8 @@ float Bsdf::delta_probability(const vec3& wo) const {
   return wd > 0.0f ? wd / (wd + wn) : 0.0f;
 }
 
-bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const {
+bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out,
+                  const vec3& tint) const {
   if (kind_ == Kind::Lambertian) {
     const bool front = glm::dot(wo, ng_) > 0.0f;
     const vec3 ng = front ? ng_ : -ng_;
@@ -455,13 +459,13 @@ bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) con
     out.delta = false;
     return true;
   }
-  if (kind_ == Kind::Delta) return sample_delta(wo, rng, mode, out);
+  if (kind_ == Kind::Delta) return sample_delta(wo, rng, mode, out, tint);
   if (part_ != Part::All) return sample_non_delta(wo, rng, mode, out);  // one term, no delta
   const float pd = delta_probability(wo);
   if (pd > 0.0f) {
     const float u = rng.next_float();  // which part, then that part's numbers
     if (u < pd) {
-      if (!sample_delta(wo, rng, mode, out)) return false;
+      if (!sample_delta(wo, rng, mode, out, tint)) return false;
       out.weight /= pd;
       return true;
     }
@@ -577,13 +581,30 @@ bool Bsdf::sample_base(const vec3& wo, Rng& rng, BsdfSample& out) const {
   return glm::dot(out.wi, ng) > 0.0f;  // below the true surface: absorbed
 }
 
-bool Bsdf::sample_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const {
+bool Bsdf::sample_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out,
+                        const vec3& tint) const {
   SpecularBranch b[kMaxDeltaBranches];
   const int n = delta_branches(wo, mode, b);
   if (n == 0) return false;
   int pick = 0;
   float p = 1.0f;
-  if (n == 2) {
+  if (dispersion_ > 0.0f) {
+    // A dispersive volume: in proportion to what each branch would carry of this path. A
+    // branch the path cannot use (another channel's refraction) is never drawn, and any it can
+    // has a positive probability, so the weight w / p stays unbiased.
+    float a[kMaxDeltaBranches], total = 0.0f;
+    for (int k = 0; k < n; ++k) total += a[k] = average(glm::max(tint, vec3(0.0f)) * b[k].weight);
+    if (!(total > 0.0f)) return false;
+    const float u = rng.next_float() * total;
+    float acc = 0.0f;
+    pick = -1;
+    for (int k = 0; k < n && pick < 0; ++k)
+      if (a[k] > 0.0f && u < (acc += a[k])) pick = k;
+    if (pick < 0)  // rounding past the end: the last branch that can be drawn
+      for (int k = n - 1; k >= 0 && pick < 0; --k)
+        if (a[k] > 0.0f) pick = k;
+    p = a[pick] / total;
+  } else if (n == 2) {
     // Reflection or refraction in proportion to their throughput.
     const float a0 = average(b[0].weight), a1 = average(b[1].weight);
     p = a0 / (a0 + a1);
@@ -630,7 +651,7 @@ int Bsdf::delta_branches(const vec3& wo, Transport mode,
   return n + 1;
 }
 
-int Bsdf::base_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) const {
+int Bsdf::base_branches(const vec3& wo, Transport mode, SpecularBranch out[4]) const {
   const bool front = glm::dot(wo, ng_) > 0.0f;
   const vec3 ng = front ? ng_ : -ng_;  // normals on wo's side
   const vec3 ns = front ? ns_ : -ns_;
@@ -655,6 +676,7 @@ int Bsdf::base_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) c
     out[1] = {-wo, brdf_.base_color * (glass_ * (1.0f - max_component(fr)))};
     return 2;
   }
+  if (dispersion_ > 0.0f) return dispersive_branches(wo, mode, out);
   // A volume boundary: the exact Fresnel equations with total internal reflection (Schlick's
   // term has none from the dense side; KHR_materials_volume, "Implementation").
   const float eta = front ? brdf_.ior : 1.0f / brdf_.ior;  // eta_t / eta_i
@@ -681,6 +703,61 @@ int Bsdf::base_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) c
   const float scale = mode == Transport::Radiance ? 1.0f / (eta * eta) : 1.0f;
   out[1] = {wt, glass_ * brdf_.base_color * ((1.0f - max_component(fr)) * scale)};
   return 2;
+}
+
+float dispersed_ior(float ior, float dispersion, int channel) {
+  // KHR_materials_dispersion: n(lambda) = max(n_d + (n_d - 1) / V_d (523655 / lambda^2 -
+  // 1.5168), 1), V_d = 20 / dispersion, lambda in nm, at the C, d and F lines (bsdf.h).
+  constexpr float kLambda[3] = {656.3f, 587.6f, 486.1f};
+  const float l = kLambda[channel];
+  return std::max(1.0f,
+                  ior + (ior - 1.0f) * (dispersion / 20.0f) * (523655.0f / (l * l) - 1.5168f));
+}
+
+int Bsdf::dispersive_branches(const vec3& wo, Transport mode, SpecularBranch out[4]) const {
+  // A dispersive volume boundary: each channel refracts by its own index, so the transmission
+  // is up to three branches, channel c's carrying channel c alone (0 in the others), and the
+  // reflection one branch whose exact Fresnel term differs per channel. A channel under total
+  // internal reflection reflects whole. With a film (base_branches) the refractions keep 1 -
+  // the largest mixed F, the extension's rgb_mix, so that dispersion 0+ meets dispersion 0.
+  const bool front = glm::dot(wo, ng_) > 0.0f;
+  const vec3 ng = front ? ng_ : -ng_, ns = front ? ns_ : -ns_;
+  const float cos_i = std::fabs(glm::dot(wo, ns));
+  vec3 mirror(0.0f);
+  if (smooth_ && reflect_ > 0.0f) {
+    const float mu = brdf_.metallic;
+    mirror =
+        reflect_ * ((1.0f - mu) * brdf_.layer_fresnel(cos_i) + mu * brdf_.metal_fresnel(cos_i));
+  }
+  const bool film = brdf_.iridescence > 0.0f && front;
+  const vec3 film_f =
+      film ? iridescent_fresnel(1.0f, brdf_.iridescence_ior, vec3(dielectric_f0(brdf_.ior)),
+                                brdf_.iridescence_thickness, cos_i)
+           : vec3(0.0f);
+  vec3 fr(1.0f), dir[3];
+  float eta[3];
+  bool passes[3] = {false, false, false};
+  for (int c = 0; c < 3; ++c) {
+    eta[c] = front ? dispersed_ior(brdf_.ior, dispersion_, c)
+                   : 1.0f / dispersed_ior(brdf_.ior, dispersion_, c);
+    const float f = fresnel_dielectric(cos_i, eta[c]);
+    if (f >= 1.0f || ((!refract(wo, ns, eta[c], dir[c]) || glm::dot(dir[c], ng) >= 0.0f) &&
+                      !refract(wo, ng, eta[c], dir[c])))
+      continue;  // no transmission about either normal: fr[c] stays 1
+    fr[c] = film ? f + brdf_.iridescence * (film_f[c] - f) : f;
+    passes[c] = true;
+  }
+  out[0] = {reflect_checked(wo, ns, ng), mirror + glass_ * fr};
+  const float largest = max_component(fr);
+  int n = 1;
+  for (int c = 0; c < 3; ++c) {
+    if (!passes[c]) continue;
+    vec3 w(0.0f);
+    w[c] = glass_ * brdf_.base_color[c] * (1.0f - (film ? largest : fr[c])) *
+           (mode == Transport::Radiance ? 1.0f / (eta[c] * eta[c]) : 1.0f);
+    out[n++] = {dir[c], w};
+  }
+  return n;
 }
 
 bool Bsdf::has_lobe_below(float below) const {

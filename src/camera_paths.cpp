@@ -153,7 +153,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
         weight *= 2.0f;
       }
       BsdfSample b;
-      if (!s.bsdf.sample_delta(wo, rng, Transport::Radiance, b)) break;
+      if (!s.bsdf.sample_delta(wo, rng, Transport::Radiance, b, weight)) break;
       weight *= p_delta < 1.0f ? b.weight / p_delta : b.weight;
       if (!(max_component(weight) > 0.0f)) break;
       origin = s.position;

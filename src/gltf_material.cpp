@@ -174,6 +174,14 @@ Material Loader::convert_material(size_t index) {  // the rules are in the comme
   out.anisotropy_rotation = float(std::remainder(rotation, 2.0 * M_PI));
   out.anisotropy_texture = ext_texture(ext, ml, "KHR_materials_anisotropy", "anisotropyTexture");
   if (out.anisotropy == 0.0f) out.anisotropy_texture = TextureRef{};  // strength 0: isotropic
+  // KHR_materials_dispersion: the volume's index varies with the wavelength (Bsdf); it only
+  // changes refraction, so a thin-walled material ignores it (warned).
+  const double dispersion = ext_number(ext, ml, "KHR_materials_dispersion", "dispersion", 0.0);
+  if (!(dispersion >= 0.0 && fits_float(dispersion)))
+    fail(ml + ": dispersion " + num(dispersion) + " must be finite and at least 0");
+  out.dispersion = float(dispersion);
+  if (out.dispersion > 0.0f && out.thin)
+    warn(ml + ": dispersion without KHR_materials_volume (thin-walled) has no effect");
   // KHR_materials_iridescence: a thin film whose Fresnel term (thin_film.h) is mixed into the
   // layers' by iridescenceFactor x the texture's R, of thickness mix(minimum, maximum, the
   // thickness texture's G) nanometres (the maximum without the texture).

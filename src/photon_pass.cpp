@@ -68,7 +68,7 @@ void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, std::vect
     if (!s.bsdf.is_delta() && (bounce >= 1 || deposit_first_hit_))
       out.push_back({s.position, wo, ng, flux});
     BsdfSample b;
-    if (!s.bsdf.sample(wo, rng, Transport::Importance, b)) return;
+    if (!s.bsdf.sample(wo, rng, Transport::Importance, b, flux)) return;
     const vec3 next = b.wi;
     // The shading-normal correction of adjoint transport (bsdf.h).
     const vec3 factor = b.weight * adjoint_shading_factor(wo, next, ng, ns);

@@ -33,8 +33,8 @@ dvec3 sensitivity(double opd, const dvec3& shift) {
   for (int c = 0; c < 3; ++c)
     xyz[c] = val[c] * std::sqrt(2.0 * kPiD * var[c]) * std::cos(pos[c] * phase + shift[c]) *
              std::exp(-phase * phase * var[c]);
-  xyz.x += 9.7470e-14 * std::sqrt(2.0 * kPiD * 4.5282e+09) * std::cos(2.2399e+06 * phase + shift.x) *
-           std::exp(-4.5282e+09 * phase * phase);
+  xyz.x += 9.7470e-14 * std::sqrt(2.0 * kPiD * 4.5282e+09) *
+           std::cos(2.2399e+06 * phase + shift.x) * std::exp(-4.5282e+09 * phase * phase);
   xyz /= 1.0685e-7;
   // XYZ to linear Rec. 709 (sRGB primaries, D65).
   return dvec3(3.2404542 * xyz.x - 1.5371385 * xyz.y - 0.4985314 * xyz.z,

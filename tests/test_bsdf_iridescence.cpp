@@ -32,8 +32,8 @@ dvec3 spec_sensitivity(double opd, dvec3 shift) {
       var(4.3278e+09, 9.3046e+09, 6.6121e+09);
   dvec3 xyz = val * glm::sqrt(2.0 * kPiD * var) * glm::cos(pos * phase + shift) *
               glm::exp(-(phase * phase) * var);
-  xyz.x += 9.7470e-14 * std::sqrt(2.0 * kPiD * 4.5282e+09) * std::cos(2.2399e+06 * phase + shift[0]) *
-           std::exp(-4.5282e+09 * phase * phase);
+  xyz.x += 9.7470e-14 * std::sqrt(2.0 * kPiD * 4.5282e+09) *
+           std::cos(2.2399e+06 * phase + shift[0]) * std::exp(-4.5282e+09 * phase * phase);
   xyz /= 1.0685e-7;
   const glm::dmat3 m(3.2404542, -0.9692660, 0.0556434, -1.5371385, 1.8760108, -0.2040259,
                      -0.4985314, 0.0415560, 1.0572252);
@@ -74,7 +74,8 @@ TEST(ThinFilm, IsTheExtensionsIridescentFresnel) {
   Rng rng(701, 0, 0, Stream::Test);
   int above_one = 0;
   for (int k = 0; k < 20000; ++k) {
-    const float film = 1.0f + 1.5f * rng.next_float(), thickness = 10.0f + 1190.0f * rng.next_float();
+    const float film = 1.0f + 1.5f * rng.next_float(),
+                thickness = 10.0f + 1190.0f * rng.next_float();
     // f0 up to 0.999: above 0.9999 the GLSL's guard f0 + 1e-4 passes 1 and its base index turns
     // negative; photonbound keeps f0 + 1e-4 at most 0.9999 (a base index of 4e4, a mirror).
     const float u = rng.next_float(), v = rng.next_float(), w = rng.next_float();
@@ -111,7 +112,8 @@ TEST(ThinFilm, PhysicalLimits) {
     const double r0 = std::pow(0.3 / 2.3, 2.0), r12 = r0 + (1 - r0) * std::pow(1.0 - c, 5.0);
     const double c2 = std::sqrt(1.0 - (1.0 - c * c) / (1.3 * 1.3));
     const double sq = std::sqrt(grey + 1e-4), n = (1 + sq) / (1 - sq);
-    const double rb = std::pow((n - 1.3) / (n + 1.3), 2.0), r23 = rb + (1 - rb) * std::pow(1 - c2, 5.0);
+    const double rb = std::pow((n - 1.3) / (n + 1.3), 2.0),
+                 r23 = rb + (1 - rb) * std::pow(1 - c2, 5.0);
     const double incoherent = r12 + (1 - r12) * (1 - r12) * r23 / (1 - r12 * r23);
     for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(thick[ch], incoherent, 1e-3) << c << " " << ch;
   }
@@ -136,9 +138,9 @@ TEST(Iridescence, EvalIsTheExtensionsLayering) {
   Rng rng(702, 0, 0, Stream::Test);
   const vec3 n(0, 0, 1);
   for (int k = 0; k < 20000; ++k) {
-    const BsdfParams p = film(vec3(rng.next_float(), rng.next_float(), rng.next_float()),
-                              rng.next_float(), 0.1f + 0.9f * rng.next_float(), rng.next_float(),
-                              100.0f + 700.0f * rng.next_float());
+    const BsdfParams p =
+        film(vec3(rng.next_float(), rng.next_float(), rng.next_float()), rng.next_float(),
+             0.1f + 0.9f * rng.next_float(), rng.next_float(), 100.0f + 700.0f * rng.next_float());
     const Bsdf bsdf(p, n, n);
     const vec3 wo = random_unit(rng), wi = random_unit(rng);
     if (wo.z < 0.05f || wi.z < 0.05f) continue;
@@ -146,12 +148,12 @@ TEST(Iridescence, EvalIsTheExtensionsLayering) {
     const float vh = glm::dot(wo, h), a = p.roughness * p.roughness;
     const float vd = ggx_visibility(wo.z, wi.z, a) * ggx_d(h, a);
     const float w = std::pow(1.0f - vh, 5.0f);
-    const vec3 fd = glm::mix(vec3(0.04f + 0.96f * w),
-                             iridescent_fresnel(1.0f, 1.3f, vec3(0.04f), p.iridescence_thickness, vh),
-                             p.iridescence);
-    const vec3 fm = glm::mix(p.base_color + (vec3(1.0f) - p.base_color) * w,
-                             iridescent_fresnel(1.0f, 1.3f, p.base_color, p.iridescence_thickness, vh),
-                             p.iridescence);
+    const vec3 fd = glm::mix(
+        vec3(0.04f + 0.96f * w),
+        iridescent_fresnel(1.0f, 1.3f, vec3(0.04f), p.iridescence_thickness, vh), p.iridescence);
+    const vec3 fm = glm::mix(
+        p.base_color + (vec3(1.0f) - p.base_color) * w,
+        iridescent_fresnel(1.0f, 1.3f, p.base_color, p.iridescence_thickness, vh), p.iridescence);
     const vec3 dielectric = (1.0f - max_component(fd)) * p.base_color / kPi + fd * vd;
     const vec3 want = glm::mix(dielectric, fm * vd, p.metallic);
     const vec3 got = bsdf.eval(wo, wi);
@@ -189,9 +191,9 @@ TEST(Iridescence, ReciprocalBoundedByMaxFAndSampledByItsPdf) {
     const vec3 ng = random_unit(rng);
     vec3 ns = glm::normalize(ng + 0.3f * random_unit(rng));
     if (glm::dot(ns, ng) < 0.2f) ns = ng;
-    const BsdfParams p = film(vec3(rng.next_float()), rng.next_float(),
-                              0.05f + 0.95f * rng.next_float(), rng.next_float(),
-                              100.0f + 700.0f * rng.next_float());
+    const BsdfParams p =
+        film(vec3(rng.next_float()), rng.next_float(), 0.05f + 0.95f * rng.next_float(),
+             rng.next_float(), 100.0f + 700.0f * rng.next_float());
     const Bsdf bsdf(p, ng, ns);
     const vec3 wo = random_unit(rng);
     const vec3 cap = bsdf.max_f(wo);
@@ -231,8 +233,9 @@ TEST(Iridescence, MirrorsAndThinGlassReflectTheFilm) {
     const Bsdf metal(film(vec3(0.95f, 0.6f, 0.3f), 1.0f, 0.0f, 0.8f, 300.0f), n, n);
     SpecularBranch b[kMaxDeltaBranches];
     ASSERT_EQ(metal.delta_branches(wo, Transport::Radiance, b), 1);
-    const vec3 fm = glm::mix(schlick_fresnel(vec3(0.95f, 0.6f, 0.3f), c),
-                             iridescent_fresnel(1.0f, 1.3f, vec3(0.95f, 0.6f, 0.3f), 300.0f, c), 0.8f);
+    const vec3 fm =
+        glm::mix(schlick_fresnel(vec3(0.95f, 0.6f, 0.3f), c),
+                 iridescent_fresnel(1.0f, 1.3f, vec3(0.95f, 0.6f, 0.3f), 300.0f, c), 0.8f);
     for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(b[0].weight[ch], fm[ch], 1e-6f) << c;
     BsdfParams glass = film(vec3(1.0f), 0.0f, 0.0f, 1.0f, 450.0f);
     glass.transmission = 1.0f;

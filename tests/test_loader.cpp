@@ -394,6 +394,8 @@ TEST_F(LoaderTest, MaterialFactorsOutOfRangeAreRefused) {
        "iridescenceIor 0.8 must be finite and at least 1"},
       {"\"extensions\":{\"KHR_materials_iridescence\":{\"iridescenceThicknessMaximum\":-1}}",
        "iridescenceThicknessMaximum -1 must be finite and at least 0"},
+      {"\"extensions\":{\"KHR_materials_dispersion\":{\"dispersion\":-0.1}}",
+       "dispersion -0.1 must be finite and at least 0"},
       {"\"alphaMode\":\"SOMETIMES\"", "unknown alphaMode 'SOMETIMES'"},
       {"\"pbrMetallicRoughness\":{\"baseColorTexture\":{\"index\":3}}",
        "texture 3, which does not"},
@@ -578,6 +580,29 @@ TEST_F(LoaderTest, IridescenceIsReadWithItsTextures) {
   const pb::Material& o = off.materials[off.meshes[0].material];
   EXPECT_EQ(o.iridescence, 0.0f);
   EXPECT_FALSE(o.iridescence_texture.present() || o.iridescence_thickness_texture.present());
+}
+
+TEST_F(LoaderTest, DispersionIsReadAndIgnoredOnThinWalls) {
+  // KHR_materials_dispersion: the value as given (20 / Abbe number, any value >= 0) on a
+  // volume; on a thin wall, which does not refract, it is kept but warned to have no effect.
+  Gltf g = basic();
+  g.top = "\"extensionsUsed\":[\"KHR_materials_dispersion\"],";
+  const std::string volume =
+      "{\"name\":\"prism\",\"pbrMetallicRoughness\":{\"metallicFactor\":0,"
+      "\"roughnessFactor\":0},\"extensions\":{\"KHR_materials_transmission\":{"
+      "\"transmissionFactor\":1},\"KHR_materials_volume\":{\"thicknessFactor\":1},"
+      "\"KHR_materials_dispersion\":{\"dispersion\":2.5}}}";
+  g.materials[0] = volume;
+  const Scene s = load(g);
+  const pb::Material& m = s.materials[s.meshes[0].material];
+  EXPECT_EQ(m.dispersion, 2.5f);
+  EXPECT_FALSE(m.thin);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  g.materials[0] = std::string(volume).replace(volume.find("\"thicknessFactor\":1"), 19,
+                                               "\"thicknessFactor\":0");
+  const Scene thin = load(g);
+  EXPECT_TRUE(thin.materials[thin.meshes[0].material].thin);
+  EXPECT_TRUE(has_warning(thin, "material 'prism': dispersion without KHR_materials_volume"));
 }
 
 TEST_F(LoaderTest, SheenIsReadWithItsTextures) {
@@ -1308,14 +1333,14 @@ TEST_F(LoaderTest, NegativeEmission) {
 TEST_F(LoaderTest, UnsupportedRequiredExtension) {
   Gltf g = basic();
   g.top =
-      "\"extensionsUsed\":[\"EXT_mesh_gpu_instancing\",\"KHR_materials_dispersion\"],"
+      "\"extensionsUsed\":[\"EXT_mesh_gpu_instancing\",\"EXT_lights_ies\"],"
       "\"extensionsRequired\":[\"EXT_mesh_gpu_instancing\"],";
   const Scene s = load(g);
   ASSERT_EQ(s.warnings.size(), 2u);
   EXPECT_EQ(s.warnings[0],
             "extension 'EXT_mesh_gpu_instancing' is required but not implemented; rendered "
             "without it: each instanced mesh is drawn once, at its node");
-  EXPECT_EQ(s.warnings[1], "extension 'KHR_materials_dispersion' is ignored");
+  EXPECT_EQ(s.warnings[1], "extension 'EXT_lights_ies' is ignored");
 }
 
 TEST_F(LoaderTest, MorphTargetsAreIgnoredWithAWarning) {

@@ -190,6 +190,45 @@ TEST(MaterialRender, VolumetricGlassSlabTransmitsByFresnelAndBeerLambert) {
   }
 }
 
+TEST(MaterialRender, ADispersiveSlabTransmitsEachChannelByItsOwnIndex) {
+  // The slab above, wide and without attenuation, with KHR_materials_dispersion 3 (Abbe number
+  // 6.7), seen at 0.7 rad from its normal: each channel refracts by its own index n_c and goes
+  // on alone, so the camera sees T_c = b_c^2 (1 - F_c)^2 / (1 - F_c^2) of the emitter, F_c the
+  // exact Fresnel term at 0.7 rad for n_c (the same at both faces, inside at the channel's own
+  // angle). PPM splits every branch: exact (2e-6). SPPM draws one branch per vertex, inside the
+  // slab only the reflection or its own channel's refraction (Bsdf::sample_delta's tint): its
+  // 16 x 16 pixels at a 0.005 rad field of view see the same slab, so their means after 256
+  // passes are independent samples of one value, within 4 of their standard errors of T_c.
+  const float theta = 0.7f;
+  SceneBuilder b;
+  Material glass = Material::glass(1.5f, false);
+  glass.base_color = vec3(0.9f, 0.8f, 0.7f);
+  glass.dispersion = 3.0f;
+  b.box(vec3(-30, -30, -1.2f), vec3(30, 30, -1), b.material(glass));
+  b.quad(vec3(0, 0, -3), vec3(60, 0, 0), vec3(0, 60, 0), b.material(emitter(vec3(1.0f))));
+  b.camera(vec3(0, 0, 2), vec3(std::sin(theta), 0, -std::cos(theta)), vec3(0, 1, 0), 0.005f);
+  double want[3];
+  for (int ch = 0; ch < 3; ++ch) {
+    const double f = fresnel_dielectric(std::cos(theta), dispersed_ior(1.5f, 3.0f, ch));
+    const double base = glass.base_color[ch];
+    want[ch] = base * base * (1 - f) * (1 - f) / (1 - f * f);
+  }
+  const std::vector<float> ppm = render(b.done(), options(1));
+  for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(ppm[size_t(ch)], want[ch], 2e-6) << "channel " << ch;
+  EXPECT_GT(std::fabs(want[2] - want[0]), 0.01);  // the channels' Fresnel terms differ
+  const std::vector<float> sppm = render(b.done(), options(16, Method::SPPM), 256);
+  for (int ch = 0; ch < 3; ++ch) {
+    double sum = 0.0, sum2 = 0.0;
+    for (size_t p = 0; p < 256; ++p) {
+      sum += sppm[3 * p + size_t(ch)];
+      sum2 += double(sppm[3 * p + size_t(ch)]) * sppm[3 * p + size_t(ch)];
+    }
+    const double mean = sum / 256.0, se = std::sqrt((sum2 / 256.0 - mean * mean) / 255.0);
+    EXPECT_GT(se, 0.0);
+    EXPECT_NEAR(mean, want[ch], 4.0 * se) << "channel " << ch;
+  }
+}
+
 TEST(MaterialRender, ASmoothClearCoatOverBlackMirrorsByItsViewWeight) {
   // KHR_materials_clearcoat over a black base: the camera sees the coat's mirror image of an
   // emitter of radiance 2, weighted by k = clearcoat (0.04 + 0.96 (1 - cos theta)^5) at the

@@ -40,13 +40,20 @@ vec3 sample_uniform_cone(const vec3& axis, float cos_max, float u1, float u2);
 // Without it, interpolated normals create or destroy energy in photon paths.
 float adjoint_shading_factor(const vec3& wo, const vec3& wi, const vec3& ng, const vec3& ns);
 
+// KHR_materials_dispersion's index of refraction for RGB channel 0, 1 or 2 (dispersion = 20 /
+// Abbe number; ior is n_d, the index at 587.6 nm). The channels stand for the three lines that
+// define the Abbe number, C (656.3 nm), d and F (486.1 nm): green keeps the material's ior and
+// blue - red = (ior - 1) / V_d, the extension's implementation note's spread.
+float dispersed_ior(float ior, float dispersion, int channel);
+
 // How a transport quantity is carried: radiance (camera paths) picks up the (eta_i/eta_t)^2
 // factor at refraction; photons carry flux and do not (Veach thesis section 5.2).
 enum class Transport : uint8_t { Radiance, Importance };
 
 // At most: the mirror of smooth lobes (with a thin wall's or a volume's Fresnel reflection), a
-// transmission, and a smooth clear coat's mirror about its own normal.
-inline constexpr int kMaxDeltaBranches = 3;
+// transmission (three, one per RGB channel, through a dispersive volume), and a smooth clear
+// coat's mirror about its own normal.
+inline constexpr int kMaxDeltaBranches = 5;
 
 struct SpecularBranch {
   vec3 dir{0.0f};
@@ -78,6 +85,7 @@ struct BsdfParams {
   vec3 anisotropy_direction{0.0f};
   // KHR_materials_iridescence: the film's weight (0: none), index and thickness in nm.
   float iridescence = 0.0f, iridescence_ior = 1.3f, iridescence_thickness = 400.0f;
+  float dispersion = 0.0f;                  // KHR_materials_dispersion: 20 / Abbe number (0: none)
   static BsdfParams of(const Material& m);  // the factors alone (no textures)
 };
 
@@ -139,8 +147,12 @@ class Bsdf {
   // Draws wi (random numbers from rng, as many as the lobes need, in a fixed order); false when
   // the sample is absorbed (below the true surface) or carries nothing. With both parts the
   // delta part is drawn with delta_probability(wo); delta branches are chosen in proportion to
-  // their average throughput.
-  bool sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const;
+  // their average throughput. `tint` is what the path carries so far (any positive scale): a
+  // dispersive volume's branches are chosen by their average throughput times it, so that a
+  // path left with one channel does not pick another channel's refraction (the others ignore
+  // it).
+  bool sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out,
+              const vec3& tint = vec3(1.0f)) const;
   // Probability that sample() takes the delta part: 0 without one, 1 without a non-delta part,
   // otherwise in proportion to estimates of the two parts' albedos (photon weights: the same
   // for either transport direction).
@@ -150,12 +162,16 @@ class Bsdf {
   // camera path that cannot gather here continues with it (camera_paths.h).
   bool sample_non_delta_part(const vec3& wo, Rng& rng, BsdfSample& out) const;
   // One delta branch, chosen in proportion to the branches' average weights (weight divided by
-  // that probability); draws one number when there are two branches.
-  bool sample_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const;
+  // that probability; through a dispersive volume their average weights times `tint`); draws
+  // one number when there are two branches or more.
+  bool sample_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out,
+                    const vec3& tint = vec3(1.0f)) const;
   // The deterministic delta branches: the mirror reflection (smooth lobes and the transmitting
   // part's Fresnel reflection) and the transmission, refracted (KHR_materials_volume; closed
   // meshes in vacuum: the side of ng tells whether the path enters, eta = ior, or leaves,
-  // eta = 1/ior) or straight through (thin-walled). Returns the count (0, 1 or 2).
+  // eta = 1/ior) or straight through (thin-walled). Returns the count (0, 1 or 2; through a
+  // dispersive volume 1 to 4: the reflection and one refraction per RGB channel, each carrying
+  // its own channel alone).
   // With a smooth clear coat, its mirror about the coat normal is one more (merged with the
   // mirror when the directions agree); the others are weighted by 1 - k.
   int delta_branches(const vec3& wo, Transport mode, SpecularBranch out[kMaxDeltaBranches]) const;
@@ -191,7 +207,8 @@ class Bsdf {
   float non_delta_albedo(float cos_o) const;
   bool sample_non_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const;
   bool sample_base(const vec3& wo, Rng& rng, BsdfSample& out) const;  // the uncoated part
-  int base_branches(const vec3& wo, Transport mode, SpecularBranch out[2]) const;
+  int base_branches(const vec3& wo, Transport mode, SpecularBranch out[4]) const;
+  int dispersive_branches(const vec3& wo, Transport mode, SpecularBranch out[4]) const;
   // The clear coat (no coat: k = 0). k at the view v; the coat lobe's D V about n_c on wo's side
   // and its sampling density; the non-delta f with the view v and its mixture density.
   float coat_weight(const vec3& v) const;
@@ -219,6 +236,7 @@ class Bsdf {
   bool smooth_ = false;     // GGX lobes below the mirror roughness: delta branches
   bool has_delta_ = false;  // Layered with a delta part too
   bool thin_ = true;
+  float dispersion_ = 0.0f;                       // KHR_materials_dispersion, of a volume (0: none)
   Part part_ = Part::All;                         // base_part() and lobe_part()
   bool base_non_delta_ = false;                   // the uncoated material has a non-delta part
   bool coat_smooth_ = false;                      // the clear coat is a mirror

@@ -57,6 +57,7 @@ struct Material {
   float sheen_roughness = 0.0f;         // sheenRoughnessFactor
   float anisotropy = 0.0f;              // KHR_materials_anisotropy anisotropyStrength (0: none)
   float anisotropy_rotation = 0.0f;     // anisotropyRotation, radians from the tangent to b
+  float dispersion = 0.0f;              // KHR_materials_dispersion (20 / Abbe number; 0: none)
   float iridescence = 0.0f;             // KHR_materials_iridescence iridescenceFactor (0: none)
   float iridescence_ior = 1.3f;         // iridescenceIor
   float iridescence_thickness_minimum = 100.0f;  // nm, at the thickness texture's 0
