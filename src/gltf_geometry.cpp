@@ -21,14 +21,17 @@ constexpr std::initializer_list<int> kIndexComponents = {TINYGLTF_COMPONENT_TYPE
 // not) 8- and 16-bit integers (KHR_mesh_quantization; it allows fewer combinations for NORMAL,
 // but every one of these has one meaning).
 int attribute_type(const std::string& name) {
-  if (name == "TANGENT") return TINYGLTF_TYPE_VEC4;
+  if (name == "TANGENT" || name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0)
+    return TINYGLTF_TYPE_VEC4;
   return name.rfind("TEXCOORD_", 0) == 0 ? TINYGLTF_TYPE_VEC2 : TINYGLTF_TYPE_VEC3;
 }
 constexpr std::initializer_list<int> kAttributeComponents = {
     TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE,
     TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT,
     TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT};
-const char* const kAttributes[] = {"POSITION", "NORMAL", "TEXCOORD_0", "TEXCOORD_1", "TANGENT"};
+const char* const kAttributes[] = {"POSITION",  "NORMAL",   "TEXCOORD_0", "TEXCOORD_1",
+                                   "TANGENT",   "JOINTS_0", "WEIGHTS_0",  "JOINTS_1",
+                                   "WEIGHTS_1", "JOINTS_2", "WEIGHTS_2"};
 
 // The texture coordinate sets a material's textures read.
 bool uses_set(const Material& m, int set) {
@@ -174,7 +177,7 @@ std::vector<uint32_t> Loader::indices(size_t mesh, size_t p, const DracoPrimitiv
   return tris;
 }
 
-void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
+void Loader::add_primitive(size_t mesh_index, size_t p, const Instance& inst) {
   const tinygltf::Mesh& gm = m_.meshes[mesh_index];
   const tinygltf::Primitive& prim = gm.primitives[p];
   const std::string ml = label("mesh", gm.name, mesh_index);
@@ -190,19 +193,22 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
   if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
       prim.mode != TINYGLTF_MODE_TRIANGLE_FAN)
     fail(where + " uses mode " + mode_name(prim.mode) + ", which glTF 2.0 does not define");
-  if (!prim.targets.empty())
-    warn(ml + ": morph targets are ignored; the mesh is drawn in its base shape");
   if (!prim.attributes.count("POSITION")) fail(where + " has no POSITION attribute");
   const DracoPrimitive* dp = draco(mesh_index, p, where);
   const View pos = *attribute(prim, dp, "POSITION", where);
   if (pos.count > UINT32_MAX) fail(where + " has more than 2^32 vertices");
+  // The shape a viewer draws: the base plus the morph targets at the instance's weights, placed
+  // by the node or, skinned, by its joints.
+  const std::vector<dvec3> moved = morph_offsets(prim, dp, inst, "POSITION", pos.count, where);
+  const Placement place = placement(prim, dp, inst, pos.count, where);
   Mesh out;
   out.name = gm.name.empty() ? "mesh " + std::to_string(mesh_index) : gm.name;
   out.positions.resize(pos.count);
   for (size_t i = 0; i < pos.count; ++i) {
-    const dvec3 local = pos.vec3(i), w = xf.point(local);
+    const dvec3 local = pos.vec3(i);
     if (!is_finite(vec3(local)))
       fail(ml + " has a non-finite vertex coordinate (POSITION, vertex " + std::to_string(i) + ")");
+    const dvec3 w = place.point(i, moved.empty() ? local : local + moved[i]);
     if (!(std::max({std::abs(w.x), std::abs(w.y), std::abs(w.z)}) <= kMaxCoordinate))
       fail(ml + " has a vertex coordinate beyond the limit of 1e10 in world space (vertex " +
            std::to_string(i) + ")");
@@ -212,12 +218,13 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
     if (nor->count != pos.count)
       fail(where + " has " + std::to_string(nor->count) + " normals for " +
            std::to_string(pos.count) + " positions");
-    const dmat3 normal_matrix = glm::transpose(glm::inverse(xf.linear));
+    const std::vector<dvec3> bent = morph_offsets(prim, dp, inst, "NORMAL", pos.count, where);
     out.normals.resize(nor->count);
     for (size_t i = 0; i < nor->count; ++i) {
-      const dvec3 local = nor->vec3(i), w = normal_matrix * local;
+      const dvec3 local = nor->vec3(i);
       if (!is_finite(vec3(local)))
         fail(ml + " has a non-finite vertex coordinate (NORMAL, vertex " + std::to_string(i) + ")");
+      const dvec3 w = place.normal(i, bent.empty() ? local : local + bent[i]);
       const dvec3 unit = w / glm::length(w);
       out.normals[i] = vec3(unit);
       if (!(std::abs(glm::length(unit) - 1.0) < 1e-6)) {
@@ -245,7 +252,7 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
   }
   const std::vector<uint32_t> idx = indices(mesh_index, p, dp, pos.count, where);
   out.material = material(prim.material, where);
-  const bool flip = xf.det < 0.0;  // a mirroring transform: keep the counter-clockwise front
+  const bool flip = place.flip;  // a mirroring transform: keep the counter-clockwise front
   for (size_t t = 0; t < idx.size(); t += 3) {
     const uint32_t a = idx[t], b = idx[t + (flip ? 2 : 1)], c = idx[t + (flip ? 1 : 2)];
     if (degenerate(out.positions, a, b, c)) {
@@ -260,7 +267,8 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Xform& xf) {
     if (uses_set(mat, set) && out.texcoords[set].empty())
       warn(ml + ": its material's textures read TEXCOORD_" + std::to_string(set) +
            ", which it does not have (one texel is read)");
-  add_tangents(out, prim, dp, xf, where);
+  add_tangents(out, prim, dp, place, morph_offsets(prim, dp, inst, "TANGENT", pos.count, where),
+               where);
   scene_.meshes.push_back(std::move(out));
 }
 

@@ -285,15 +285,23 @@ void Loader::choose_origin() {
 // A node's own content: mesh instances, camera, light.
 void Loader::visit(const tinygltf::Node& n, const std::string& nl, const Xform& xf) {
   if (measuring_) return measure(n, xf);
-  if (n.skin != -1 && skinned_nodes_++ == 0) first_skinned_ = nl;
   if (n.mesh != -1) {
     if (n.mesh < 0 || size_t(n.mesh) >= m_.meshes.size())
       fail(nl + " refers to " + absent("mesh", n.mesh, m_.meshes.size()));
     const tinygltf::Mesh& mesh = m_.meshes[size_t(n.mesh)];
-    if (xf.singular())
+    if (n.skin != -1 && (n.skin < 0 || size_t(n.skin) >= m_.skins.size()))
+      fail(nl + " refers to " + absent("skin", n.skin, m_.skins.size()));
+    // A skinned mesh is placed by its joints alone ("Skins": the node's own transform is
+    // ignored), so only an unskinned node's transform must be invertible.
+    if (n.skin == -1 && xf.singular())
       fail(nl + " has a singular transform (determinant " + num(xf.det) + "); cannot place " +
            label("mesh", mesh.name, size_t(n.mesh)));
-    for (size_t p = 0; p < mesh.primitives.size(); ++p) add_primitive(size_t(n.mesh), p, xf);
+    Instance inst;
+    inst.xf = &xf;
+    inst.weights = n.weights.empty() ? &mesh.weights : &n.weights;
+    inst.skin = n.skin;
+    inst.label = nl;
+    for (size_t p = 0; p < mesh.primitives.size(); ++p) add_primitive(size_t(n.mesh), p, inst);
   }
   if (n.camera != -1) add_camera(n.camera, nl, xf);
   if (n.extensions.count("KHR_lights_punctual")) add_light(n, nl, xf);
@@ -304,11 +312,9 @@ void Loader::finish() {
     warn(std::to_string(scene_.degenerate_triangles) + " degenerate triangles skipped");
   // The nodes of the scene drew nothing: no mesh, or meshes of points, lines or degenerate
   // triangles alone (a primitives member that is not an array also leaves none).
-  // One line for every skinned node (a character rig has dozens).
-  if (skinned_nodes_ == 1) warn(first_skinned_ + ": skins are ignored; the mesh is drawn unposed");
-  if (skinned_nodes_ > 1)
-    warn(std::to_string(skinned_nodes_) + " nodes have skins (" + first_skinned_ +
-         " the first): skins are ignored; the meshes are drawn unposed");
+  if (unbound_vertices_ > 0)
+    warn(std::to_string(unbound_vertices_) + " skinned vertices have no joint weight (" +
+         first_unbound_ + " the first): they follow their node's transform");
   if (draco_counts_differ_ > 0)
     warn(std::to_string(draco_counts_differ_) + " Draco-compressed accessor" +
          (draco_counts_differ_ == 1 ? "'s count differs" : "s' counts differ") +

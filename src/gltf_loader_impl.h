@@ -40,6 +40,36 @@ struct Bytes {
   size_t size = 0;
 };
 
+// Where a primitive's vertices go in world space (before the scene's origin is taken off): one
+// transform for all, the node's, or one per vertex, a skin's blend of its joint matrices
+// (glTF 2.0 "Skins"; gltf_deform.cpp).
+struct Placement {
+  const Xform* rigid = nullptr;
+  dmat3 rigid_normal{1.0};     // the node's inverse transpose
+  std::vector<dmat4> skinned;  // per vertex, when skinned
+  bool flip = false;           // the counter-clockwise front is mirrored
+  explicit Placement(const Xform& xf)
+      : rigid(&xf), rigid_normal(glm::transpose(glm::inverse(xf.linear))), flip(xf.det < 0.0) {}
+  dvec3 point(size_t i, const dvec3& p) const {
+    return skinned.empty() ? rigid->point(p) : dvec3(skinned[i] * glm::dvec4(p, 1.0));
+  }
+  dvec3 direction(size_t i, const dvec3& d) const {
+    return skinned.empty() ? rigid->direction(d) : dmat3(skinned[i]) * d;
+  }
+  // The normal's direction (not unit): the inverse transpose, for a skinned vertex its cofactor
+  // matrix times the determinant's sign (0 where the blend is singular).
+  dvec3 normal(size_t i, const dvec3& n) const;
+};
+
+// What a node asks of its mesh: its world transform, the morph target weights (the node's, else
+// the mesh's) and its skin (-1: none).
+struct Instance {
+  const Xform* xf = nullptr;
+  const std::vector<double>* weights = nullptr;
+  int skin = -1;
+  std::string label;  // the node, for messages
+};
+
 // A KHR_draco_mesh_compression primitive, decoded: the attributes the renderer reads, in the
 // layout of their glTF accessors, and the faces.
 struct DracoPrimitive {
@@ -83,7 +113,14 @@ class Loader {
                                 const std::string& name, const std::string& where);
   std::vector<uint32_t> indices(size_t mesh, size_t prim, const DracoPrimitive* draco,
                                 size_t vertices, const std::string& where);
-  void add_primitive(size_t mesh, size_t prim, const Xform& xf);
+  void add_primitive(size_t mesh, size_t prim, const Instance& inst);
+  // gltf_deform.cpp: morph targets at the instance's weights, skins at the joints' poses.
+  std::vector<dvec3> morph_offsets(const tinygltf::Primitive& prim, const DracoPrimitive* dp,
+                                   const Instance& inst, const char* attribute, size_t count,
+                                   const std::string& where);
+  Placement placement(const tinygltf::Primitive& prim, const DracoPrimitive* dp,
+                      const Instance& inst, size_t count, const std::string& where);
+  const dmat4& node_world(int index, const std::string& from);
   uint32_t material(int index, const std::string& where);
   Material convert_material(size_t index);
   double ext_number(const tinygltf::ExtensionMap& ext, const std::string& owner, const char* name,
@@ -98,7 +135,8 @@ class Loader {
                          const char* name, const char* key);
   int32_t image(int index, const std::string& where);
   void add_tangents(Mesh& out, const tinygltf::Primitive& prim, const DracoPrimitive* dp,
-                    const Xform& xf, const std::string& where);
+                    const Placement& place, const std::vector<dvec3>& offsets,
+                    const std::string& where);
   void add_light(const tinygltf::Node& n, const std::string& nl, const Xform& xf);
   void add_camera(int index, const std::string& nl, const Xform& xf);
   vec3 origin(const Xform& xf, const std::string& nl) const;
@@ -122,8 +160,13 @@ class Loader {
   // Recentring (Loader::choose_origin): the world bounds of the POSITION accessors' min/max.
   dvec3 measured_lo_{INFINITY}, measured_hi_{-INFINITY};
   bool measuring_ = false;
-  size_t skinned_nodes_ = 0;  // skins are ignored: one warning for all
-  std::string first_skinned_;
+  // Skins: every node's world matrix, computed on demand for the joints (node_world), and
+  // its state (0 not yet, 1 under way: a cycle, 2 done).
+  std::vector<dmat4> node_world_;
+  std::vector<char> node_world_state_;
+  std::vector<int> parent_;
+  size_t unbound_vertices_ = 0;  // skinned vertices whose weights are all 0: one warning
+  std::string first_unbound_;
   size_t skipped_points_lines_ = 0;  // primitives of mode POINTS or LINES*, not drawn
   size_t draco_counts_differ_ = 0;   // Draco accessors whose count is not the decoded data's
   std::string first_draco_count_;    // the first of them, for the one warning

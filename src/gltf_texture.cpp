@@ -155,7 +155,8 @@ TextureRef Loader::ext_texture(const tinygltf::ExtensionMap& ext, const std::str
 // flipped with a mirroring transform, whose bitangent cross(n, t) flips), or made from the
 // texture coordinates of the normal texture after its transform (tangents.h).
 void Loader::add_tangents(Mesh& out, const tinygltf::Primitive& prim, const DracoPrimitive* dp,
-                          const Xform& xf, const std::string& where) {
+                          const Placement& place, const std::vector<dvec3>& offsets,
+                          const std::string& where) {
   const Material& mat = scene_.materials[out.material];
   // One tangent space for both normal textures (KHR_materials_clearcoat asks them to share it)
   // and the anisotropy direction (KHR_materials_anisotropy: TANGENT, or made as for the normal
@@ -173,9 +174,10 @@ void Loader::add_tangents(Mesh& out, const tinygltf::Primitive& prim, const Drac
       fail(where + " has " + std::to_string(tan->count) + " tangents for " +
            std::to_string(out.positions.size()) + " positions");
     out.tangents.resize(tan->count);
-    const float sign = xf.det < 0.0 ? -1.0f : 1.0f;
+    const float sign = place.flip ? -1.0f : 1.0f;
     for (size_t i = 0; i < tan->count; ++i) {
-      const dvec3 t = xf.direction(tan->vec3(i));
+      const dvec3 t =
+          place.direction(i, offsets.empty() ? tan->vec3(i) : tan->vec3(i) + offsets[i]);
       const double len = glm::length(t), w = tan->scalar(i, 3);
       if (!(len > 0.0) || !std::isfinite(len) || !std::isfinite(w)) {
         warn(where + ": zero or non-finite tangents; tangents are computed instead");

@@ -62,9 +62,18 @@ void sparse(const std::string& file) {
   const int idx = d.accessor(-1, kUInt, 6, "SCALAR",
                              sp(4, d.view(std::vector<uint32_t>{1, 2, 4, 5}), kUInt,
                                 d.view(std::vector<uint32_t>{1, 2, 2, 3})));
-  d.mesh_node(json{{"attributes", json{{"POSITION", pos}, {"TEXCOORD_0", uv}}}, {"indices", idx}});
-  d.j["nodes"].back()["skin"] = 0;  // and a skin without inverseBindMatrices
-  d.j["skins"] = json::array({json{{"joints", json::array({0})}}});
+  // A skin without inverseBindMatrices, its one joint the mesh's own node: the quad stays where
+  // that node puts it.
+  const int joints = d.accessor(d.view(std::vector<uint8_t>(16, 0)), 5121, 4, "VEC4");
+  const int weights =
+      d.accessor(d.view(std::vector<float>{1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0}), kFloat,
+                 4, "VEC4");
+  d.mesh_node(json{
+      {"attributes",
+       json{{"POSITION", pos}, {"TEXCOORD_0", uv}, {"JOINTS_0", joints}, {"WEIGHTS_0", weights}}},
+      {"indices", idx}});
+  d.j["nodes"].back()["skin"] = 0;
+  d.j["skins"] = json::array({json{{"joints", json::array({d.j["nodes"].size() - 1})}}});
   d.write(file);
 }
 

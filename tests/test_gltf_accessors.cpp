@@ -1,6 +1,7 @@
 // Core accessor features real exporters use: KHR_mesh_quantization (integer POSITION, NORMAL and
 // TEXCOORD_n, normalised or not), sparse accessors (with and without a bufferView, also for
-// indices), and a skin without inverseBindMatrices.
+// indices), and a skin without inverseBindMatrices (tests/test_gltf_deform.cpp: skins and
+// morph targets).
 #include "gltf_expect.h"
 
 #include <cmath>
@@ -193,20 +194,33 @@ TEST_F(DecodeTest, MalformedSparseIsASceneError) {
                "elements of 12 bytes, more than the 256 MiB");
 }
 
-TEST_F(DecodeTest, SkinWithoutInverseBindMatricesLoadsWithOnlyTheSkinWarning) {
+TEST_F(DecodeTest, SkinWithoutInverseBindMatricesLoads) {
   // tinygltf 2.7 reports "'inverseBindMatrices' property is missing in Skin." as an error
-  // although glTF makes it optional (identity matrices); the loader drops that one line.
+  // although glTF makes it optional (identity matrices); the loader drops that one line. The
+  // one joint is the mesh's own node, so the skin places the quad where the node does.
   Doc d;
-  quad_file(d, json{{"bufferView", d.view(kQuad)}}, path("unused.gltf"));
+  const std::vector<uint8_t> joints(16, 0);
+  const std::vector<float> weights = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+  const int pa = d.accessor(d.view(kQuad), kFloat, 4, "VEC3");
+  const int ja = d.accessor(d.view(joints), kUByte, 4, "VEC4");
+  const int wa = d.accessor(d.view(weights), kFloat, 4, "VEC4");
+  const int ia = d.accessor(d.view(std::vector<uint16_t>{0, 1, 2, 0, 2, 3}), kUShort, 6, "SCALAR");
+  d.mesh_node(json{{"attributes", json{{"POSITION", pa}, {"JOINTS_0", ja}, {"WEIGHTS_0", wa}}},
+                   {"indices", ia}});
   d.j["nodes"].back()["skin"] = 0;
-  d.j["skins"] = json::array({json{{"joints", json::array({0})}}});
+  d.j["skins"] = json::array({json{{"joints", json::array({2})}}});
   const Scene s = pb::load_gltf(d.write(path("skin.gltf")));
-  EXPECT_EQ(s.warnings, std::vector<std::string>{
-                            "node 'grid node': skins are ignored; the mesh is drawn unposed"});
-  EXPECT_EQ(only_mesh(s).indices.size(), 6u);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  const pb::Mesh m = only_mesh(s);
+  for (size_t i = 0; i < 4; ++i)
+    for (int k = 0; k < 3; ++k)
+      EXPECT_NEAR(m.positions[i][k],
+                  world_point(glm::dvec3(kQuad[3 * i], kQuad[3 * i + 1], kQuad[3 * i + 2]))[k],
+                  1e-5);
 }
 
-// A rig skins dozens of nodes (SharpGLTF's InfiniteSkinnedTentacle: 85): one line for all of them.
+// A rig skins dozens of nodes (SharpGLTF's InfiniteSkinnedTentacle: 85): a mesh that cannot be
+// bound (no JOINTS_0 and WEIGHTS_0) gives one line for all of them.
 TEST_F(DecodeTest, ManySkinnedNodesGiveOneWarning) {
   Doc d;
   quad_file(d, json{{"bufferView", d.view(kQuad)}}, path("unused.gltf"));
@@ -221,9 +235,9 @@ TEST_F(DecodeTest, ManySkinnedNodesGiveOneWarning) {
   }
   d.j["skins"] = json::array({json{{"joints", json::array({0})}}});
   const Scene s = pb::load_gltf(d.write(path("skins.gltf")));
-  EXPECT_EQ(s.warnings,
-            std::vector<std::string>{"4 nodes have skins (node 'grid node' the first): skins are "
-                                     "ignored; the meshes are drawn unposed"});
+  EXPECT_EQ(s.warnings, std::vector<std::string>{"mesh 'grid' primitive 0 has no JOINTS_0 and "
+                                                 "WEIGHTS_0 to bind it to skin 0; it is drawn by "
+                                                 "its node's transform"});
   EXPECT_EQ(s.meshes.size(), 4u);
 }
 
