@@ -4,7 +4,7 @@
 // mesh is placed by its joints as the node hierarchy poses them, each vertex by the weighted sum
 // of its joints' matrices, global transform x inverse bind matrix (glTF 2.0 "Skins": "only the
 // joint transforms are applied to the skinned mesh; the transform of the skinned mesh node
-// MUST be ignored").
+// MUST be ignored"). And EXT_mesh_gpu_instancing's copies of a node's mesh.
 #include "gltf_loader_impl.h"
 
 #include <cmath>
@@ -170,6 +170,75 @@ Placement Loader::placement(const tinygltf::Primitive& prim, const DracoPrimitiv
   // The winding follows the determinant (glTF 2.0 "Meshes"); per vertex here, by majority.
   place.flip = 2 * negative > count;
   return place;
+}
+
+std::vector<dmat4> Loader::instances(const tinygltf::Node& n, const std::string& nl) {
+  // EXT_mesh_gpu_instancing: the node's mesh is drawn once per instance, at node x T * R * S
+  // from the TRANSLATION, ROTATION (a quaternion) and SCALE accessors (each optional, the same
+  // count; float or, as KHR_mesh_quantization allows, normalised integers). Copied: the scene
+  // holds plain triangles.
+  const auto ext = n.extensions.find("EXT_mesh_gpu_instancing");
+  if (ext == n.extensions.end() || n.mesh < 0 || size_t(n.mesh) >= m_.meshes.size()) return {};
+  const std::string el = nl + " EXT_mesh_gpu_instancing";
+  const tinygltf::Value& e = ext->second;
+  if (!e.IsObject() || !e.Has("attributes") || !e.Get("attributes").IsObject())
+    fail(el + " has no attributes object");
+  if (n.skin != -1) {
+    warn(el +
+         ": a skinned mesh is placed by its joints, so its instances would coincide; it is "
+         "drawn once");
+    return {};
+  }
+  const tinygltf::Value& attributes = e.Get("attributes");
+  const char* names[3] = {"TRANSLATION", "ROTATION", "SCALE"};
+  std::optional<View> views[3];
+  size_t count = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (!attributes.Has(names[k])) continue;
+    const tinygltf::Value& v = attributes.Get(names[k]);
+    if (!v.IsInt() && !v.IsNumber()) fail(el + " " + names[k] + " is not an accessor index");
+    views[k] = accessor(v.GetNumberAsInt(), el + " " + names[k],
+                        {TINYGLTF_COMPONENT_TYPE_FLOAT, TINYGLTF_COMPONENT_TYPE_BYTE,
+                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE, TINYGLTF_COMPONENT_TYPE_SHORT,
+                         TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT},
+                        k == 1 ? TINYGLTF_TYPE_VEC4 : TINYGLTF_TYPE_VEC3);
+    if (count != 0 && views[k]->count != count)
+      fail(el + " has " + std::to_string(views[k]->count) + " " + names[k] + " values and " +
+           std::to_string(count) + " of another attribute");
+    count = views[k]->count;
+  }
+  if (count == 0) {
+    warn(el + " has no TRANSLATION, ROTATION or SCALE; the mesh is drawn once");
+    return {};
+  }
+  // The copies' triangles, from the primitives' index (or vertex) counts, within the budget.
+  uint64_t triangles = 0;
+  for (const tinygltf::Primitive& p : m_.meshes[size_t(n.mesh)].primitives) {
+    const int a = p.indices >= 0
+                      ? p.indices
+                      : (p.attributes.count("POSITION") ? p.attributes.at("POSITION") : -1);
+    if (a >= 0 && size_t(a) < m_.accessors.size()) triangles += m_.accessors[size_t(a)].count / 3;
+  }
+  if (!measuring_) instanced_triangles_ += triangles * count;  // the second walk places them
+  if (instanced_triangles_ > kMaxInstancedTriangles)
+    fail(el + " asks for " + std::to_string(count) + " copies of " +
+         label("mesh", m_.meshes[size_t(n.mesh)].name, size_t(n.mesh)) + " (" +
+         std::to_string(triangles) + " triangles each): instancing would hold more than " +
+         std::to_string(kMaxInstancedTriangles) + " triangles, which photonbound copies");
+  std::vector<dmat4> out(count, dmat4(1.0));
+  for (size_t i = 0; i < count; ++i) {
+    dmat3 r(1.0);
+    if (views[1]) {
+      const std::vector<double> q = {views[1]->scalar(i, 0), views[1]->scalar(i, 1),
+                                     views[1]->scalar(i, 2), views[1]->scalar(i, 3)};
+      if (!rotation_matrix(q, r))
+        fail(el + " ROTATION " + std::to_string(i) + " is a zero or non-finite quaternion");
+    }
+    const dvec3 s = views[2] ? views[2]->vec3(i) : dvec3(1.0);
+    for (int c = 0; c < 3; ++c) out[i][c] = glm::dvec4(r[c] * s[c], 0.0);
+    if (views[0]) out[i][3] = glm::dvec4(views[0]->vec3(i), 1.0);
+  }
+  return out;
 }
 
 }  // namespace pb::gltf

@@ -167,23 +167,18 @@ void Loader::check_extensions() {
       "KHR_materials_dispersion", "KHR_draco_mesh_compression",
       "EXT_meshopt_compression",  "KHR_mesh_quantization",
       "KHR_texture_transform",    "KHR_texture_basisu",
-      "EXT_texture_webp"};  // basisu: the fallback image or a warning
+      "EXT_texture_webp",         "EXT_mesh_gpu_instancing"};  // basisu: the fallback image or a
+                                                               // warning
   // Unknown extensions, even required ones, are rendered without (README "Scenes"): a material
   // extension then falls back to the core factors; data an unknown extension holds is missing,
   // and the accessors that lack it are refused with their own message.
-  // What rendering without it means, where that is not only a material falling back.
-  auto without = [](const std::string& e) -> std::string {
-    if (e == "EXT_mesh_gpu_instancing") return ": each instanced mesh is drawn once, at its node";
-    return "";
-  };
   for (const std::string& e : m_.extensionsRequired)
     if (!known.count(e))
-      warn("extension '" + e + "' is required but not implemented; rendered without it" +
-           without(e));
+      warn("extension '" + e + "' is required but not implemented; rendered without it");
   for (const std::string& e : m_.extensionsUsed)
     if (!known.count(e) &&
         !std::count(m_.extensionsRequired.begin(), m_.extensionsRequired.end(), e))
-      warn("extension '" + e + "' is ignored" + without(e));
+      warn("extension '" + e + "' is ignored");
   if (!m_.animations.empty())
     warn(std::to_string(m_.animations.size()) +
          (m_.animations.size() == 1 ? " animation is" : " animations are") +
@@ -247,8 +242,14 @@ void Loader::walk(int root, const std::string& root_from) {
 
 // The world box of the node's mesh from its POSITION accessors' min and max (glTF requires
 // them; a primitive without them, or of a kind the loader skips, is left out).
-void Loader::measure(const tinygltf::Node& n, const Xform& xf) {
+void Loader::measure(const tinygltf::Node& n, const std::string& nl, const Xform& xf) {
   if (n.mesh < 0 || size_t(n.mesh) >= m_.meshes.size()) return;
+  const std::vector<dmat4> copies = instances(n, nl);
+  if (copies.empty()) return measure_mesh(n, xf);
+  for (const dmat4& c : copies) measure_mesh(n, Xform(xf.m * c));
+}
+
+void Loader::measure_mesh(const tinygltf::Node& n, const Xform& xf) {
   for (const tinygltf::Primitive& p : m_.meshes[size_t(n.mesh)].primitives) {
     const auto it = p.attributes.find("POSITION");
     if (it == p.attributes.end() || it->second < 0 || size_t(it->second) >= m_.accessors.size())
@@ -284,7 +285,7 @@ void Loader::choose_origin() {
 
 // A node's own content: mesh instances, camera, light.
 void Loader::visit(const tinygltf::Node& n, const std::string& nl, const Xform& xf) {
-  if (measuring_) return measure(n, xf);
+  if (measuring_) return measure(n, nl, xf);
   if (n.mesh != -1) {
     if (n.mesh < 0 || size_t(n.mesh) >= m_.meshes.size())
       fail(nl + " refers to " + absent("mesh", n.mesh, m_.meshes.size()));
@@ -301,7 +302,17 @@ void Loader::visit(const tinygltf::Node& n, const std::string& nl, const Xform& 
     inst.weights = n.weights.empty() ? &mesh.weights : &n.weights;
     inst.skin = n.skin;
     inst.label = nl;
-    for (size_t p = 0; p < mesh.primitives.size(); ++p) add_primitive(size_t(n.mesh), p, inst);
+    const std::vector<dmat4> copies = instances(n, nl);
+    if (copies.empty())
+      for (size_t p = 0; p < mesh.primitives.size(); ++p) add_primitive(size_t(n.mesh), p, inst);
+    for (size_t k = 0; k < copies.size(); ++k) {  // EXT_mesh_gpu_instancing: node x instance
+      const Xform each(xf.m * copies[k]);
+      if (!each.finite() || each.singular())
+        fail(nl + " EXT_mesh_gpu_instancing instance " + std::to_string(k) +
+             " has a non-finite or singular transform");
+      inst.xf = &each;
+      for (size_t p = 0; p < mesh.primitives.size(); ++p) add_primitive(size_t(n.mesh), p, inst);
+    }
   }
   if (n.camera != -1) add_camera(n.camera, nl, xf);
   if (n.extensions.count("KHR_lights_punctual")) add_light(n, nl, xf);

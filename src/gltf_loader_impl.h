@@ -29,6 +29,9 @@ using glm::dmat4;
 inline constexpr double kMaxCoordinate = 1e10;  // |world coordinate| limit
 inline constexpr double kRecentreRatio = 64.0;  // distance / size past which a model is centred
 inline constexpr int kMaxDepth = 1000;          // node hierarchy depth limit
+// EXT_mesh_gpu_instancing copies each instance's triangles: at most this many in all (about
+// 6 GB of triangles, vertices and their acceleration structure).
+inline constexpr uint64_t kMaxInstancedTriangles = uint64_t(1) << 26;
 
 inline bool fits_float(double v) {
   return std::abs(v) <= double(std::numeric_limits<float>::max());
@@ -121,6 +124,8 @@ class Loader {
   Placement placement(const tinygltf::Primitive& prim, const DracoPrimitive* dp,
                       const Instance& inst, size_t count, const std::string& where);
   const dmat4& node_world(int index, const std::string& from);
+  // EXT_mesh_gpu_instancing: each instance's T * R * S, in the node's frame (none without it).
+  std::vector<dmat4> instances(const tinygltf::Node& n, const std::string& nl);
   uint32_t material(int index, const std::string& where);
   Material convert_material(size_t index);
   double ext_number(const tinygltf::ExtensionMap& ext, const std::string& owner, const char* name,
@@ -141,7 +146,8 @@ class Loader {
   void add_camera(int index, const std::string& nl, const Xform& xf);
   vec3 origin(const Xform& xf, const std::string& nl) const;
   void finish();
-  void measure(const tinygltf::Node& n, const Xform& xf);
+  void measure(const tinygltf::Node& n, const std::string& nl, const Xform& xf);
+  void measure_mesh(const tinygltf::Node& n, const Xform& xf);
   void choose_origin();
 
   const std::string& file_;
@@ -167,9 +173,10 @@ class Loader {
   std::vector<int> parent_;
   size_t unbound_vertices_ = 0;  // skinned vertices whose weights are all 0: one warning
   std::string first_unbound_;
-  size_t skipped_points_lines_ = 0;  // primitives of mode POINTS or LINES*, not drawn
-  size_t draco_counts_differ_ = 0;   // Draco accessors whose count is not the decoded data's
-  std::string first_draco_count_;    // the first of them, for the one warning
+  uint64_t instanced_triangles_ = 0;  // EXT_mesh_gpu_instancing copies so far
+  size_t skipped_points_lines_ = 0;   // primitives of mode POINTS or LINES*, not drawn
+  size_t draco_counts_differ_ = 0;    // Draco accessors whose count is not the decoded data's
+  std::string first_draco_count_;     // the first of them, for the one warning
 };
 
 }  // namespace pb::gltf

@@ -187,4 +187,60 @@ TEST_F(Deform, UnweightedVerticesAndUnboundMeshesFollowTheirNodeWithAWarning) {
   expect_near(only_mesh(u).positions[1], dvec3(101, 0, 0));
 }
 
+// EXT_mesh_gpu_instancing: the quad under mesh_trs() drawn twice, at node x T R S of each
+// instance: the first at the node itself, the second moved by (5, 0, 0), turned 90 degrees about
+// z (a quaternion stored as normalised shorts, as gltfpack writes it) and scaled by 2.
+TEST_F(Deform, InstancesAreTheMeshAtTheNodeTimesTheirOwnTransforms) {
+  Doc d;
+  d.mesh_node(quad(d), mesh_trs());
+  const int t = d.accessor(d.view(std::vector<float>{0, 0, 0, 5, 0, 0}), kFloat, 2, "VEC3");
+  const int r = d.accessor(d.view(std::vector<int16_t>{0, 0, 0, 32767, 0, 0, 23170, 23170}), kShort,
+                           2, "VEC4", json{{"normalized", true}});
+  const int s = d.accessor(d.view(std::vector<float>{1, 1, 1, 2, 2, 2}), kFloat, 2, "VEC3");
+  d.j["nodes"][2]["extensions"] =
+      json{{"EXT_mesh_gpu_instancing",
+            json{{"attributes", json{{"TRANSLATION", t}, {"ROTATION", r}, {"SCALE", s}}}}}};
+  d.require({"EXT_mesh_gpu_instancing", "KHR_mesh_quantization"});
+  const Scene scene = pb::load_gltf(d.write(path("instances.gltf")));
+  EXPECT_TRUE(scene.warnings.empty()) << scene.warnings[0];
+  ASSERT_EQ(scene.meshes.size(), 2u);
+  const dmat4 second =
+      glm::scale(glm::rotate(glm::translate(dmat4(1.0), dvec3(5, 0, 0)), M_PI / 2, dvec3(0, 0, 1)),
+                 dvec3(2.0));
+  for (size_t i = 0; i < 4; ++i) {
+    const dvec3 p(kQuad[3 * i], kQuad[3 * i + 1], kQuad[3 * i + 2]);
+    expect_near(scene.meshes[0].positions[i], world_point(p), 1e-5);
+    // 23170 / 32767 is sqrt(1/2) to 1e-5: the turn is 90 degrees to that, renormalised.
+    expect_near(scene.meshes[1].positions[i], world_point(dvec3(second * glm::dvec4(p, 1.0))),
+                1e-4);
+  }
+}
+
+TEST_F(Deform, BadInstancesAreRefusedNamingTheFileAndTheirFault) {
+  const auto with = [&](const json& attributes, const char* name, uint32_t indices = 6) {
+    Doc d;
+    json prim = quad(d);
+    if (indices != 6)
+      prim["indices"] = d.accessor(d.view(std::vector<uint16_t>(6, 0)), kUShort, indices, "SCALAR");
+    d.mesh_node(prim, json::object());
+    json a = json::object();
+    for (const auto& [key, values] : attributes.items()) {
+      const std::vector<float> v = values.get<std::vector<float>>();
+      const bool rotation = key == "ROTATION";
+      a[key] =
+          d.accessor(d.view(v), kFloat, v.size() / (rotation ? 4 : 3), rotation ? "VEC4" : "VEC3");
+    }
+    d.j["nodes"][2]["extensions"] = json{{"EXT_mesh_gpu_instancing", json{{"attributes", a}}}};
+    return d.write(path(name));
+  };
+  expect_error(with(json{{"TRANSLATION", {0, 0, 0, 1, 0, 0}}, {"SCALE", {1, 1, 1}}}, "n.gltf"),
+               "EXT_mesh_gpu_instancing has 1 SCALE values and 2 of another attribute");
+  expect_error(with(json{{"ROTATION", {0, 0, 0, 0}}}, "q.gltf"),
+               "EXT_mesh_gpu_instancing ROTATION 0 is a zero or non-finite quaternion");
+  // The copies are counted before any is made (the indices accessor's count is enough).
+  expect_error(with(json{{"TRANSLATION", {0, 0, 0, 1, 0, 0, 2, 0, 0}}}, "big.gltf", 3u << 25),
+               "asks for 3 copies of mesh 'grid' (33554432 triangles each): instancing would "
+               "hold more than 67108864 triangles");
+}
+
 }  // namespace

@@ -1333,13 +1333,13 @@ TEST_F(LoaderTest, NegativeEmission) {
 TEST_F(LoaderTest, UnsupportedRequiredExtension) {
   Gltf g = basic();
   g.top =
-      "\"extensionsUsed\":[\"EXT_mesh_gpu_instancing\",\"EXT_lights_ies\"],"
-      "\"extensionsRequired\":[\"EXT_mesh_gpu_instancing\"],";
+      "\"extensionsUsed\":[\"EXT_lights_image_based\",\"EXT_lights_ies\"],"
+      "\"extensionsRequired\":[\"EXT_lights_image_based\"],";
   const Scene s = load(g);
   ASSERT_EQ(s.warnings.size(), 2u);
   EXPECT_EQ(s.warnings[0],
-            "extension 'EXT_mesh_gpu_instancing' is required but not implemented; rendered "
-            "without it: each instanced mesh is drawn once, at its node");
+            "extension 'EXT_lights_image_based' is required but not implemented; rendered "
+            "without it");
   EXPECT_EQ(s.warnings[1], "extension 'EXT_lights_ies' is ignored");
 }
 
