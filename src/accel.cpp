@@ -45,7 +45,7 @@ void cut_out_filter(const RTCFilterFunctionNArguments* args) {
     const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
     const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
     const vec2 uv[2] = {mesh_uv(*m->mesh, prim, 0, u, v), mesh_uv(*m->mesh, prim, 1, u, v)};
-    if (cut_out(m->images, *m->material, uv)) args->valid[i] = 0;
+    if (cut_out(m->images, *m->material, uv, mesh_alpha(*m->mesh, prim, u, v))) args->valid[i] = 0;
   }
 }
 

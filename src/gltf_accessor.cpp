@@ -32,7 +32,12 @@ const tinygltf::Accessor& Loader::header(int index, const std::string& ctx,
     fail(ctx + " refers to " + absent("accessor", index, m_.accessors.size()));
   const tinygltf::Accessor& a = m_.accessors[size_t(index)];
   al = ctx + " accessor " + std::to_string(index);
-  if (a.type != type) fail(al + " has type " + type_name(a.type) + "; expected " + type_name(type));
+  if (type == kVec3OrVec4) {
+    if (a.type != TINYGLTF_TYPE_VEC3 && a.type != TINYGLTF_TYPE_VEC4)
+      fail(al + " has type " + type_name(a.type) + "; expected VEC3 or VEC4");
+  } else if (a.type != type) {
+    fail(al + " has type " + type_name(a.type) + "; expected " + type_name(type));
+  }
   if (std::find(components.begin(), components.end(), a.componentType) == components.end()) {
     std::string want;
     for (int c : components) want += (want.empty() ? "" : " or ") + component_name(c);
@@ -65,7 +70,9 @@ View Loader::stored(const tinygltf::Accessor& a, const std::string& al, size_t e
          std::to_string(a.count) + " elements of " + std::to_string(element) + " bytes, stride " +
          std::to_string(stride) + ", from offset " + std::to_string(a.byteOffset) + " in " +
          std::to_string(b.size) + " bytes)");
-  return View{b.data + a.byteOffset, stride, a.count, a.componentType, a.normalized};
+  return View{
+      b.data + a.byteOffset, stride,       a.count,
+      a.componentType,       a.normalized, tinygltf::GetNumComponentsInType(uint32_t(a.type))};
 }
 
 // The bufferView's elements (or zeros without one) copied tightly packed, then the sparse
@@ -89,7 +96,8 @@ View Loader::synthesized(int index, const tinygltf::Accessor& a, const std::stri
     if (a.sparse.isSparse) substitute(a, al, element, data);
     it = synthesized_.emplace(index, std::move(data)).first;
   }
-  return View{it->second.data(), element, a.count, a.componentType, a.normalized};
+  return View{it->second.data(), element,      a.count,
+              a.componentType,   a.normalized, tinygltf::GetNumComponentsInType(uint32_t(a.type))};
 }
 
 // glTF 2.0 "Sparse Accessors": count in 1 .. accessor count, indices strictly increasing and

@@ -23,6 +23,7 @@ constexpr std::initializer_list<int> kIndexComponents = {TINYGLTF_COMPONENT_TYPE
 int attribute_type(const std::string& name) {
   if (name == "TANGENT" || name.rfind("JOINTS_", 0) == 0 || name.rfind("WEIGHTS_", 0) == 0)
     return TINYGLTF_TYPE_VEC4;
+  if (name.rfind("COLOR_", 0) == 0) return kVec3OrVec4;
   return name.rfind("TEXCOORD_", 0) == 0 ? TINYGLTF_TYPE_VEC2 : TINYGLTF_TYPE_VEC3;
 }
 constexpr std::initializer_list<int> kAttributeComponents = {
@@ -31,7 +32,7 @@ constexpr std::initializer_list<int> kAttributeComponents = {
     TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT};
 const char* const kAttributes[] = {"POSITION",  "NORMAL",   "TEXCOORD_0", "TEXCOORD_1",
                                    "TANGENT",   "JOINTS_0", "WEIGHTS_0",  "JOINTS_1",
-                                   "WEIGHTS_1", "JOINTS_2", "WEIGHTS_2"};
+                                   "WEIGHTS_1", "JOINTS_2", "WEIGHTS_2",  "COLOR_0"};
 
 // The texture coordinate sets a material's textures read.
 bool uses_set(const Material& m, int set) {
@@ -118,7 +119,8 @@ std::optional<View> Loader::attribute(const tinygltf::Primitive& prim, const Dra
                          std::to_string(dp->points) + " points";
   const size_t element = size_t(tinygltf::GetComponentSizeInBytes(uint32_t(a.componentType)) *
                                 tinygltf::GetNumComponentsInType(uint32_t(a.type)));
-  return View{d->second.data(), element, dp->points, a.componentType, a.normalized};
+  return View{d->second.data(), element,      dp->points,
+              a.componentType,  a.normalized, tinygltf::GetNumComponentsInType(uint32_t(a.type))};
 }
 
 // Three per triangle (strips and fans unrolled), each below `vertices`: the Draco faces, the
@@ -249,6 +251,37 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Instance& inst) {
         fail(ml + " has a non-finite texture coordinate (" + name + ", vertex " +
              std::to_string(i) + ")");
     }
+  }
+  if (const std::optional<View> col = attribute(prim, dp, "COLOR_0", where)) {
+    // glTF 2.0 "Meshes": COLOR_0 multiplies the base colour, as float or normalised unsigned
+    // bytes or shorts in [0, 1]; an RGB attribute has alpha 1.
+    if (col->count != pos.count)
+      fail(where + " has " + std::to_string(col->count) + " COLOR_0 values for " +
+           std::to_string(pos.count) + " positions");
+    const bool integer = col->component != TINYGLTF_COMPONENT_TYPE_FLOAT;
+    if (col->component == TINYGLTF_COMPONENT_TYPE_BYTE ||
+        col->component == TINYGLTF_COMPONENT_TYPE_SHORT)
+      fail(where + " COLOR_0 has componentType " + component_name(col->component) +
+           "; expected FLOAT, UNSIGNED_BYTE or UNSIGNED_SHORT");
+    View v = *col;
+    if (integer && !v.normalized) {
+      warn(where + ": COLOR_0 is not marked normalized; read as normalised, as glTF requires");
+      v.normalized = true;
+    }
+    out.colors.resize(v.count);
+    bool clamped = false;
+    for (size_t i = 0; i < v.count; ++i) {
+      glm::vec4 c(1.0f);
+      for (int k = 0; k < v.components; ++k) {
+        const double x = v.scalar(i, k);
+        if (!std::isfinite(x))
+          fail(ml + " has a non-finite COLOR_0 value (vertex " + std::to_string(i) + ")");
+        clamped = clamped || x < 0.0 || x > 1.0;
+        c[k] = float(std::clamp(x, 0.0, 1.0));
+      }
+      out.colors[i] = c;
+    }
+    if (clamped) warn(where + ": COLOR_0 values outside [0, 1] are clamped to it");
   }
   const std::vector<uint32_t> idx = indices(mesh_index, p, dp, pos.count, where);
   out.material = material(prim.material, where);

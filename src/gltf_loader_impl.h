@@ -29,6 +29,7 @@ using glm::dmat4;
 inline constexpr double kMaxCoordinate = 1e10;  // |world coordinate| limit
 inline constexpr double kRecentreRatio = 64.0;  // distance / size past which a model is centred
 inline constexpr int kMaxDepth = 1000;          // node hierarchy depth limit
+inline constexpr int kVec3OrVec4 = -1;          // an accessor type COLOR_n may have
 // EXT_mesh_gpu_instancing copies each instance's triangles: at most this many in all (about
 // 6 GB of triangles, vertices and their acceleration structure).
 inline constexpr uint64_t kMaxInstancedTriangles = uint64_t(1) << 26;

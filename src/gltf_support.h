@@ -32,6 +32,7 @@ struct View {
   size_t stride = 0, count = 0;
   int component = 0;  // glTF componentType
   bool normalized = false;
+  int components = 0;  // per element: 1 (SCALAR) to 16 (MAT4)
   template <class T>
   T get(size_t i, int c) const {
     T v;

@@ -35,7 +35,7 @@ vec3 Lights::radiance_at(const Triangle& t, float c1, float c2) const {
   const vec2 b = src.b0 + c1 * src.d1 + c2 * src.d2;  // barycentrics in the mesh triangle
   const vec2 uv[2] = {mesh_uv(*src.mesh, src.tri, 0, b.x, b.y),
                       mesh_uv(*src.mesh, src.tri, 1, b.x, b.y)};
-  return emission_at(images_, *src.material, uv);
+  return emission_at(images_, *src.material, uv, mesh_alpha(*src.mesh, src.tri, b.x, b.y));
 }
 
 int Lights::textured_split(const Mesh& mesh, const Material& mat, uint32_t tri,

@@ -88,6 +88,8 @@ Surface World::surface(const Hit& hit) const {
   const std::span<const Image> images = scene_.images;
   BsdfParams p = BsdfParams::of(m);
   p.base_color *= vec3(lookup(images, m.base_color_texture, s.uv, true));
+  if (mesh.colors)  // COLOR_0 multiplies the base colour (glTF 2.0 "Metallic-Roughness Material")
+    p.base_color *= vec3(w * mesh.colors[i0] + hit.u * mesh.colors[i1] + hit.v * mesh.colors[i2]);
   const glm::vec4 mr = lookup(images, m.metallic_roughness_texture, s.uv, false);
   p.metallic *= mr.z;   // B: metalness
   p.roughness *= mr.y;  // G: roughness

@@ -145,14 +145,23 @@ vec2 mesh_uv(const Mesh& mesh, size_t tri, int set, float b1, float b2) {
   return (1.0f - b1 - b2) * uv[i[0]] + b1 * uv[i[1]] + b2 * uv[i[2]];
 }
 
-bool cut_out(std::span<const Image> images, const Material& m, const vec2 uv[2]) {
+float mesh_alpha(const Mesh& mesh, size_t tri, float b1, float b2) {
+  if (mesh.colors.empty()) return 1.0f;
+  const uint32_t* i = mesh.indices.data() + 3 * tri;
+  return (1.0f - b1 - b2) * mesh.colors[i[0]].w + b1 * mesh.colors[i[1]].w +
+         b2 * mesh.colors[i[2]].w;
+}
+
+bool cut_out(std::span<const Image> images, const Material& m, const vec2 uv[2],
+             float vertex_alpha) {
   if (!m.masked()) return false;
-  const float a = m.alpha * lookup(images, m.base_color_texture, uv, false).w;
+  const float a = m.alpha * lookup(images, m.base_color_texture, uv, false).w * vertex_alpha;
   return a < m.alpha_cutoff;
 }
 
-vec3 emission_at(std::span<const Image> images, const Material& m, const vec2 uv[2]) {
-  if (!m.emits() || cut_out(images, m, uv)) return vec3(0.0f);
+vec3 emission_at(std::span<const Image> images, const Material& m, const vec2 uv[2],
+                 float vertex_alpha) {
+  if (!m.emits() || cut_out(images, m, uv, vertex_alpha)) return vec3(0.0f);
   return m.emission * vec3(lookup(images, m.emissive_texture, uv, true));
 }
 

@@ -194,6 +194,58 @@ TEST_F(DecodeTest, MalformedSparseIsASceneError) {
                "elements of 12 bytes, more than the 256 MiB");
 }
 
+// COLOR_0 as exporters write it: RGB float, RGBA normalised unsigned bytes and shorts (alpha 1
+// for RGB), read into [0, 1]; signed types refused; integers not marked normalised read as
+// normalised and floats outside [0, 1] clamped, each with one warning.
+TEST_F(DecodeTest, VertexColoursAreReadAsGltfDefinesThem) {
+  const auto load = [&](int component, const char* type, const std::vector<unsigned char>& bytes,
+                        bool normalized, const char* name) {
+    Doc d;
+    const int ca = d.accessor(d.view(bytes), component, 4, type,
+                              normalized ? json{{"normalized", true}} : json::object());
+    const int pa = d.accessor(d.view(kQuad), kFloat, 4, "VEC3");
+    const int ia =
+        d.accessor(d.view(std::vector<uint16_t>{0, 1, 2, 0, 2, 3}), kUShort, 6, "SCALAR");
+    d.mesh_node(json{{"attributes", json{{"POSITION", pa}, {"COLOR_0", ca}}}, {"indices", ia}});
+    return d.write(path(name));
+  };
+  const auto bytes = [](const auto& v) {
+    std::vector<unsigned char> out(v.size() * sizeof(v[0]));
+    std::memcpy(out.data(), v.data(), out.size());
+    return out;
+  };
+  const Scene rgb = pb::load_gltf(load(
+      kFloat, "VEC3", bytes(std::vector<float>{1, 0.5f, 0, 0, 0, 0, 0.25f, 0.25f, 0.25f, 1, 1, 1}),
+      false, "rgb.gltf"));
+  EXPECT_TRUE(rgb.warnings.empty()) << rgb.warnings[0];
+  EXPECT_EQ(only_mesh(rgb).colors[0], glm::vec4(1, 0.5f, 0, 1));
+  EXPECT_EQ(only_mesh(rgb).colors[2], glm::vec4(0.25f, 0.25f, 0.25f, 1));
+  const std::vector<uint8_t> u8 = {255, 0, 51, 102, 0, 0, 0, 0, 255, 255, 255, 255, 1, 2, 3, 4};
+  const pb::Mesh b = only_mesh(pb::load_gltf(load(kUByte, "VEC4", bytes(u8), true, "u8.gltf")));
+  EXPECT_EQ(b.colors[0], glm::vec4(1, 0, 0.2f, 0.4f));
+  EXPECT_EQ(b.colors[2], glm::vec4(1));
+  const std::vector<uint16_t> u16 = {65535, 0, 13107, 26214, 0, 0, 0, 0,
+                                     1,     1, 1,     1,     0, 0, 0, 65535};
+  const pb::Mesh c = only_mesh(pb::load_gltf(load(kUShort, "VEC4", bytes(u16), true, "u16.gltf")));
+  EXPECT_EQ(c.colors[0], glm::vec4(1, 0, 0.2f, 0.4f));
+  EXPECT_EQ(c.colors[3], glm::vec4(0, 0, 0, 1));
+  const Scene plain = pb::load_gltf(load(kUByte, "VEC4", bytes(u8), false, "plain.gltf"));
+  EXPECT_EQ(plain.warnings,
+            std::vector<std::string>{"mesh 'grid' primitive 0: COLOR_0 is not marked normalized; "
+                                     "read as normalised, as glTF requires"});
+  EXPECT_EQ(only_mesh(plain).colors[0], glm::vec4(1, 0, 0.2f, 0.4f));
+  const Scene hot = pb::load_gltf(
+      load(kFloat, "VEC3", bytes(std::vector<float>{2, 0.5f, -1, 0, 0, 0, 0, 0, 0, 0, 0, 0}), false,
+           "hot.gltf"));
+  EXPECT_EQ(hot.warnings, std::vector<std::string>{"mesh 'grid' primitive 0: COLOR_0 values "
+                                                   "outside [0, 1] are clamped to it"});
+  EXPECT_EQ(only_mesh(hot).colors[0], glm::vec4(1, 0.5f, 0, 1));
+  expect_error(load(kShort, "VEC4", bytes(std::vector<int16_t>(16, 0)), true, "s16.gltf"),
+               "COLOR_0 has componentType SHORT; expected FLOAT, UNSIGNED_BYTE or UNSIGNED_SHORT");
+  expect_error(load(kFloat, "VEC2", bytes(std::vector<float>(8, 0)), false, "vec2.gltf"),
+               "has type VEC2; expected VEC3 or VEC4");
+}
+
 TEST_F(DecodeTest, SkinWithoutInverseBindMatricesLoads) {
   // tinygltf 2.7 reports "'inverseBindMatrices' property is missing in Skin." as an error
   // although glTF makes it optional (identity matrices); the loader drops that one line. The

@@ -321,6 +321,54 @@ Scene masked_scene(bool masked) {
   return b.done();
 }
 
+// Equal to float rounding: 1e-5 relative (a few ulps through a path of products).
+void expect_close(const std::vector<float>& a, const std::vector<float>& b) {
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t k = 0; k < a.size(); ++k) EXPECT_NEAR(a[k], b[k], 1e-5f * std::fabs(b[k])) << k;
+}
+
+TEST(MaterialRender, VertexColoursMultiplyTheBaseColourAndItsAlpha) {
+  // glTF's COLOR_0 multiplies the base colour: a room whose floor has the constant vertex colour
+  // c over a white factor renders as the floor of factor c, in both methods, to float rounding
+  // (the barycentric weights sum to 1 within 1 ulp, and every random number is the same).
+  auto room = [](vec3 factor, const std::vector<glm::vec4>& colours, bool wall) {
+    SceneBuilder b;
+    Mesh& floor = b.quad(vec3(0, -1, 0), vec3(1, 0, 0), vec3(0, 0, -1),
+                         b.material(Material::lambertian(factor)));  // front +y
+    floor.colors = colours;
+    b.quad(vec3(0, 1, 0), vec3(0.2f, 0, 0), vec3(0, 0, 0.2f), b.material(emitter(vec3(5.0f))));
+    if (wall)  // front +z, toward the camera
+      b.quad(vec3(0, 0, -1), vec3(1, 0, 0), vec3(0, 1, 0),
+             b.material(Material::lambertian(vec3(0.5f))));
+    b.camera(vec3(0, 0, 2), vec3(0, -0.5f, -1), vec3(0, 1, 0), 0.9f);
+    return b.done();
+  };
+  const vec3 c(0.9f, 0.4f, 0.2f);
+  const std::vector<glm::vec4> constant(4, glm::vec4(c, 1.0f));
+  for (Method method : {Method::PPM, Method::SPPM}) {
+    const std::vector<float> coloured =
+        render(room(vec3(1.0f), constant, true), options(8, method), 3);
+    expect_close(coloured, render(room(c, {}, true), options(8, method), 3));
+    EXPECT_NE(coloured, render(room(vec3(1.0f), {}, true), options(8, method), 3));
+  }
+  // Its alpha multiplies the base colour's: under MASK (cutoff 0.5), an alpha of 0.3 at every
+  // vertex cuts the floor out, so the camera sees through it to nothing (every pixel 0, the
+  // wall gone), and an alpha of 0.7 keeps it.
+  auto masked = [&](float alpha) {
+    Scene s =
+        room(vec3(1.0f), std::vector<glm::vec4>(4, glm::vec4(1.0f, 1.0f, 1.0f, alpha)), false);
+    s.materials[s.meshes[0].material].alpha_mode = AlphaMode::Mask;
+    s.materials[s.meshes[0].material].alpha_cutoff = 0.5f;
+    return render(std::move(s), options(8), 1);
+  };
+  const std::vector<float> opaque = render(room(vec3(1.0f), {}, false), options(8), 1);
+  expect_close(masked(0.7f), opaque);
+  size_t lit = 0;
+  for (float v : opaque) lit += v > 0.0f;
+  EXPECT_GT(lit, 30u);
+  EXPECT_EQ(masked(0.3f), std::vector<float>(opaque.size(), 0.0f));
+}
+
 TEST(MaterialRender, MaskCutOutsPassCameraRaysShadowRaysAndPhotons) {
   // Plane points (x, 0, z) with x < 0, |z| < 0.5 see the light through the transparent left
   // column of the occluder (the segment to the light crosses y = 0.5 at x / 2); their radiance is

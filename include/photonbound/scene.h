@@ -131,6 +131,9 @@ struct Mesh {
   // xyz) w). The file's TANGENT, or made from the normal (or anisotropy) texture's coordinates;
   // empty when the material has neither a normal texture nor anisotropy.
   std::vector<glm::vec4> tangents;
+  // COLOR_0, linear RGBA in [0, 1] (A = 1 from an RGB attribute), one per position: it multiplies
+  // the base colour and its alpha; empty when absent.
+  std::vector<glm::vec4> colors;
   std::vector<uint32_t> indices;  // three per triangle, degenerate triangles already removed
   uint32_t material = 0;          // index into Scene::materials
 };

@@ -43,12 +43,17 @@ inline glm::vec4 lookup(std::span<const Image> images, const TextureRef& t, cons
 // The texture coordinates of set `set` of a mesh at barycentrics (b1, b2) of triangle `tri`
 // (weights 1 - b1 - b2, b1, b2 of its three vertices); (0, 0) when the mesh has no such set.
 vec2 mesh_uv(const Mesh& mesh, size_t tri, int set, float b1, float b2);
+// COLOR_0's alpha there (1 without COLOR_0).
+float mesh_alpha(const Mesh& mesh, size_t tri, float b1, float b2);
 
-// Whether a material's alpha at a point is below its cutoff (alphaMode MASK): rays pass there.
-bool cut_out(std::span<const Image> images, const Material& m, const vec2 uv[2]);
+// Whether a material's alpha at a point (times COLOR_0's, `vertex_alpha`) is below its cutoff
+// (alphaMode MASK): rays pass there.
+bool cut_out(std::span<const Image> images, const Material& m, const vec2 uv[2],
+             float vertex_alpha = 1.0f);
 
 // A material's emitted radiance at a point (emissiveFactor x strength x the emissive texture),
 // 0 where a MASK material is cut out. Either side; one-sidedness is the caller's.
-vec3 emission_at(std::span<const Image> images, const Material& m, const vec2 uv[2]);
+vec3 emission_at(std::span<const Image> images, const Material& m, const vec2 uv[2],
+                 float vertex_alpha = 1.0f);
 
 }  // namespace pb

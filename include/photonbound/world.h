@@ -135,7 +135,8 @@ class World {
     const Material* material;
     const vec2* texcoords[2];   // null when the mesh has none
     const glm::vec4* tangents;  // null without a normal texture
-    bool textured;              // the material has a texture (or a MASK cut-out)
+    const glm::vec4* colors;    // COLOR_0, null without it
+    bool textured;  // the material has a texture (or a MASK cut-out), or the mesh COLOR_0
   };
 
   const Scene scene_;
