@@ -159,16 +159,26 @@ Scene Loader::run(const std::vector<std::string>& parse_warnings) {
 
 void Loader::check_extensions() {
   static const std::set<std::string> known = {
-      "KHR_lights_punctual",      "KHR_materials_transmission",
-      "KHR_materials_ior",        "KHR_materials_emissive_strength",
-      "KHR_materials_specular",   "KHR_materials_volume",
-      "KHR_materials_clearcoat",  "KHR_materials_sheen",
-      "KHR_materials_anisotropy", "KHR_materials_iridescence",
-      "KHR_materials_dispersion", "KHR_draco_mesh_compression",
-      "EXT_meshopt_compression",  "KHR_mesh_quantization",
-      "KHR_texture_transform",    "KHR_texture_basisu",
-      "EXT_texture_webp",         "EXT_mesh_gpu_instancing"};  // basisu: the fallback image or a
-                                                               // warning
+      "KHR_lights_punctual",
+      "KHR_materials_transmission",
+      "KHR_materials_ior",
+      "KHR_materials_emissive_strength",
+      "KHR_materials_specular",
+      "KHR_materials_volume",
+      "KHR_materials_clearcoat",
+      "KHR_materials_sheen",
+      "KHR_materials_anisotropy",
+      "KHR_materials_iridescence",
+      "KHR_materials_dispersion",
+      "KHR_draco_mesh_compression",
+      "EXT_meshopt_compression",
+      "KHR_mesh_quantization",
+      "KHR_texture_transform",
+      "KHR_texture_basisu",
+      "EXT_texture_webp",
+      "EXT_mesh_gpu_instancing",
+      "KHR_materials_pbrSpecularGlossiness"};  // basisu: the fallback image or a
+                                               // warning
   // Unknown extensions, even required ones, are rendered without (README "Scenes"): a material
   // extension then falls back to the core factors; data an unknown extension holds is missing,
   // and the accessors that lack it are refused with their own message.

@@ -129,6 +129,7 @@ class Loader {
   std::vector<dmat4> instances(const tinygltf::Node& n, const std::string& nl);
   uint32_t material(int index, const std::string& where);
   Material convert_material(size_t index);
+  void specular_glossiness(const tinygltf::ExtensionMap& ext, const std::string& ml, Material& out);
   double ext_number(const tinygltf::ExtensionMap& ext, const std::string& owner, const char* name,
                     const char* key, double fallback) const;
   // Three numbers in [0, hi], or nullopt when absent.

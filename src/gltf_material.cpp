@@ -208,6 +208,7 @@ Material Loader::convert_material(size_t index) {  // the rules are in the comme
         TextureRef{};
   }
 
+  specular_glossiness(ext, ml, out);
   const double strength =
       ext_number(ext, ml, "KHR_materials_emissive_strength", "emissiveStrength", 1.0);
   if (gm.emissiveFactor.size() != 3) fail(ml + ": emissiveFactor must have 3 numbers");
@@ -230,6 +231,54 @@ Material Loader::convert_material(size_t index) {  // the rules are in the comme
     fail(ml + ": unknown alphaMode '" + one_line(gm.alphaMode) + "'");
   }
   return out;
+}
+
+// KHR_materials_pbrSpecularGlossiness (archived in 2021, and still in many files: Sketchfab's
+// older downloads, Unity's and three.js's exporters; often without pbrMetallicRoughness, whose
+// default would be a rough white metal). "Any client that supports the extension should always
+// render the asset using the specular-glossiness material properties." Its BRDF inputs are
+// c_diff = diffuse.rgb (1 - max(specular)), F0 = specular, alpha = (1 - glossiness)^2 with
+// glTF's GGX, which is the dielectric of KHR_materials_specular with specularFactor 1 (F90 = 1)
+// and f0 = min(0.04 x specularColor, 1) = specular for specularColor = specular / 0.04 at ior
+// 1.5, over a base colour c_diff, roughness 1 - glossiness. The diffuse part is weighted by
+// 1 - max F (the specular extension's rgb_mix) where the extension's appendix-B BRDF has 1 - F
+// per channel: they differ only for a coloured specular.
+void Loader::specular_glossiness(const tinygltf::ExtensionMap& ext, const std::string& ml,
+                                 Material& out) {
+  const char* name = "KHR_materials_pbrSpecularGlossiness";
+  const auto it = ext.find(name);
+  if (it == ext.end()) return;
+  vec3 diffuse(1.0f);
+  float alpha = 1.0f;
+  if (it->second.IsObject() && it->second.Has("diffuseFactor")) {
+    const tinygltf::Value& v = it->second.Get("diffuseFactor");
+    bool ok = v.IsArray() && v.ArrayLen() == 4;
+    for (int c = 0; ok && c < 4; ++c) {
+      const double x = v.Get(c).IsNumber() ? v.Get(c).GetNumberAsDouble() : -1.0;
+      ok = x >= 0.0 && x <= 1.0;
+      (c < 3 ? diffuse[c] : alpha) = float(x);
+    }
+    if (!ok) fail(ml + ": " + name + ".diffuseFactor must be 4 numbers in [0, 1]");
+  }
+  const vec3 specular = ext_color(ext, ml, name, "specularFactor", 1.0).value_or(vec3(1.0f));
+  const double gloss = ext_number(ext, ml, name, "glossinessFactor", 1.0);
+  if (!(gloss >= 0.0 && gloss <= 1.0))
+    fail(ml + ": glossinessFactor " + num(gloss) + " is outside [0, 1]");
+  out.base_color = diffuse;
+  out.alpha = alpha;
+  out.base_color_texture = ext_texture(ext, ml, name, "diffuseTexture");
+  out.metallic = 0.0f;
+  out.metallic_roughness_texture = TextureRef{};
+  out.roughness = 1.0f - float(gloss);
+  out.ior = 1.5f;
+  out.specular = 1.0f;
+  out.specular_texture = out.specular_color_texture = TextureRef{};
+  out.specular_color = specular / 0.04f;
+  out.sg_specular = specular;
+  out.sg_glossiness = float(gloss);
+  out.specular_glossiness_texture = ext_texture(ext, ml, name, "specularGlossinessTexture");
+  // With the texture, c_diff's factor (1 - max specular) varies per texel (World::surface).
+  if (!out.specular_glossiness_texture.present()) out.base_color *= 1.0f - max_component(specular);
 }
 
 void Loader::add_light(const tinygltf::Node& n, const std::string& nl, const Xform& xf) {

@@ -93,6 +93,15 @@ Surface World::surface(const Hit& hit) const {
   const glm::vec4 mr = lookup(images, m.metallic_roughness_texture, s.uv, false);
   p.metallic *= mr.z;   // B: metalness
   p.roughness *= mr.y;  // G: roughness
+  if (m.specular_glossiness_texture.present()) {
+    // KHR_materials_pbrSpecularGlossiness (gltf_material.cpp): specular = factor x RGB (sRGB),
+    // glossiness = factor x A; c_diff = diffuse (1 - max specular), f0 = specular.
+    const glm::vec4 sg = lookup(images, m.specular_glossiness_texture, s.uv, true);
+    const vec3 specular = m.sg_specular * vec3(sg);
+    p.base_color *= 1.0f - max_component(specular);
+    p.specular_color = specular / 0.04f;
+    p.roughness = 1.0f - m.sg_glossiness * sg.w;
+  }
   p.transmission *= lookup(images, m.transmission_texture, s.uv, false).x;
   p.specular *= lookup(images, m.specular_texture, s.uv, false).w;
   p.specular_color *= vec3(lookup(images, m.specular_color_texture, s.uv, true));
@@ -135,7 +144,9 @@ Surface World::surface(const Hit& hit) const {
 }
 
 bool World::may_hold_points(const Material& m) const {
-  if (m.metallic_roughness_texture.present() || m.transmission_texture.present()) return true;
+  if (m.metallic_roughness_texture.present() || m.transmission_texture.present() ||
+      m.specular_glossiness_texture.present())
+    return true;
   if (m.anisotropy > 0.0f) return true;  // a mirror's roughness with anisotropy is a lobe
   const vec3 n(0.0f, 0.0f, 1.0f);
   return !Bsdf(m, n, n, mirror_roughness_).is_delta();

@@ -83,6 +83,12 @@ struct Material {
   TextureRef anisotropy_texture;             // RG direction in [-1, 1], B strength (linear)
   TextureRef iridescence_texture;            // R (linear)
   TextureRef iridescence_thickness_texture;  // G (linear)
+  // KHR_materials_pbrSpecularGlossiness's specularGlossinessTexture (RGB specular sRGB, A
+  // glossiness linear) and the factors it multiplies; the conversion to the fields above is in
+  // the loader (gltf_material.cpp), this texture's part per hit (World::surface).
+  TextureRef specular_glossiness_texture;
+  vec3 sg_specular{1.0f};
+  float sg_glossiness = 1.0f;
 
   // Emits somewhere: the factor is positive (an emissive texture may still be black in places).
   bool emits() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
