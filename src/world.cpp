@@ -32,10 +32,9 @@ World::World(Scene scene, float mirror_roughness)
         mat.specular_color_texture.present() || mat.masked() || mat.clearcoat_texture.present() ||
         mat.clearcoat_roughness_texture.present() || mat.clearcoat_normal_texture.present() ||
         mat.sheen_color_texture.present() || mat.sheen_roughness_texture.present() ||
-        (mat.anisotropy > 0.0f && !m.tangents.empty()) || mat.iridescence_texture.present() ||
-        mat.iridescence_thickness_texture.present() ||
-        mat.specular_glossiness_texture.present() ||  // the direction needs the tangents
-        !m.colors.empty();
+        (mat.anisotropy > 0.0f && !m.tangents.empty()) ||  // the direction needs the tangents
+        mat.iridescence_texture.present() || mat.iridescence_thickness_texture.present() ||
+        mat.specular_glossiness_texture.present() || !m.colors.empty();
     auto uv = [&](int set) { return m.texcoords[set].empty() ? nullptr : m.texcoords[set].data(); };
     first_triangle_.push_back(uint32_t(first));
     meshes_.push_back({m.positions.data(),

@@ -1343,6 +1343,21 @@ TEST_F(LoaderTest, UnsupportedRequiredExtension) {
   EXPECT_EQ(s.warnings[1], "extension 'EXT_lights_ies' is ignored");
 }
 
+TEST_F(LoaderTest, ExtensionsWithoutWhichTheImageIsTheSameAreNotWarned) {
+  // Metadata, the variants' default materials and MSFT_lod's finest level are what photonbound
+  // draws anyway; unlit materials are lit, which the warning says.
+  Gltf g = basic();
+  g.top =
+      "\"extensionsUsed\":[\"KHR_xmp_json_ld\",\"KHR_materials_variants\",\"MSFT_lod\","
+      "\"KHR_materials_unlit\"],";
+  const Scene s = load(g);
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_EQ(
+      s.warnings[0],
+      "extension 'KHR_materials_unlit' is ignored: its materials are lit (light is simulated, "
+      "not painted on), by their metallic-roughness factors");
+}
+
 TEST_F(LoaderTest, MorphTargetsAreDrawnAtTheMeshsWeights) {
   // As viewers draw the mesh with no animation playing: weight 1 lifts it by the target's 1
   // (tests/test_gltf_deform.cpp has the rest).
