@@ -117,8 +117,14 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
   // KHR_materials_transmission: dielectric = fresnel_mix(mix(diffuse, btdf, t), specular) is
   // (1 - t) fresnel_mix(diffuse, specular) + t fresnel_mix(btdf, specular): the parts split.
   glass_ = (1.0f - m) * t;
-  // KHR_materials_dispersion changes only a volume's refraction.
-  if (!p.thin && glass_ > 0.0f && p.dispersion > 0.0f) dispersion_ = p.dispersion;
+  // Rough glass (bsdf_glass.cpp) where the transmitting part's roughness is at or above the
+  // mirror's, unless it is asked to be smooth (PPM). A volume of index 1 does not refract at any
+  // microfacet: its transmission is straight through, a delta branch (Walter's half vector
+  // eta wi + wo vanishes there).
+  rough_glass_ = glass_ > 0.0f && p.rough_transmission && !(p.roughness < mirror_roughness) &&
+                 (p.thin || std::fabs(p.ior - 1.0f) > 1e-4f);
+  // KHR_materials_dispersion changes only a smooth volume's refraction.
+  if (!p.thin && glass_ > 0.0f && p.dispersion > 0.0f && !rough_glass_) dispersion_ = p.dispersion;
   reflect_ = m + (1.0f - m) * (1.0f - t);
   brdf_.metallic = reflect_ > 0.0f ? m / reflect_ : 0.0f;
   if (p.anisotropy > 0.0f) {  // KHR_materials_anisotropy: the direction in ns's tangent plane
@@ -136,8 +142,8 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
   if ((coat > 0.0f || sheen > 0.0f) && m == 0.0f && p.specular == 0.0f) smooth_ = false;
   const float opaque = (1.0f - m) * (1.0f - t);
   base_non_delta_ = reflect_ > 0.0f && (!smooth_ || opaque > 0.0f);
-  bool non_delta = base_non_delta_;
-  bool delta = glass_ > 0.0f || (smooth_ && reflect_ > 0.0f);
+  bool non_delta = base_non_delta_ || rough_glass_;
+  bool delta = (glass_ > 0.0f && !rough_glass_) || (smooth_ && reflect_ > 0.0f);
   if (coat > 0.0f) {  // KHR_materials_clearcoat
     coat_ = coat;
     coat_smooth_ = p.clearcoat_roughness < mirror_roughness;
@@ -212,7 +218,9 @@ vec3 Bsdf::eval(const vec3& wo, const vec3& wi) const {
   if (kind_ == Kind::Lambertian) return diffuse_f();
   if (layered()) return eval_with_view(wo, wi, wo, nullptr);
   const Frame f(glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_, tangent_);
-  return eval_local(f.local(wo), f.local(wi), nullptr);
+  const vec3 value = eval_local(f.local(wo), f.local(wi), nullptr);
+  // Rough glass's reflection (its transmission reaches only the other side).
+  return glass_in_part() ? value + eval_glass(wo, wi, wo, Transport::Radiance, nullptr) : value;
 }
 
 float Bsdf::coat_weight(const vec3& v) const {
@@ -291,6 +299,9 @@ vec3 Bsdf::eval_with_view(const vec3& wo, const vec3& wi, const vec3& v, float* 
       base += reflect_ * brdf_.eval_specular(lo, li);
       p[1] = brdf_.specular_pdf(lo, li);
     }
+    // Rough glass's reflection (drawn apart from these terms: sample()).
+    if (glass_in_part())
+      base += glass_f(lo, li, glm::dot(wo, ng_) > 0.0f, Transport::Radiance, nullptr);
     under = sheen_scaling(lo.z, li.z) * base;
     if (t.sheen) {  // f_sheen + scaling x f_material (KHR_materials_sheen, "albedo scaling")
       under += sheen_ * sheen_dv(lo, li, sheen_alpha(sheen_roughness_));
@@ -382,6 +393,7 @@ vec3 Bsdf::max_f(const vec3& wo) const {
     vec3 base(0.0f);
     if (t.diffuse) base += reflect_ * diffuse;
     if (t.lobe) base += vec3(reflect_ * lobe_bound(wo));
+    if (glass_in_part()) base += vec3(glass_reflection_bound(wo));
     const float cos_o = std::fabs(glm::dot(wo, ns_));
     if (sheen_max() > 0.0f)  // s <= 1 - max(sheen) E(wo); D <= its horizon value, V <= 1
       base *= std::max(0.0f, 1.0f - sheen_max() * sheen_albedo(cos_o, sheen_roughness_));
@@ -394,8 +406,29 @@ vec3 Bsdf::max_f(const vec3& wo) const {
     }
     return out;
   }
-  if (smooth_ || part_ == Part::Base) return reflect_ * diffuse;
-  return reflect_ * ((part_ == Part::Lobe ? vec3(0.0f) : diffuse) + vec3(lobe_bound(wo)));
+  const vec3 glass(glass_in_part() ? glass_reflection_bound(wo) : 0.0f);
+  if (smooth_ || part_ == Part::Base || !base_non_delta_) return reflect_ * diffuse + glass;
+  return reflect_ * ((part_ == Part::Lobe ? vec3(0.0f) : diffuse) + vec3(lobe_bound(wo))) + glass;
+}
+
+float Bsdf::glass_reflection_bound(const vec3& wo) const {
+  // Rough glass's reflection glass_ F D V: on a thin wall Schlick's layer term falls with v.h
+  // (the film's is at most 1); a volume's exact term falls with v.h from outside, and from
+  // inside total internal reflection makes it 1.
+  const bool front = glm::dot(wo, ng_) > 0.0f;
+  const float zo = std::max(std::fabs(glm::dot(wo, ns_)), kMinCosine);
+  const float irid = brdf_.iridescence;
+  const auto fresnel = [&](float v_h) {
+    float f = 1.0f;
+    if (thin_) {
+      const vec3 f0 = brdf_.dielectric_f0();
+      f = max_component(f0 + (vec3(brdf_.dielectric_f90()) - f0) * schlick_weight(v_h));
+    } else if (front) {
+      f = fresnel_dielectric(v_h, brdf_.ior);
+    }
+    return irid > 0.0f ? (1.0f - irid) * f + irid : f;
+  };
+  return glass_ * ggx_term_bound(zo, ggx_alpha(brdf_.roughness), fresnel);
 }
 
 float Bsdf::pdf(const vec3& wo, const vec3& wi) const {
@@ -433,17 +466,57 @@ float Bsdf::delta_probability(const vec3& wo) const {
   const int n = delta_branches(wo, Transport::Importance, b);
   float wd = 0.0f;
   for (int k = 0; k < n; ++k) wd += average(b[k].weight);
-  float wn = non_delta_albedo(std::fabs(glm::dot(wo, ns_)));
+  float wn = base_non_delta_ ? non_delta_albedo(std::fabs(glm::dot(wo, ns_))) : 0.0f;
   if (layered()) {  // the coat's lobe (if rough), the sheen and the material under them
     float a[kTerms];
     term_albedos(wo, a);
     wn = a[0] + a[1] + a[2] + a[3];
   }
+  if (glass_in_part()) wn += glass_albedo(wo);
   return wd > 0.0f ? wd / (wd + wn) : 0.0f;
 }
 
 bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out,
                   const vec3& tint) const {
+  if (glass_in_part()) {
+    // Rough glass or the rest of this part, by their albedo estimates, each divided by its
+    // probability (an unbiased choice of one component of a sum).
+    const float ag = glass_albedo(wo), ar = rest_albedo(wo);
+    const float pg = ag / (ag + ar);
+    if (pg >= 1.0f || rng.next_float() < pg) {
+      if (!sample_glass(wo, rng, mode, out)) return false;
+      out.weight /= pg;
+      out.pdf *= pg;
+      return true;
+    }
+    if (!sample_rest(wo, rng, mode, out, tint)) return false;
+    out.weight /= 1.0f - pg;
+    out.pdf *= 1.0f - pg;
+    return true;
+  }
+  return sample_rest(wo, rng, mode, out, tint);
+}
+
+float Bsdf::rest_albedo(const vec3& wo) const {
+  // This part's estimate without rough glass: its delta branches (All) and its non-delta terms.
+  float a = 0.0f;
+  if (part_ == Part::All && has_delta()) {
+    SpecularBranch b[kMaxDeltaBranches];
+    const int n = delta_branches(wo, Transport::Importance, b);
+    for (int k = 0; k < n; ++k) a += average(b[k].weight);
+  }
+  if (layered()) {
+    float t[kTerms];
+    term_albedos(wo, t);
+    return a + t[0] + t[1] + t[2] + t[3];
+  }
+  if (base_non_delta_ && (part_ == Part::All || follow_lobe_))
+    a += non_delta_albedo(std::fabs(glm::dot(wo, ns_)));
+  return a;
+}
+
+bool Bsdf::sample_rest(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out,
+                       const vec3& tint) const {
   if (kind_ == Kind::Lambertian) {
     const bool front = glm::dot(wo, ng_) > 0.0f;
     const vec3 ng = front ? ng_ : -ng_;
@@ -663,7 +736,7 @@ int Bsdf::base_branches(const vec3& wo, Transport mode, SpecularBranch out[4]) c
     mirror =
         reflect_ * ((1.0f - mu) * brdf_.layer_fresnel(cos_i) + mu * brdf_.metal_fresnel(cos_i));
   }
-  if (glass_ <= 0.0f) {
+  if (glass_ <= 0.0f || rough_glass_) {  // rough glass is not a delta branch
     if (!(max_component(mirror) > 0.0f)) return 0;
     out[0] = {reflect_checked(wo, ns, ng), mirror};
     return 1;
@@ -761,6 +834,7 @@ int Bsdf::dispersive_branches(const vec3& wo, Transport mode, SpecularBranch out
 }
 
 bool Bsdf::has_lobe_below(float below) const {
+  if (rough_glass_ && part_ == Part::All) return true;  // always followed
   if (layered())
     return kind_ == Kind::Layered && part_ == Part::All &&
            (follows_lobe(below) || follows_coat(below));
@@ -770,7 +844,9 @@ bool Bsdf::has_lobe_below(float below) const {
 }
 
 bool Bsdf::follows_lobe(float below) const {
-  return base_non_delta_ && !smooth_ && lobe_roughness() < below &&
+  // With rough glass, followed anyway, the base's lobe is followed too: a part then always
+  // splits as the lobes and the diffuse base.
+  return base_non_delta_ && !smooth_ && (lobe_roughness() < below || rough_glass_) &&
          (brdf_.metallic > 0.0f || brdf_.specular > 0.0f);
 }
 
@@ -784,11 +860,12 @@ float Bsdf::lobe_roughness() const {
 bool Bsdf::follows_coat(float below) const { return coat_lobe() && coat_roughness_ < below; }
 
 float Bsdf::lobe_probability(const vec3& wo, float below) const {
+  const float glass = rough_glass_ ? glass_albedo(wo) : 0.0f;  // followed, always
   if (layered()) {  // the followed terms' share of the albedo estimates
     float all[kTerms], lobe[kTerms];
     term_albedos(wo, all);
     lobe_part(below).term_albedos(wo, lobe);
-    float sum = 0.0f, followed = 0.0f;
+    float sum = glass, followed = glass;
     for (int j = 0; j < kTerms; ++j) {
       sum += all[j];
       followed += lobe[j];
@@ -796,7 +873,11 @@ float Bsdf::lobe_probability(const vec3& wo, float below) const {
     return sum > 0.0f ? std::min(1.0f, followed / sum) : 0.0f;
   }
   // specular_probability reads only the cosine of wo with the shading normal.
-  return brdf_.specular_probability(vec3(0.0f, 0.0f, std::fabs(glm::dot(wo, ns_))));
+  const float share = brdf_.specular_probability(vec3(0.0f, 0.0f, std::fabs(glm::dot(wo, ns_))));
+  if (!rough_glass_) return share;
+  const float rest = base_non_delta_ ? non_delta_albedo(std::fabs(glm::dot(wo, ns_))) : 0.0f;
+  const float lobe = follows_lobe(below) ? share * rest : 0.0f;
+  return std::min(1.0f, (glass + lobe) / (glass + rest));
 }
 
 Bsdf Bsdf::base_part(float below) const {

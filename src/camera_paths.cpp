@@ -11,6 +11,21 @@ namespace pb {
 // Passes over (ESTIMATOR.md section 10) a path may take beyond --max-depth, by roulette.
 constexpr int kPassOverDepth = 16;
 
+// Russian roulette past --max-depth: the path survives with q = min(1, its largest channel) and
+// its weight is divided by q, so it keeps its mean and, below 1, a weight of 1 at most (a fixed
+// 1/2 doubled the weight at every step: a path that bounced inside rough glass came out with
+// 2^k, one pixel's firefly).
+namespace {
+
+bool survives(vec3& weight, Rng& rng) {
+  const float q = std::min(1.0f, max_component(weight));
+  if (!(q > 0.0f) || (q < 1.0f && rng.next_float() >= q)) return false;
+  weight /= q;
+  return true;
+}
+
+}  // namespace
+
 size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
                             std::span<MeasurementPoint> points, std::span<GlossyPoint> glossy,
                             std::span<PassGather> out) {
@@ -69,20 +84,27 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
         if (depth < in.max_depth + kPassOverDepth && s.bsdf.has_lobe_below(in.follow_roughness)) {
           // This vertex's direct light with its whole Bsdf (so the choice below adds no noise
           // to it), then follow the GGX lobe with p_lobe or gather photons at the diffuse base
-          // with 1 - p_lobe, each divided by its probability (ESTIMATOR.md section 10).
-          const GlossyPoint whole{0, wo, s.bsdf};
+          // with 1 - p_lobe, each divided by its probability (ESTIMATOR.md section 10). Rough
+          // glass is followed with all light from photons too (its photons are never gathered);
+          // its direct light from the other side is one more sample, through the surface.
+          // Sharp rough glass is left out: its light comes from what its paths hit.
+          const bool glass_direct = s.bsdf.glass_lit_directly();
+          const bool sharp_glass = s.bsdf.has_rough_glass() && !glass_direct;
+          const GlossyPoint whole{0, wo, sharp_glass ? s.bsdf.without_glass() : s.bsdf};
           point.f = w;
-          emission += direct_light(in.world, point, &whole, rng);
+          if (in.next_event) {
+            emission += direct_light(in.world, point, &whole, rng);
+            if (glass_direct) emission += direct_light_through(in.world, s, wo, w, rng);
+          }
           const float p_lobe = s.bsdf.lobe_probability(wo, in.follow_roughness);
           if (p_lobe >= 1.0f || (p_lobe > 0.0f && rng.next_float() < p_lobe)) {
             const GlossyPoint lobe{0, wo, s.bsdf.lobe_part(in.follow_roughness)};
             weight = w / p_lobe;
             point = MeasurementPoint{};  // no visible point here
-            // At or beyond --max-depth the followed path goes on by Russian roulette (1/2,
-            // weight 2), as a pass-over does: the lobe's indirect light keeps its mean.
+            // At or beyond --max-depth the followed path goes on by Russian roulette, as a
+            // pass-over does: the lobe's indirect light keeps its mean.
             if (depth >= in.max_depth) {
-              if (rng.next_float() >= 0.5f) break;
-              weight *= 2.0f;
+              if (!survives(weight, rng)) break;
               past_limit = true;
             }
             BsdfSample b;
@@ -93,7 +115,9 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
             origin_normal = s.ng;
             origin_error = s.error;
             dir = b.wi;
-            after_lobe = true;
+            // The light this path finds directly was counted by the next-event sample, unless
+            // it left through sharp rough glass, which that sample left out.
+            after_lobe = in.next_event && !(sharp_glass && b.glass);
             continue;
           }
           w /= 1.0f - p_lobe;
@@ -124,12 +148,11 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
             disc = DiscMoments{};
             // At --max-depth the path does not keep the point (its pixel would be unknown for
             // good: validity is the least mass over the passes, and over thousands of passes a
-            // rare deep path comes): it goes on by Russian roulette, 1/2 with weight 2, so the
-            // indirect part keeps its mean; kPassOverDepth more vertices cut it (no point, the
-            // truncation every depth limit makes, here of weight 2^-16).
+            // rare deep path comes): it goes on by Russian roulette (survives), so the indirect
+            // part keeps its mean; kPassOverDepth more vertices cut it (no point, the truncation
+            // every depth limit makes).
             if (depth >= in.max_depth) {
-              if (depth >= in.max_depth + kPassOverDepth || rng.next_float() >= 0.5f) break;
-              w *= 2.0f;
+              if (depth >= in.max_depth + kPassOverDepth || !survives(w, rng)) break;
               past_limit = true;
             }
             BsdfSample b;
@@ -148,9 +171,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
         break;
       }
       if (depth >= in.max_depth) {  // the chain is cut, unless it is past the limit already
-        if (!past_limit || depth >= in.max_depth + kPassOverDepth || rng.next_float() >= 0.5f)
-          break;
-        weight *= 2.0f;
+        if (!past_limit || depth >= in.max_depth + kPassOverDepth || !survives(weight, rng)) break;
       }
       BsdfSample b;
       if (!s.bsdf.sample_delta(wo, rng, Transport::Radiance, b, weight)) break;

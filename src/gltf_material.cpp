@@ -123,9 +123,6 @@ Material Loader::convert_material(size_t index) {  // the rules are in the comme
         std::isinf(distance) ? 0.0f : float(-std::log(double(color[c])) / distance);
   if (out.transmission > 0.0f || out.transmission_texture.present()) {
     if (!out.thin && out.ior == 0.0f) fail(ml + ": a volume boundary cannot have ior 0");
-    if (out.roughness >= kMinMirrorRoughness || out.metallic_roughness_texture.present())
-      warn(ml + ": roughness " + num(pbr.roughnessFactor) +
-           " with transmission: the transmitted part is rendered as smooth glass");
     if (!out.thin && ext.count("KHR_materials_specular"))
       warn(ml + ": KHR_materials_specular does not change a volume boundary (exact Fresnel)");
   }

@@ -99,6 +99,13 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   pb::ThreadLimit threads(options.threads);
   pb::Renderer renderer(std::move(scene), options);
   if (saved) renderer.restore(saved->render);
+  // PPM's points are fixed, so it cannot follow a rough lobe through a surface (bsdf.h).
+  if (const std::string glass = renderer.world().rough_glass_names();
+      !glass.empty() && options.method == pb::Method::PPM)
+    std::cerr << "photonbound: warning: " << options.scene << ": " << glass
+              << ": rough transmission is rendered as smooth glass by --method ppm (its fixed "
+                 "points cannot follow a rough lobe through a surface); --method sppm renders "
+                 "it rough\n";
   // Which materials the mirror threshold turns into perfect mirrors (a choice, not a flaw).
   if (const std::string note = renderer.world().mirror_note();
       !note.empty() && options.progress != pb::ProgressMode::Never)

@@ -45,7 +45,8 @@ double default_initial_radius(const EyePassResult& eye, const World& world) {
 
 Renderer::Renderer(Scene scene, const RenderOptions& options)
     : options_(options),
-      world_(completed(std::move(scene), options), float(options.mirror_roughness)),
+      world_(completed(std::move(scene), options), float(options.mirror_roughness),
+             options.method == Method::SPPM),
       camera_(choose_camera(world_.scene(), options)),
       tracer_(world_, options.direct == DirectMode::Photons) {
   const auto t0 = Clock::now();

@@ -76,7 +76,9 @@ Surface World::surface(const Hit& hit) const {
   const Material& m = *mesh.material;
   s.material = &m;
   if (!mesh.textured) {
-    s.bsdf = Bsdf(m, s.ng, s.ns, mirror_roughness_);
+    BsdfParams p = BsdfParams::of(m);
+    p.rough_transmission = rough_transmission_;
+    s.bsdf = Bsdf(p, s.ng, s.ns, mirror_roughness_);
     return s;
   }
   for (int set = 0; set < 2; ++set) {
@@ -87,6 +89,7 @@ Surface World::surface(const Hit& hit) const {
   // are sRGB, the others linear; metalness in B, roughness in G.
   const std::span<const Image> images = scene_.images;
   BsdfParams p = BsdfParams::of(m);
+  p.rough_transmission = rough_transmission_;
   p.base_color *= vec3(lookup(images, m.base_color_texture, s.uv, true));
   if (mesh.colors)  // COLOR_0 multiplies the base colour (glTF 2.0 "Metallic-Roughness Material")
     p.base_color *= vec3(w * mesh.colors[i0] + hit.u * mesh.colors[i1] + hit.v * mesh.colors[i2]);
@@ -149,7 +152,9 @@ bool World::may_hold_points(const Material& m) const {
     return true;
   if (m.anisotropy > 0.0f) return true;  // a mirror's roughness with anisotropy is a lobe
   const vec3 n(0.0f, 0.0f, 1.0f);
-  return !Bsdf(m, n, n, mirror_roughness_).is_delta();
+  BsdfParams p = BsdfParams::of(m);
+  p.rough_transmission = rough_transmission_;
+  return !Bsdf(p, n, n, mirror_roughness_).is_delta();
 }
 
 std::string World::mirror_note() const {
@@ -186,6 +191,23 @@ std::string World::mirror_note() const {
   std::snprintf(threshold, sizeof threshold, "%g", double(mirror_roughness_));
   return std::string(count == 1 ? "material " : "materials ") + names + ": roughness below " +
          threshold + " (--mirror-roughness) is rendered as a perfect mirror";
+}
+
+std::string World::rough_glass_names() const {
+  std::string names;
+  size_t count = 0;
+  for (const Material& m : scene_.materials) {
+    const bool transmits = m.transmission > 0.0f || m.transmission_texture.present();
+    const bool rough = !(m.roughness < mirror_roughness_) ||
+                       m.metallic_roughness_texture.present() ||
+                       m.specular_glossiness_texture.present();
+    if (!transmits || !rough || !(m.metallic < 1.0f || m.metallic_roughness_texture.present()))
+      continue;
+    if (++count <= 4) names += std::string(names.empty() ? "" : ", ") + "'" + m.name + "'";
+  }
+  if (count == 0) return "";
+  if (count > 4) names += " and " + std::to_string(count - 4) + " more";
+  return std::string(count == 1 ? "material " : "materials ") + names;
 }
 
 }  // namespace pb

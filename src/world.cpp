@@ -6,12 +6,13 @@
 
 namespace pb {
 
-World::World(Scene scene, float mirror_roughness)
+World::World(Scene scene, float mirror_roughness, bool rough_transmission)
     : scene_(std::move(scene)),
       accel_(scene_),
       lights_(scene_),
       scene_size_(std::max(scene_.bounds.diagonal(), 1e-30f)),
-      mirror_roughness_(mirror_roughness) {
+      mirror_roughness_(mirror_roughness),
+      rough_transmission_(rough_transmission) {
   size_t triangles = 0;
   for (const Mesh& m : scene_.meshes) triangles += m.indices.size() / 3;
   face_normals_.resize(triangles);

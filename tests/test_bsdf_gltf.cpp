@@ -38,6 +38,9 @@ BsdfParams params(vec3 base, float metallic, float roughness, float transmission
   p.transmission = transmission;
   p.thin = thin;
   p.specular = specular;
+  // Transmission here is the smooth glass beside a glossy reflection (PPM's; SPPM's rough glass
+  // has its own tests, test_bsdf_rough_glass.cpp).
+  p.rough_transmission = false;
   return p;
 }
 

@@ -350,7 +350,6 @@ TEST_F(LoaderTest, MaterialsKeepGltfParametersAndDefaults) {
   EXPECT_TRUE(all.double_sided);
   EXPECT_TRUE(all.masked());
   EXPECT_NEAR(all.alpha_cutoff, 0.3f, 1e-7f);
-  EXPECT_TRUE(has_warning(s, "material 'all': roughness 0.5 with transmission"));
   EXPECT_TRUE(has_warning(s, "material 'all': KHR_materials_specular does not change a volume"));
   EXPECT_TRUE(mat(3).thin);
   EXPECT_FALSE(has_warning(s, "material 'thin'"));

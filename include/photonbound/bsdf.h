@@ -55,6 +55,9 @@ enum class Transport : uint8_t { Radiance, Importance };
 // coat's mirror about its own normal.
 inline constexpr int kMaxDeltaBranches = 5;
 
+// Rough glass at least this rough takes next-event light (Bsdf::glass_lit_directly).
+inline constexpr float kGlassDirectRoughness = 0.4f;
+
 struct SpecularBranch {
   vec3 dir{0.0f};
   vec3 weight{0.0f};  // throughput factor of the branch (Fresnel term included)
@@ -65,6 +68,7 @@ struct BsdfSample {
   vec3 weight{0.0f};  // f |cos| / pdf; for a delta lobe, the branch weight over its probability
   float pdf = 0.0f;   // solid-angle pdf; 0 for a delta lobe
   bool delta = false;
+  bool glass = false;  // drawn from rough glass (Bsdf::sample)
 };
 
 // The material's parameters at one surface point: the factors times the textures there.
@@ -85,7 +89,11 @@ struct BsdfParams {
   vec3 anisotropy_direction{0.0f};
   // KHR_materials_iridescence: the film's weight (0: none), index and thickness in nm.
   float iridescence = 0.0f, iridescence_ior = 1.3f, iridescence_thickness = 400.0f;
-  float dispersion = 0.0f;                  // KHR_materials_dispersion: 20 / Abbe number (0: none)
+  float dispersion = 0.0f;  // KHR_materials_dispersion: 20 / Abbe number (0: none)
+  // A transmitting part of roughness at or above the mirror roughness is rough glass (a GGX
+  // component, bsdf_glass.cpp), or, false, smooth glass as PPM renders it (its fixed points
+  // cannot follow a rough lobe through a surface).
+  bool rough_transmission = true;
   static BsdfParams of(const Material& m);  // the factors alone (no textures)
 };
 
@@ -139,6 +147,17 @@ class Bsdf {
 
   // f(wo, wi) of the non-delta part, without the cosine; 0 for wi on the other side of ng.
   vec3 eval(const vec3& wo, const vec3& wi) const;
+  // Rough glass's transmission f(wo, wi) for radiance (view wo), wi on the other side of ng;
+  // 0 otherwise and without rough glass. Next-event light through the surface (camera paths).
+  vec3 eval_transmission(const vec3& wo, const vec3& wi) const;
+  bool has_rough_glass() const { return glass_in_part(); }
+  // Rough glass broad enough for next-event light (roughness at least kGlassDirectRoughness):
+  // camera paths sample lights for it (through the surface too). A sharper one is lit only by
+  // what the paths that follow it hit, since a light sample would land in its narrow lobe
+  // rarely and then weigh its peak (glass seen at a roughness near the mirror's, under an
+  // environment: single samples of 5e5 on a pixel of radiance 0.5).
+  bool glass_lit_directly() const;
+  Bsdf without_glass() const;  // this Bsdf less rough glass (next-event light for a sharp one)
   // An upper bound of eval(wo, wi) over every wi: what one photon can bring at a glossy point
   // (the sparse-photon bound, ESTIMATOR.md section 12).
   vec3 max_f(const vec3& wo) const;
@@ -151,6 +170,10 @@ class Bsdf {
   // dispersive volume's branches are chosen by their average throughput times it, so that a
   // path left with one channel does not pick another channel's refraction (the others ignore
   // it).
+  // Rough glass (KHR_materials_transmission at a roughness above the mirror's) is a component
+  // of its own, drawn with its albedo estimate's share: its reflection and its transmission
+  // through the surface, which eval() never returns (a gather and next-event see only what
+  // reaches their side).
   bool sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out,
               const vec3& tint = vec3(1.0f)) const;
   // Probability that sample() takes the delta part: 0 without one, 1 without a non-delta part,
@@ -179,11 +202,12 @@ class Bsdf {
   // The split SPPM's camera paths make at a rough GGX lobe (camera_paths.h, ESTIMATOR.md
   // section 10): the non-delta part is the diffuse base plus the lobe (MetalRoughBrdf's
   // eval_diffuse and eval_specular), and a path may follow the lobe by sampling it and gather
-  // photons at the base alone.
+  // photons at the base alone. Rough glass is always followed (photons that cross the surface
+  // are not gathered), and with it the base's GGX lobe.
   // True when the non-delta part has a GGX lobe that is not a mirror, of roughness below
   // `below`, that can reflect something (metal, or a dielectric layer with specular > 0), or a
-  // clear coat's lobe (not a mirror) of roughness below `below`. The lobes below `below` are
-  // followed, the rest (the diffuse base, and a lobe at or above `below`) gathered.
+  // clear coat's lobe (not a mirror) of roughness below `below`, or rough glass. The lobes below
+  // `below` are followed, the rest (the diffuse base, and a lobe at or above `below`) gathered.
   bool has_lobe_below(float below) const;
   // The probability of following the lobe instead of gathering at the base: the lobe's share
   // of the two parts' albedo estimates (MetalRoughBrdf::specular_probability); 1 where the
@@ -231,15 +255,31 @@ class Bsdf {
   float lobe_roughness() const;  // the base lobe's roughness for --follow-roughness
   vec3 diffuse_term(const vec3& wo, const vec3& wi) const;  // local frame, both above
   float lobe_bound(const vec3& wo) const;                   // of F D V of the base's lobe (max_f)
+  // The part sample() draws from apart from rough glass.
+  bool sample_rest(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out,
+                   const vec3& tint) const;
+  // Rough glass (bsdf_glass.cpp), in this part (not a base part's): its f in world directions
+  // on either side, times the layering above it (the sheen's scaling, 1 - k at the view v),
+  // and the density of sample_glass; its draw; the estimate of its albedo that picks it; that
+  // of the rest of this part; and a bound of its reflection's F D V (max_f).
+  bool glass_in_part() const { return rough_glass_ && part_ != Part::Base; }
+  vec3 glass_fresnel(float cos_h, bool front) const;
+  vec3 glass_f(const vec3& lo, const vec3& li, bool front, Transport mode, float* pdf) const;
+  vec3 eval_glass(const vec3& wo, const vec3& wi, const vec3& v, Transport mode, float* pdf) const;
+  bool sample_glass(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const;
+  float glass_albedo(const vec3& wo) const;
+  float rest_albedo(const vec3& wo) const;
+  float glass_reflection_bound(const vec3& wo) const;
 
   Kind kind_ = Kind::Lambertian;
   bool smooth_ = false;     // GGX lobes below the mirror roughness: delta branches
   bool has_delta_ = false;  // Layered with a delta part too
   bool thin_ = true;
-  float dispersion_ = 0.0f;                       // KHR_materials_dispersion, of a volume (0: none)
-  Part part_ = Part::All;                         // base_part() and lobe_part()
-  bool base_non_delta_ = false;                   // the uncoated material has a non-delta part
-  bool coat_smooth_ = false;                      // the clear coat is a mirror
+  bool rough_glass_ = false;     // the transmitting part is a GGX component (bsdf_glass.cpp)
+  float dispersion_ = 0.0f;      // KHR_materials_dispersion, of a volume (0: none)
+  Part part_ = Part::All;        // base_part() and lobe_part()
+  bool base_non_delta_ = false;  // the uncoated material has a non-delta part
+  bool coat_smooth_ = false;     // the clear coat is a mirror
   bool follow_lobe_ = true, follow_coat_ = true;  // which lobes a coated part follows
   // The reflecting parts as one MetalRoughBrdf whose metallic is m / (m + o), scaled by
   // reflect_ = m + o; the Lambertian kind keeps its reflectance in brdf_.base_color.
