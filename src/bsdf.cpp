@@ -724,18 +724,19 @@ int Bsdf::delta_branches(const vec3& wo, Transport mode,
   return n + 1;
 }
 
+vec3 Bsdf::smooth_mirror(float cos_i) const {
+  if (!smooth_ || !(reflect_ > 0.0f)) return vec3(0.0f);
+  // The mirror limit of the GGX lobes (h = n): appendix B's Fresnel terms at cos_i.
+  const float mu = brdf_.metallic;
+  return reflect_ * ((1.0f - mu) * brdf_.layer_fresnel(cos_i) + mu * brdf_.metal_fresnel(cos_i));
+}
+
 int Bsdf::base_branches(const vec3& wo, Transport mode, SpecularBranch out[4]) const {
   const bool front = glm::dot(wo, ng_) > 0.0f;
   const vec3 ng = front ? ng_ : -ng_;  // normals on wo's side
   const vec3 ns = front ? ns_ : -ns_;
   const float cos_i = std::fabs(glm::dot(wo, ns));
-  vec3 mirror(0.0f);
-  if (smooth_ && reflect_ > 0.0f) {
-    // The mirror limit of the GGX lobes (h = n): appendix B's Fresnel terms at cos_i.
-    const float mu = brdf_.metallic;
-    mirror =
-        reflect_ * ((1.0f - mu) * brdf_.layer_fresnel(cos_i) + mu * brdf_.metal_fresnel(cos_i));
-  }
+  const vec3 mirror = smooth_mirror(cos_i);
   if (glass_ <= 0.0f || rough_glass_) {  // rough glass is not a delta branch
     if (!(max_component(mirror) > 0.0f)) return 0;
     out[0] = {reflect_checked(wo, ns, ng), mirror};
@@ -796,12 +797,7 @@ int Bsdf::dispersive_branches(const vec3& wo, Transport mode, SpecularBranch out
   const bool front = glm::dot(wo, ng_) > 0.0f;
   const vec3 ng = front ? ng_ : -ng_, ns = front ? ns_ : -ns_;
   const float cos_i = std::fabs(glm::dot(wo, ns));
-  vec3 mirror(0.0f);
-  if (smooth_ && reflect_ > 0.0f) {
-    const float mu = brdf_.metallic;
-    mirror =
-        reflect_ * ((1.0f - mu) * brdf_.layer_fresnel(cos_i) + mu * brdf_.metal_fresnel(cos_i));
-  }
+  const vec3 mirror = smooth_mirror(cos_i);
   const bool film = brdf_.iridescence > 0.0f && front;
   const vec3 film_f =
       film ? iridescent_fresnel(1.0f, brdf_.iridescence_ior, vec3(dielectric_f0(brdf_.ior)),

@@ -81,6 +81,23 @@ std::vector<float> render(Scene scene, const RenderOptions& o, uint64_t passes =
   return img.radiance;
 }
 
+// The mean of one channel over an image's pixels and its standard error: for images whose
+// pixels are independent samples of one value (a tiny field of view on a uniform scene).
+struct PixelMean {
+  double mean, se;
+};
+PixelMean pixel_mean(const std::vector<float>& image, int channel) {
+  const size_t n = image.size() / 3;
+  double sum = 0.0, sum2 = 0.0;
+  for (size_t p = 0; p < n; ++p) {
+    const double v = image[3 * p + size_t(channel)];
+    sum += v;
+    sum2 += v * v;
+  }
+  const double mean = sum / double(n);
+  return {mean, std::sqrt(std::max(0.0, sum2 / double(n) - mean * mean) / double(n - 1))};
+}
+
 Material emitter(vec3 le, bool double_sided = false) {
   Material m = Material::lambertian(vec3(0.0f));
   m.emission = le;
@@ -218,14 +235,9 @@ TEST(MaterialRender, ADispersiveSlabTransmitsEachChannelByItsOwnIndex) {
   EXPECT_GT(std::fabs(want[2] - want[0]), 0.01);  // the channels' Fresnel terms differ
   const std::vector<float> sppm = render(b.done(), options(16, Method::SPPM), 256);
   for (int ch = 0; ch < 3; ++ch) {
-    double sum = 0.0, sum2 = 0.0;
-    for (size_t p = 0; p < 256; ++p) {
-      sum += sppm[3 * p + size_t(ch)];
-      sum2 += double(sppm[3 * p + size_t(ch)]) * sppm[3 * p + size_t(ch)];
-    }
-    const double mean = sum / 256.0, se = std::sqrt((sum2 / 256.0 - mean * mean) / 255.0);
-    EXPECT_GT(se, 0.0);
-    EXPECT_NEAR(mean, want[ch], 4.0 * se) << "channel " << ch;
+    const PixelMean m = pixel_mean(sppm, ch);
+    EXPECT_GT(m.se, 0.0);
+    EXPECT_NEAR(m.mean, want[ch], 4.0 * m.se) << "channel " << ch;
   }
 }
 
@@ -268,14 +280,9 @@ TEST(MaterialRender, ARoughThinSheetTransmitsItsBlurredLobe) {
     const std::vector<float> ppm = render(b.done(), options(1));
     const double smooth = 1.0 - (0.04 + 0.96 * std::pow(1.0 - zo, 5.0));
     for (int ch = 0; ch < 3; ++ch) {
-      double sum = 0.0, sum2 = 0.0;
-      for (size_t p = 0; p < 256; ++p) {
-        sum += sppm[3 * p + size_t(ch)];
-        sum2 += double(sppm[3 * p + size_t(ch)]) * sppm[3 * p + size_t(ch)];
-      }
-      const double mean = sum / 256.0, se = std::sqrt((sum2 / 256.0 - mean * mean) / 255.0);
+      const PixelMean m = pixel_mean(sppm, ch);
       const double want = sheet.base_color[ch] * lobe;
-      EXPECT_NEAR(mean, want, 4.0 * se + 0.005 * want) << roughness << " channel " << ch;
+      EXPECT_NEAR(m.mean, want, 4.0 * m.se + 0.005 * want) << roughness << " channel " << ch;
       EXPECT_NEAR(ppm[size_t(ch)], sheet.base_color[ch] * smooth, 2e-6) << "channel " << ch;
     }
     // Single scattering loses some (at roughness 0.5, lobe = 0.905 smooth).

@@ -232,6 +232,7 @@ class Bsdf {
   bool sample_non_delta(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const;
   bool sample_base(const vec3& wo, Rng& rng, BsdfSample& out) const;  // the uncoated part
   int base_branches(const vec3& wo, Transport mode, SpecularBranch out[4]) const;
+  vec3 smooth_mirror(float cos_i) const;  // the reflecting parts' mirror weight (0 unless smooth)
   int dispersive_branches(const vec3& wo, Transport mode, SpecularBranch out[4]) const;
   // The clear coat (no coat: k = 0). k at the view v; the coat lobe's D V about n_c on wo's side
   // and its sampling density; the non-delta f with the view v and its mixture density.
