@@ -90,6 +90,8 @@ BsdfParams BsdfParams::of(const Material& m) {
   p.iridescence_ior = m.iridescence_ior;
   p.iridescence_thickness = m.iridescence_thickness_maximum;  // the texture's 1 (none: 1)
   p.dispersion = m.dispersion;
+  p.diffuse_transmission = m.diffuse_transmission;
+  p.diffuse_transmission_color = m.diffuse_transmission_color;
   return p;
 }
 
@@ -108,8 +110,9 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
   const float m = std::clamp(p.metallic, 0.0f, 1.0f), t = std::clamp(p.transmission, 0.0f, 1.0f);
   const float coat = std::clamp(p.clearcoat, 0.0f, 1.0f);
   const float sheen = max_component(p.sheen_color);
+  const float dt = p.follows_transmission ? std::clamp(p.diffuse_transmission, 0.0f, 1.0f) : 0.0f;
   if (m == 0.0f && t == 0.0f && p.specular == 0.0f && coat == 0.0f && !(sheen > 0.0f) &&
-      brdf_.iridescence == 0.0f) {
+      brdf_.iridescence == 0.0f && dt == 0.0f) {
     brdf_.metallic = 0.0f;
     reflect_ = 1.0f;
     return;  // kind_ Lambertian
@@ -121,12 +124,20 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
   // mirror's, unless it is asked to be smooth (PPM). A volume of index 1 does not refract at any
   // microfacet: its transmission is straight through, a delta branch (Walter's half vector
   // eta wi + wo vanishes there).
-  rough_glass_ = glass_ > 0.0f && p.rough_transmission && !(p.roughness < mirror_roughness) &&
+  rough_glass_ = glass_ > 0.0f && p.follows_transmission && !(p.roughness < mirror_roughness) &&
                  (p.thin || std::fabs(p.ior - 1.0f) > 1e-4f);
   // KHR_materials_dispersion changes only a smooth volume's refraction.
   if (!p.thin && glass_ > 0.0f && p.dispersion > 0.0f && !rough_glass_) dispersion_ = p.dispersion;
   reflect_ = m + (1.0f - m) * (1.0f - t);
   brdf_.metallic = reflect_ > 0.0f ? m / reflect_ : 0.0f;
+  // KHR_materials_diffuse_transmission: the opaque dielectric's diffuse base becomes
+  // mix(diffuse_brdf(baseColor), diffuse_btdf(colour), dt); the BTDF is a component of its own
+  // (bsdf_glass.cpp), the BRDF keeps 1 - dt.
+  if (dt > 0.0f && reflect_ * (1.0f - brdf_.metallic) > 0.0f) {
+    dt_ = dt;
+    dt_color_ = glm::clamp(p.diffuse_transmission_color, vec3(0.0f), vec3(1.0f));
+    brdf_.diffuse_weight = 1.0f - dt;
+  }
   if (p.anisotropy > 0.0f) {  // KHR_materials_anisotropy: the direction in ns's tangent plane
     const vec3 d = p.anisotropy_direction - glm::dot(p.anisotropy_direction, ns) * ns;
     const float len = glm::length(d);
@@ -208,7 +219,7 @@ vec3 Bsdf::diffuse_term(const vec3& wo, const vec3& wi) const {
   const float v_h = 0.5f * (glm::dot(wo, h) + glm::dot(wi, h));
   const vec3 fr = brdf_.layer_fresnel(v_h);
   const float opaque = reflect_ * (1.0f - brdf_.metallic);
-  return (opaque * (1.0f - max_component(fr)) / kPi) * brdf_.base_color;
+  return (opaque * (1.0f - max_component(fr)) / kPi) * (brdf_.base_color * brdf_.diffuse_weight);
 }
 
 vec3 Bsdf::eval(const vec3& wo, const vec3& wi) const {
@@ -271,9 +282,10 @@ void Bsdf::term_albedos(const vec3& wo, float a[kTerms]) const {
   const float sm = sheen_max();
   const float e = sm > 0.0f ? sm * sheen_albedo(cos_o, sheen_roughness_) : 0.0f;
   const float under = (1.0f - k) * std::max(0.0f, 1.0f - e) * reflect_;
-  a[0] = t.diffuse
-             ? std::max(under * (1.0f - mu) * (1.0f - f0) * max_component(brdf_.base_color), 1e-3f)
-             : 0.0f;
+  a[0] = t.diffuse ? std::max(under * (1.0f - mu) * (1.0f - f0) * brdf_.diffuse_weight *
+                                  max_component(brdf_.base_color),
+                              1e-3f)
+                   : 0.0f;
   a[1] = t.lobe ? std::max(under * ((1.0f - mu) * (f0 + (brdf_.dielectric_f90() - f0) *
                                                             schlick_weight(cos_o)) +
                                     mu * max_component(schlick_fresnel(brdf_.base_color, cos_o))),
@@ -451,7 +463,8 @@ float Bsdf::non_delta_albedo(float cos_o) const {
   // (1 - f0) max(base) and, for glossy lobes, Schlick's Fresnel at the macro normal. The floor
   // keeps the part's probability above 0 wherever it may reflect.
   const float mu = brdf_.metallic, f0 = max_component(brdf_.dielectric_f0());
-  const float diffuse = (1.0f - mu) * (1.0f - f0) * max_component(brdf_.base_color);
+  const float diffuse =
+      (1.0f - mu) * (1.0f - f0) * brdf_.diffuse_weight * max_component(brdf_.base_color);
   float a = part_ == Part::Lobe ? 0.0f : diffuse;
   if (!smooth_ && part_ != Part::Base)
     a += (1.0f - mu) * (f0 + (brdf_.dielectric_f90() - f0) * schlick_weight(cos_o)) +
@@ -473,25 +486,31 @@ float Bsdf::delta_probability(const vec3& wo) const {
     wn = a[0] + a[1] + a[2] + a[3];
   }
   if (glass_in_part()) wn += glass_albedo(wo);
+  if (dt_in_part()) wn += dt_albedo(wo);
   return wd > 0.0f ? wd / (wd + wn) : 0.0f;
 }
 
 bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out,
                   const vec3& tint) const {
-  if (glass_in_part()) {
-    // Rough glass or the rest of this part, by their albedo estimates, each divided by its
-    // probability (an unbiased choice of one component of a sum).
-    const float ag = glass_albedo(wo), ar = rest_albedo(wo);
-    const float pg = ag / (ag + ar);
-    if (pg >= 1.0f || rng.next_float() < pg) {
-      if (!sample_glass(wo, rng, mode, out)) return false;
-      out.weight /= pg;
-      out.pdf *= pg;
-      return true;
+  if (transmits()) {
+    // Rough glass, diffuse transmission or the rest of this part, by their albedo estimates,
+    // each divided by its probability (an unbiased choice of one component of a sum).
+    const float a[3] = {glass_in_part() ? glass_albedo(wo) : 0.0f,
+                        dt_in_part() ? dt_albedo(wo) : 0.0f, rest_albedo(wo)};
+    const float sum = a[0] + a[1] + a[2];
+    int pick = a[0] > 0.0f ? 0 : 1;
+    if (a[pick] < sum) {  // more than one: draw
+      const float u = rng.next_float() * sum;
+      pick = u < a[0] ? 0 : u < a[0] + a[1] ? 1 : 2;
+      while (!(a[pick] > 0.0f)) --pick;  // rounding past the last one there is
     }
-    if (!sample_rest(wo, rng, mode, out, tint)) return false;
-    out.weight /= 1.0f - pg;
-    out.pdf *= 1.0f - pg;
+    const float p = a[pick] / sum;
+    const bool drawn = pick == 0   ? sample_glass(wo, rng, mode, out)
+                       : pick == 1 ? sample_dt(wo, rng, mode, out)
+                                   : sample_rest(wo, rng, mode, out, tint);
+    if (!drawn) return false;
+    out.weight /= p;
+    out.pdf *= p;
     return true;
   }
   return sample_rest(wo, rng, mode, out, tint);
@@ -510,7 +529,10 @@ float Bsdf::rest_albedo(const vec3& wo) const {
     term_albedos(wo, t);
     return a + t[0] + t[1] + t[2] + t[3];
   }
-  if (base_non_delta_ && (part_ == Part::All || follow_lobe_))
+  // (A diffuse base that transmits all, without a layer or metal, reflects nothing to draw.)
+  const bool reflects =
+      brdf_.diffuse_weight > 0.0f || brdf_.specular > 0.0f || brdf_.metallic > 0.0f;
+  if (base_non_delta_ && reflects && (part_ == Part::All || follow_lobe_))
     a += non_delta_albedo(std::fabs(glm::dot(wo, ns_)));
   return a;
 }
@@ -830,7 +852,7 @@ int Bsdf::dispersive_branches(const vec3& wo, Transport mode, SpecularBranch out
 }
 
 bool Bsdf::has_lobe_below(float below) const {
-  if (rough_glass_ && part_ == Part::All) return true;  // always followed
+  if ((rough_glass_ || dt_ > 0.0f) && part_ == Part::All) return true;  // always followed
   if (layered())
     return kind_ == Kind::Layered && part_ == Part::All &&
            (follows_lobe(below) || follows_coat(below));
@@ -842,7 +864,7 @@ bool Bsdf::has_lobe_below(float below) const {
 bool Bsdf::follows_lobe(float below) const {
   // With rough glass, followed anyway, the base's lobe is followed too: a part then always
   // splits as the lobes and the diffuse base.
-  return base_non_delta_ && !smooth_ && (lobe_roughness() < below || rough_glass_) &&
+  return base_non_delta_ && !smooth_ && (lobe_roughness() < below || rough_glass_ || dt_ > 0.0f) &&
          (brdf_.metallic > 0.0f || brdf_.specular > 0.0f);
 }
 
@@ -856,7 +878,9 @@ float Bsdf::lobe_roughness() const {
 bool Bsdf::follows_coat(float below) const { return coat_lobe() && coat_roughness_ < below; }
 
 float Bsdf::lobe_probability(const vec3& wo, float below) const {
-  const float glass = rough_glass_ ? glass_albedo(wo) : 0.0f;  // followed, always
+  // Rough glass and diffuse transmission are followed, always.
+  const float glass =
+      (rough_glass_ ? glass_albedo(wo) : 0.0f) + (dt_ > 0.0f ? dt_albedo(wo) : 0.0f);
   if (layered()) {  // the followed terms' share of the albedo estimates
     float all[kTerms], lobe[kTerms];
     term_albedos(wo, all);
@@ -870,7 +894,7 @@ float Bsdf::lobe_probability(const vec3& wo, float below) const {
   }
   // specular_probability reads only the cosine of wo with the shading normal.
   const float share = brdf_.specular_probability(vec3(0.0f, 0.0f, std::fabs(glm::dot(wo, ns_))));
-  if (!rough_glass_) return share;
+  if (!rough_glass_ && !(dt_ > 0.0f)) return share;
   const float rest = base_non_delta_ ? non_delta_albedo(std::fabs(glm::dot(wo, ns_))) : 0.0f;
   const float lobe = follows_lobe(below) ? share * rest : 0.0f;
   return std::min(1.0f, (glass + lobe) / (glass + rest));

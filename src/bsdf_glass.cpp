@@ -1,3 +1,6 @@
+// What passes through a surface as a non-delta component: rough glass and diffuse transmission
+// (KHR_materials_diffuse_transmission, below).
+//
 // Rough glass: KHR_materials_transmission's transmitting part, (1 - metallic) transmission, at a
 // roughness at or above --mirror-roughness (at a smaller one it is the smooth glass of
 // base_branches). glTF writes it fresnel_mix(layer = specular_brdf(alpha), base =
@@ -116,9 +119,61 @@ Bsdf Bsdf::without_glass() const {
   return b;
 }
 
-vec3 Bsdf::eval_transmission(const vec3& wo, const vec3& wi) const {
-  if (!glass_in_part() || glm::dot(wo, ng_) * glm::dot(wi, ng_) >= 0.0f) return vec3(0.0f);
-  return eval_glass(wo, wi, wo, Transport::Radiance, nullptr);
+vec3 Bsdf::eval_transmission(const vec3& wo, const vec3& wi, bool glass) const {
+  if (glm::dot(wo, ng_) * glm::dot(wi, ng_) >= 0.0f) return vec3(0.0f);
+  vec3 f =
+      glass && glass_in_part() ? eval_glass(wo, wi, wo, Transport::Radiance, nullptr) : vec3(0.0f);
+  if (dt_in_part()) {
+    const LocalFrame fr(glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_);
+    const vec3 lo = fr.local(wo), li = fr.local(wi);
+    f += dt_f(lo, li) * (sheen_scaling(lo.z, li.z) * (1.0f - coat_weight(wo)));
+  }
+  return f;
+}
+
+// KHR_materials_diffuse_transmission's diffuse_btdf(colour) x dt inside fresnel_mix: the
+// dielectric layer's weight 1 - max F at the half vector of wo and wi mirrored through the
+// surface (v.h averaged over both, as the diffuse base's, diffuse_term), over the opaque
+// dielectric's share; a Lambertian BTDF, the same both ways (photons need no adjoint).
+vec3 Bsdf::dt_f(const vec3& lo, const vec3& li) const {
+  if (!(lo.z > 0.0f) || !(li.z < 0.0f)) return vec3(0.0f);
+  const vec3 lr(li.x, li.y, -li.z);
+  const vec3 h = glm::normalize(lo + lr);
+  const vec3 fr = brdf_.layer_fresnel(0.5f * (glm::dot(lo, h) + glm::dot(lr, h)));
+  const float opaque = reflect_ * (1.0f - brdf_.metallic);
+  return (opaque * dt_ * (1.0f - max_component(fr)) / kPi) * dt_color_;
+}
+
+bool Bsdf::sample_dt(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const {
+  const bool front = glm::dot(wo, ng_) > 0.0f;
+  const vec3 ng = front ? ng_ : -ng_;
+  const LocalFrame fr(front ? ns_ : -ns_);
+  const vec3 lo = fr.local(wo);
+  if (!(lo.z > 0.0f)) return false;
+  const float u2 = rng.next_float(), u1 = rng.next_float();
+  const vec3 wi = sample_cosine_hemisphere(-fr.n, u1, u2);  // the other side
+  if (!(glm::dot(wi, ng) < 0.0f)) return false;             // not through the true surface
+  const vec3 li = fr.local(wi);
+  const float layer =
+      sheen_scaling(lo.z, li.z) * (1.0f - coat_weight(mode == Transport::Radiance ? wo : wi));
+  const float p = -li.z / kPi;
+  if (!(p > 0.0f)) return false;
+  out.wi = wi;
+  out.weight = dt_f(lo, li) * (layer * kPi);  // f |cos| / (|cos| / pi)
+  out.pdf = p;
+  out.delta = false;
+  out.glass = false;
+  return max_component(out.weight) > 0.0f;
+}
+
+float Bsdf::dt_albedo(const vec3& wo) const {
+  const float c = std::fabs(glm::dot(wo, ns_));
+  const float f0 = max_component(brdf_.dielectric_f0());
+  const float sm = sheen_max();
+  const float sheen =
+      sm > 0.0f ? std::max(0.0f, 1.0f - sm * sheen_albedo(c, sheen_roughness_)) : 1.0f;
+  const float a = reflect_ * (1.0f - brdf_.metallic) * dt_ * (1.0f - f0) * max_component(dt_color_);
+  return std::max(a * sheen * (1.0f - coat_weight(wo)), 1e-3f * dt_);
 }
 
 bool Bsdf::sample_glass(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const {

@@ -94,7 +94,9 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
           point.f = w;
           if (in.next_event) {
             emission += direct_light(in.world, point, &whole, rng);
-            if (glass_direct) emission += direct_light_through(in.world, s, wo, w, rng);
+            // Through the surface: diffuse transmission, and rough glass when broad.
+            if (glass_direct || s.bsdf.transmits_diffusely())
+              emission += direct_light_through(in.world, s, wo, w, glass_direct, rng);
           }
           const float p_lobe = s.bsdf.lobe_probability(wo, in.follow_roughness);
           if (p_lobe >= 1.0f || (p_lobe > 0.0f && rng.next_float() < p_lobe)) {

@@ -41,7 +41,8 @@ bool uses_set(const Material& m, int set) {
         &m.emissive_texture, &m.transmission_texture, &m.specular_texture,
         &m.specular_color_texture, &m.clearcoat_texture, &m.clearcoat_roughness_texture,
         &m.clearcoat_normal_texture, &m.sheen_color_texture, &m.sheen_roughness_texture,
-        &m.specular_glossiness_texture})
+        &m.specular_glossiness_texture, &m.diffuse_transmission_texture,
+        &m.diffuse_transmission_color_texture})
     if (t->present() && t->texcoord == set) return true;
   return false;
 }

@@ -169,7 +169,7 @@ void Loader::check_extensions() {
       "KHR_draco_mesh_compression", "EXT_meshopt_compression",
       "KHR_mesh_quantization",      "KHR_texture_transform",
       "KHR_texture_basisu",         "EXT_texture_webp",
-      "EXT_mesh_gpu_instancing"};
+      "EXT_mesh_gpu_instancing",    "KHR_materials_diffuse_transmission"};
   // What changes nothing photonbound draws, so that leaving it out is exact: metadata, the
   // material variants' default (what a viewer shows first), and MSFT_lod's base node (the
   // finest level of detail).
@@ -183,8 +183,6 @@ void Loader::check_extensions() {
     if (e == "KHR_materials_unlit")
       return ": its materials are lit (light is simulated, not painted on), by their "
              "metallic-roughness factors";
-    if (e == "KHR_materials_diffuse_transmission")
-      return ": what its materials would transmit diffusely is reflected";
     return "";
   };
   for (const std::string& e : m_.extensionsRequired)

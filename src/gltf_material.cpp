@@ -179,6 +179,19 @@ Material Loader::convert_material(size_t index) {  // the rules are in the comme
   out.dispersion = float(dispersion);
   if (out.dispersion > 0.0f && out.thin)
     warn(ml + ": dispersion without KHR_materials_volume (thin-walled) has no effect");
+  // KHR_materials_diffuse_transmission: the opaque dielectric's diffuse base transmits the share
+  // diffuseTransmissionFactor x the texture's A through the surface, as a Lambertian BTDF of
+  // diffuseTransmissionColorFactor x the colour texture (sRGB) (Bsdf).
+  const char* dtx = "KHR_materials_diffuse_transmission";
+  out.diffuse_transmission =
+      unit(ext_number(ext, ml, dtx, "diffuseTransmissionFactor", 0.0), "diffuseTransmissionFactor");
+  out.diffuse_transmission_color =
+      ext_color(ext, ml, dtx, "diffuseTransmissionColorFactor", 1.0).value_or(vec3(1.0f));
+  out.diffuse_transmission_texture = ext_texture(ext, ml, dtx, "diffuseTransmissionTexture");
+  out.diffuse_transmission_color_texture =
+      ext_texture(ext, ml, dtx, "diffuseTransmissionColorTexture");
+  if (out.diffuse_transmission == 0.0f)  // the factor multiplies the texture: 0 is none
+    out.diffuse_transmission_texture = out.diffuse_transmission_color_texture = TextureRef{};
   // KHR_materials_iridescence: a thin film whose Fresnel term (thin_film.h) is mixed into the
   // layers' by iridescenceFactor x the texture's R, of thickness mix(minimum, maximum, the
   // thickness texture's G) nanometres (the maximum without the texture).

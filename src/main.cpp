@@ -100,12 +100,12 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   pb::Renderer renderer(std::move(scene), options);
   if (saved) renderer.restore(saved->render);
   // PPM's points are fixed, so it cannot follow a rough lobe through a surface (bsdf.h).
-  if (const std::string glass = renderer.world().rough_glass_names();
+  if (const std::string glass = renderer.world().followed_transmission_names();
       !glass.empty() && options.method == pb::Method::PPM)
     std::cerr << "photonbound: warning: " << options.scene << ": " << glass
-              << ": rough transmission is rendered as smooth glass by --method ppm (its fixed "
-                 "points cannot follow a rough lobe through a surface); --method sppm renders "
-                 "it rough\n";
+              << ": rough and diffuse transmission are rendered by --method ppm as smooth glass "
+                 "and as diffuse reflection (its fixed points cannot follow a path through a "
+                 "surface); --method sppm renders them\n";
   // Which materials the mirror threshold turns into perfect mirrors (a choice, not a flaw).
   if (const std::string note = renderer.world().mirror_note();
       !note.empty() && options.progress != pb::ProgressMode::Never)

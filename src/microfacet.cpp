@@ -216,7 +216,8 @@ vec3 eval_and_pdf(const MetalRoughBrdf& m, const vec3& wo, const vec3& wi, float
   }
   // glTF appendix B "Metal BRDF and Dielectric BRDF", the full code, with KHR_materials_specular's
   // RGB Fresnel term (the diffuse base keeps 1 - its largest channel).
-  const vec3 dielectric = (1.0f - max_component(fr)) * m.base_color / kPi + fr * specular;
+  const vec3 diffuse = m.base_color * m.diffuse_weight;
+  const vec3 dielectric = (1.0f - max_component(fr)) * diffuse / kPi + fr * specular;
   const vec3 metal = fm * specular;
   if (pdf) {
     const float ps = m.specular_probability(wo);
@@ -226,7 +227,7 @@ vec3 eval_and_pdf(const MetalRoughBrdf& m, const vec3& wo, const vec3& wi, float
     *pdf = ps * spec_pdf + (1.0f - ps) * wi.z / kPi;
   }
   if (parts) {
-    parts[0] = (1.0f - m.metallic) * ((1.0f - max_component(fr)) * m.base_color / kPi);
+    parts[0] = (1.0f - m.metallic) * ((1.0f - max_component(fr)) * diffuse / kPi);
     parts[1] = (1.0f - m.metallic) * (fr * specular) + m.metallic * metal;
   }
   return (1.0f - m.metallic) * dielectric + m.metallic * metal;
@@ -310,7 +311,7 @@ float MetalRoughBrdf::specular_probability(const vec3& wo) const {
   const float f90 = dielectric_f90();
   const float s = (1.0f - metallic) * (f0 + (f90 - f0) * schlick_weight(wo.z)) +
                   metallic * max_component(schlick_fresnel(base_color, wo.z));
-  const float d = (1.0f - metallic) * (1.0f - f0) * max_component(base_color);
+  const float d = (1.0f - metallic) * (1.0f - f0) * diffuse_weight * max_component(base_color);
   return s + d > 0.0f ? s / (s + d) : 1.0f;
 }
 

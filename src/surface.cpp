@@ -77,7 +77,7 @@ Surface World::surface(const Hit& hit) const {
   s.material = &m;
   if (!mesh.textured) {
     BsdfParams p = BsdfParams::of(m);
-    p.rough_transmission = rough_transmission_;
+    p.follows_transmission = follows_transmission_;
     s.bsdf = Bsdf(p, s.ng, s.ns, mirror_roughness_);
     return s;
   }
@@ -89,7 +89,7 @@ Surface World::surface(const Hit& hit) const {
   // are sRGB, the others linear; metalness in B, roughness in G.
   const std::span<const Image> images = scene_.images;
   BsdfParams p = BsdfParams::of(m);
-  p.rough_transmission = rough_transmission_;
+  p.follows_transmission = follows_transmission_;
   p.base_color *= vec3(lookup(images, m.base_color_texture, s.uv, true));
   if (mesh.colors)  // COLOR_0 multiplies the base colour (glTF 2.0 "Metallic-Roughness Material")
     p.base_color *= vec3(w * mesh.colors[i0] + hit.u * mesh.colors[i1] + hit.v * mesh.colors[i2]);
@@ -106,6 +106,11 @@ Surface World::surface(const Hit& hit) const {
     p.roughness = 1.0f - m.sg_glossiness * sg.w;
   }
   p.transmission *= lookup(images, m.transmission_texture, s.uv, false).x;
+  if (p.diffuse_transmission > 0.0f) {  // KHR_materials_diffuse_transmission: A; colour sRGB
+    p.diffuse_transmission *= lookup(images, m.diffuse_transmission_texture, s.uv, false).w;
+    p.diffuse_transmission_color *=
+        vec3(lookup(images, m.diffuse_transmission_color_texture, s.uv, true));
+  }
   p.specular *= lookup(images, m.specular_texture, s.uv, false).w;
   p.specular_color *= vec3(lookup(images, m.specular_color_texture, s.uv, true));
   if (p.clearcoat > 0.0f) {  // KHR_materials_clearcoat: clearcoat x R, roughness x G
@@ -153,7 +158,7 @@ bool World::may_hold_points(const Material& m) const {
   if (m.anisotropy > 0.0f) return true;  // a mirror's roughness with anisotropy is a lobe
   const vec3 n(0.0f, 0.0f, 1.0f);
   BsdfParams p = BsdfParams::of(m);
-  p.rough_transmission = rough_transmission_;
+  p.follows_transmission = follows_transmission_;
   return !Bsdf(p, n, n, mirror_roughness_).is_delta();
 }
 
@@ -193,7 +198,7 @@ std::string World::mirror_note() const {
          threshold + " (--mirror-roughness) is rendered as a perfect mirror";
 }
 
-std::string World::rough_glass_names() const {
+std::string World::followed_transmission_names() const {
   std::string names;
   size_t count = 0;
   for (const Material& m : scene_.materials) {
@@ -201,8 +206,8 @@ std::string World::rough_glass_names() const {
     const bool rough = !(m.roughness < mirror_roughness_) ||
                        m.metallic_roughness_texture.present() ||
                        m.specular_glossiness_texture.present();
-    if (!transmits || !rough || !(m.metallic < 1.0f || m.metallic_roughness_texture.present()))
-      continue;
+    const bool dielectric = m.metallic < 1.0f || m.metallic_roughness_texture.present();
+    if (!((transmits && rough) || m.diffuse_transmission > 0.0f) || !dielectric) continue;
     if (++count <= 4) names += std::string(names.empty() ? "" : ", ") + "'" + m.name + "'";
   }
   if (count == 0) return "";

@@ -6,13 +6,13 @@
 
 namespace pb {
 
-World::World(Scene scene, float mirror_roughness, bool rough_transmission)
+World::World(Scene scene, float mirror_roughness, bool follows_transmission)
     : scene_(std::move(scene)),
       accel_(scene_),
       lights_(scene_),
       scene_size_(std::max(scene_.bounds.diagonal(), 1e-30f)),
       mirror_roughness_(mirror_roughness),
-      rough_transmission_(rough_transmission) {
+      follows_transmission_(follows_transmission) {
   size_t triangles = 0;
   for (const Mesh& m : scene_.meshes) triangles += m.indices.size() / 3;
   face_normals_.resize(triangles);
@@ -35,7 +35,8 @@ World::World(Scene scene, float mirror_roughness, bool rough_transmission)
         mat.sheen_color_texture.present() || mat.sheen_roughness_texture.present() ||
         (mat.anisotropy > 0.0f && !m.tangents.empty()) ||  // the direction needs the tangents
         mat.iridescence_texture.present() || mat.iridescence_thickness_texture.present() ||
-        mat.specular_glossiness_texture.present() || !m.colors.empty();
+        mat.specular_glossiness_texture.present() || mat.diffuse_transmission_texture.present() ||
+        mat.diffuse_transmission_color_texture.present() || !m.colors.empty();
     auto uv = [&](int set) { return m.texcoords[set].empty() ? nullptr : m.texcoords[set].data(); };
     first_triangle_.push_back(uint32_t(first));
     meshes_.push_back({m.positions.data(),

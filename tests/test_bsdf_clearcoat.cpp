@@ -37,7 +37,7 @@ BsdfParams coated(vec3 base, float metallic, float roughness, float coat, float 
   p.transmission = transmission;
   p.clearcoat = coat;
   p.clearcoat_roughness = coat_roughness;
-  p.rough_transmission = false;  // smooth glass under the coat (rough: test_bsdf_rough_glass.cpp)
+  p.follows_transmission = false;  // smooth glass under the coat (rough: test_bsdf_rough_glass.cpp)
   return p;
 }
 

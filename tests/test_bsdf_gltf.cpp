@@ -40,7 +40,7 @@ BsdfParams params(vec3 base, float metallic, float roughness, float transmission
   p.specular = specular;
   // Transmission here is the smooth glass beside a glossy reflection (PPM's; SPPM's rough glass
   // has its own tests, test_bsdf_rough_glass.cpp).
-  p.rough_transmission = false;
+  p.follows_transmission = false;
   return p;
 }
 

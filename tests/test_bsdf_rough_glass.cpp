@@ -222,7 +222,7 @@ TEST(RoughGlass, AWhiteThinWallReflectsAndTransmitsTheWholeWhiteLobe) {
 TEST(RoughGlass, FollowedAlwaysAndNeverADeltaBranch) {
   // SPPM follows rough glass at any --follow-roughness (its transmitted photons are never
   // gathered); its part to follow is all of it here (metallic 0, transmission 1); PPM's smooth
-  // glass (rough_transmission false) is the delta branches it was.
+  // glass (follows_transmission false) is the delta branches it was.
   const vec3 n(0, 0, 1), wo = glm::normalize(vec3(0.3f, 0.0f, 1.0f));
   const Bsdf rough = make(glass(0.4f, false), true);
   EXPECT_TRUE(rough.has_lobe_below(0.0f));
@@ -231,7 +231,7 @@ TEST(RoughGlass, FollowedAlwaysAndNeverADeltaBranch) {
   SpecularBranch br[kMaxDeltaBranches];
   EXPECT_EQ(rough.delta_branches(wo, Transport::Radiance, br), 0);
   BsdfParams smooth = glass(0.4f, false);
-  smooth.rough_transmission = false;
+  smooth.follows_transmission = false;
   const Bsdf ppm(smooth, n, n);
   EXPECT_TRUE(ppm.is_delta());
   EXPECT_EQ(ppm.delta_branches(wo, Transport::Radiance, br), 2);

@@ -393,6 +393,9 @@ TEST_F(LoaderTest, MaterialFactorsOutOfRangeAreRefused) {
        "iridescenceIor 0.8 must be finite and at least 1"},
       {"\"extensions\":{\"KHR_materials_iridescence\":{\"iridescenceThicknessMaximum\":-1}}",
        "iridescenceThicknessMaximum -1 must be finite and at least 0"},
+      {"\"extensions\":{\"KHR_materials_diffuse_transmission\":{"
+       "\"diffuseTransmissionFactor\":1.5}}",
+       "diffuseTransmissionFactor 1.5"},
       {"\"extensions\":{\"KHR_materials_dispersion\":{\"dispersion\":-0.1}}",
        "dispersion -0.1 must be finite and at least 0"},
       {"\"alphaMode\":\"SOMETIMES\"", "unknown alphaMode 'SOMETIMES'"},
@@ -602,6 +605,33 @@ TEST_F(LoaderTest, DispersionIsReadAndIgnoredOnThinWalls) {
   const Scene thin = load(g);
   EXPECT_TRUE(thin.materials[thin.meshes[0].material].thin);
   EXPECT_TRUE(has_warning(thin, "material 'prism': dispersion without KHR_materials_volume"));
+}
+
+TEST_F(LoaderTest, DiffuseTransmissionIsReadWithItsTextures) {
+  // KHR_materials_diffuse_transmission: the factor and colour, the A texture and the sRGB colour
+  // texture; a factor of 0 is none, textures too.
+  const std::vector<unsigned char> png = png_bytes(2, 2, dir_);
+  const std::string images =
+      "\"extensionsUsed\":[\"KHR_materials_diffuse_transmission\"],"
+      "\"images\":[{\"uri\":\"data:image/png;base64," +
+      base64(png) + "\"}],\"textures\":[{\"source\":0}],";
+  const std::string dt =
+      "\"extensions\":{\"KHR_materials_diffuse_transmission\":{"
+      "\"diffuseTransmissionFactor\":0.25,\"diffuseTransmissionColorFactor\":[1,0.5,0.25],"
+      "\"diffuseTransmissionTexture\":{\"index\":0},"
+      "\"diffuseTransmissionColorTexture\":{\"index\":0,\"texCoord\":1}}}";
+  const Scene s = load(textured(images, dt));
+  const pb::Material& m = s.materials[s.meshes[0].material];
+  EXPECT_EQ(m.diffuse_transmission, 0.25f);
+  expect_vec(m.diffuse_transmission_color, vec3(1, 0.5f, 0.25f));
+  EXPECT_TRUE(m.diffuse_transmission_texture.present());
+  EXPECT_EQ(m.diffuse_transmission_color_texture.texcoord, 1);
+  EXPECT_TRUE(s.warnings.empty()) << s.warnings[0];
+  const Scene off = load(textured(images, std::string(dt).replace(dt.find("0.25"), 4, "0")));
+  const pb::Material& o = off.materials[off.meshes[0].material];
+  EXPECT_EQ(o.diffuse_transmission, 0.0f);
+  EXPECT_FALSE(o.diffuse_transmission_texture.present() ||
+               o.diffuse_transmission_color_texture.present());
 }
 
 TEST_F(LoaderTest, SheenIsReadWithItsTextures) {

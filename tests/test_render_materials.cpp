@@ -290,7 +290,31 @@ TEST(MaterialRender, ARoughThinSheetTransmitsItsBlurredLobe) {
   }
 }
 
-TEST(MaterialRender, RoughGlassIsNamedForPpmsWarning) {
+TEST(MaterialRender, ADiffuselyTransmittingSheetPassesItsColour) {
+  // KHR_materials_diffuse_transmission 1 without a specular layer: f = colour / pi through the
+  // sheet, so in front of an emitter of radiance 1 that fills everything behind it the camera
+  // sees the colour exactly, whatever the angle. SPPM follows the sheet and samples the emitter
+  // through it (next-event): its 16 x 16 pixels are samples of the colour after 128 passes,
+  // within 4 standard errors. PPM's fixed points cannot follow it: the sheet is then a plain
+  // diffuse reflector whose lit side faces away, 0 exactly.
+  SceneBuilder b;
+  Material sheet = Material::lambertian(vec3(0.5f));
+  sheet.diffuse_transmission = 1.0f;
+  sheet.diffuse_transmission_color = vec3(0.8f, 0.6f, 0.4f);
+  sheet.double_sided = true;
+  b.quad(vec3(0), vec3(50, 0, 0), vec3(0, 50, 0), b.material(sheet));
+  b.quad(vec3(0, 0, -1), vec3(1000, 0, 0), vec3(0, 1000, 0), b.material(emitter(vec3(1.0f))));
+  b.camera(vec3(0, 0, 2), vec3(0.4f, 0, -1), vec3(0, 1, 0), 0.005f);
+  const std::vector<float> sppm = render(b.done(), options(16, Method::SPPM), 128);
+  for (int ch = 0; ch < 3; ++ch) {
+    const PixelMean m = pixel_mean(sppm, ch);
+    EXPECT_NEAR(m.mean, sheet.diffuse_transmission_color[ch], 4.0 * m.se + 1e-6) << ch;
+    EXPECT_GT(m.se, 0.0);
+  }
+  EXPECT_EQ(render(b.done(), options(1)), std::vector<float>(3, 0.0f));
+}
+
+TEST(MaterialRender, TransmissionPpmCannotFollowIsNamed) {
   // The materials PPM renders smooth though rough (main.cpp warns with their names): rough
   // transmission, thin or not, or a roughness texture; not smooth glass, an opaque material,
   // or a metal (which transmits nothing).
@@ -305,12 +329,14 @@ TEST(MaterialRender, RoughGlassIsNamedForPpmsWarning) {
   };
   for (uint32_t m : {named("frosted", 0.5f, 1.0f, 0.0f), named("clear", 0.01f, 1.0f, 0.0f),
                      named("opaque", 0.5f, 0.0f, 0.0f), named("metal", 0.5f, 1.0f, 1.0f),
-                     named("veiled", 0.04f, 0.3f, 0.0f)})
+                     named("veiled", 0.04f, 0.3f, 0.0f), named("leaf", 0.01f, 0.0f, 0.0f)})
     b.quad(vec3(0, 0, -float(m)), vec3(1, 0, 0), vec3(0, 1, 0), m);
   b.quad(vec3(0, 0, 3), vec3(1, 0, 0), vec3(0, -1, 0), b.material(emitter(vec3(1.0f))));
   b.camera(vec3(0, 0, 2), vec3(0, 0, -1), vec3(0, 1, 0), 0.5f);
   const World world(b.done());
-  EXPECT_EQ(world.rough_glass_names(), "materials 'frosted', 'veiled'");
+  b.s.materials[5].diffuse_transmission = 0.5f;  // the leaf transmits diffusely
+  EXPECT_EQ(World(b.done()).followed_transmission_names(), "materials 'frosted', 'veiled', 'leaf'");
+  EXPECT_EQ(world.followed_transmission_names(), "materials 'frosted', 'veiled'");
 }
 
 TEST(MaterialRender, ASmoothClearCoatOverBlackMirrorsByItsViewWeight) {

@@ -90,10 +90,15 @@ struct BsdfParams {
   // KHR_materials_iridescence: the film's weight (0: none), index and thickness in nm.
   float iridescence = 0.0f, iridescence_ior = 1.3f, iridescence_thickness = 400.0f;
   float dispersion = 0.0f;  // KHR_materials_dispersion: 20 / Abbe number (0: none)
+  // KHR_materials_diffuse_transmission: the share of the diffuse base transmitted to the other
+  // side (a Lambertian BTDF), and its colour.
+  float diffuse_transmission = 0.0f;
+  vec3 diffuse_transmission_color{1.0f};
   // A transmitting part of roughness at or above the mirror roughness is rough glass (a GGX
-  // component, bsdf_glass.cpp), or, false, smooth glass as PPM renders it (its fixed points
-  // cannot follow a rough lobe through a surface).
-  bool rough_transmission = true;
+  // component, bsdf_glass.cpp) and diffuse transmission a Lambertian BTDF, both followed by
+  // SPPM's camera paths; or, false, smooth glass and no diffuse transmission (its share
+  // reflected), as PPM renders them (its fixed points cannot follow a path through a surface).
+  bool follows_transmission = true;
   static BsdfParams of(const Material& m);  // the factors alone (no textures)
 };
 
@@ -147,10 +152,14 @@ class Bsdf {
 
   // f(wo, wi) of the non-delta part, without the cosine; 0 for wi on the other side of ng.
   vec3 eval(const vec3& wo, const vec3& wi) const;
-  // Rough glass's transmission f(wo, wi) for radiance (view wo), wi on the other side of ng;
-  // 0 otherwise and without rough glass. Next-event light through the surface (camera paths).
-  vec3 eval_transmission(const vec3& wo, const vec3& wi) const;
+  // What reaches wi on the other side of ng through the surface, f(wo, wi) for radiance (view
+  // wo): diffuse transmission and, with `glass`, rough glass's; 0 on wo's side. Next-event light
+  // through the surface (camera paths).
+  vec3 eval_transmission(const vec3& wo, const vec3& wi, bool glass = true) const;
   bool has_rough_glass() const { return glass_in_part(); }
+  // A part that transmits (rough glass, diffuse transmission): followed by SPPM's paths.
+  bool transmits() const { return glass_in_part() || dt_in_part(); }
+  bool transmits_diffusely() const { return dt_in_part(); }
   // Rough glass broad enough for next-event light (roughness at least kGlassDirectRoughness):
   // camera paths sample lights for it (through the surface too). A sharper one is lit only by
   // what the paths that follow it hit, since a light sample would land in its narrow lobe
@@ -264,6 +273,12 @@ class Bsdf {
   // and the density of sample_glass; its draw; the estimate of its albedo that picks it; that
   // of the rest of this part; and a bound of its reflection's F D V (max_f).
   bool glass_in_part() const { return rough_glass_ && part_ != Part::Base; }
+  // Diffuse transmission (bsdf_glass.cpp), in this part: its f through the surface (local
+  // directions, unlayered), its draw (cosine-weighted on the other side) and albedo estimate.
+  bool dt_in_part() const { return dt_ > 0.0f && part_ != Part::Base; }
+  vec3 dt_f(const vec3& lo, const vec3& li) const;
+  bool sample_dt(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const;
+  float dt_albedo(const vec3& wo) const;
   vec3 glass_fresnel(float cos_h, bool front) const;
   vec3 glass_f(const vec3& lo, const vec3& li, bool front, Transport mode, float* pdf) const;
   vec3 eval_glass(const vec3& wo, const vec3& wi, const vec3& v, Transport mode, float* pdf) const;
@@ -277,6 +292,8 @@ class Bsdf {
   bool has_delta_ = false;  // Layered with a delta part too
   bool thin_ = true;
   bool rough_glass_ = false;     // the transmitting part is a GGX component (bsdf_glass.cpp)
+  float dt_ = 0.0f;              // KHR_materials_diffuse_transmission's share (0: none)
+  vec3 dt_color_{1.0f};          // its colour
   float dispersion_ = 0.0f;      // KHR_materials_dispersion, of a volume (0: none)
   Part part_ = Part::All;        // base_part() and lobe_part()
   bool base_non_delta_ = false;  // the uncoated material has a non-delta part

@@ -146,6 +146,8 @@ struct MetalRoughBrdf {
   float iridescence = 0.0f;
   float iridescence_ior = 1.3f;
   float iridescence_thickness = 400.0f;
+  // KHR_materials_diffuse_transmission: the share of the diffuse base reflected (1 - dt).
+  float diffuse_weight = 1.0f;
 
   // The Fresnel terms of the two layers at cos = v.h: the dielectric's F = f0 + (f90 - f0)
   // (1 - cos)^5 and the metal's Schlick of base_color, each mixed with the iridescent Fresnel

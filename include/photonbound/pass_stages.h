@@ -53,10 +53,10 @@ dvec3 direct_light(const World& world, const MeasurementPoint& point, const Glos
 inline dvec3 direct_light(const World& world, const MeasurementPoint& point, Rng& rng) {
   return direct_light(world, point, nullptr, rng);
 }
-// One light sample through rough glass at s (Bsdf::eval_transmission), seen from wo, from the
-// other side of the surface, times the path weight.
+// One light sample through the surface at s (Bsdf::eval_transmission: diffuse transmission, and
+// rough glass with `glass`), seen from wo, from the other side, times the path weight.
 dvec3 direct_light_through(const World& world, const Surface& s, const vec3& wo, const vec3& weight,
-                           Rng& rng);
+                           bool glass, Rng& rng);
 
 // The glossy side table of a span of points: entries sorted by GlossyPoint::point, which counts
 // from the span's first point at `base` (entries outside the span are skipped).

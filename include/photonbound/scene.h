@@ -45,21 +45,23 @@ struct Material {
   vec3 base_color{1.0f};  // baseColorFactor.rgb, linear
   float alpha = 1.0f;     // baseColorFactor.a
   float metallic = 1.0f, roughness = 1.0f;
-  float ior = 1.5f;                     // KHR_materials_ior
-  float specular = 1.0f;                // KHR_materials_specular specularFactor
-  vec3 specular_color{1.0f};            // KHR_materials_specular specularColorFactor
-  float transmission = 0.0f;            // KHR_materials_transmission transmissionFactor
-  bool thin = true;                     // no KHR_materials_volume (or thicknessFactor 0)
-  float clearcoat = 0.0f;               // KHR_materials_clearcoat clearcoatFactor (0: no coat)
-  float clearcoat_roughness = 0.0f;     // clearcoatRoughnessFactor
-  float clearcoat_normal_scale = 1.0f;  // clearcoatNormalTexture.scale
-  vec3 sheen_color{0.0f};               // KHR_materials_sheen sheenColorFactor (black: none)
-  float sheen_roughness = 0.0f;         // sheenRoughnessFactor
-  float anisotropy = 0.0f;              // KHR_materials_anisotropy anisotropyStrength (0: none)
-  float anisotropy_rotation = 0.0f;     // anisotropyRotation, radians from the tangent to b
-  float dispersion = 0.0f;              // KHR_materials_dispersion (20 / Abbe number; 0: none)
-  float iridescence = 0.0f;             // KHR_materials_iridescence iridescenceFactor (0: none)
-  float iridescence_ior = 1.3f;         // iridescenceIor
+  float ior = 1.5f;                       // KHR_materials_ior
+  float specular = 1.0f;                  // KHR_materials_specular specularFactor
+  vec3 specular_color{1.0f};              // KHR_materials_specular specularColorFactor
+  float transmission = 0.0f;              // KHR_materials_transmission transmissionFactor
+  bool thin = true;                       // no KHR_materials_volume (or thicknessFactor 0)
+  float clearcoat = 0.0f;                 // KHR_materials_clearcoat clearcoatFactor (0: no coat)
+  float clearcoat_roughness = 0.0f;       // clearcoatRoughnessFactor
+  float clearcoat_normal_scale = 1.0f;    // clearcoatNormalTexture.scale
+  vec3 sheen_color{0.0f};                 // KHR_materials_sheen sheenColorFactor (black: none)
+  float sheen_roughness = 0.0f;           // sheenRoughnessFactor
+  float anisotropy = 0.0f;                // KHR_materials_anisotropy anisotropyStrength (0: none)
+  float anisotropy_rotation = 0.0f;       // anisotropyRotation, radians from the tangent to b
+  float dispersion = 0.0f;                // KHR_materials_dispersion (20 / Abbe number; 0: none)
+  float diffuse_transmission = 0.0f;      // KHR_materials_diffuse_transmission factor (0: none)
+  vec3 diffuse_transmission_color{1.0f};  // diffuseTransmissionColorFactor
+  float iridescence = 0.0f;               // KHR_materials_iridescence iridescenceFactor (0: none)
+  float iridescence_ior = 1.3f;           // iridescenceIor
   float iridescence_thickness_minimum = 100.0f;  // nm, at the thickness texture's 0
   float iridescence_thickness_maximum = 400.0f;  // nm, at its 1 (and without it)
   vec3 attenuation{0.0f};     // KHR_materials_volume: Beer-Lambert coefficient, 1/length
@@ -87,6 +89,8 @@ struct Material {
   // glossiness linear) and the factors it multiplies; the conversion to the fields above is in
   // the loader (gltf_material.cpp), this texture's part per hit (World::surface).
   TextureRef specular_glossiness_texture;
+  TextureRef diffuse_transmission_texture;        // A (linear)
+  TextureRef diffuse_transmission_color_texture;  // sRGB
   vec3 sg_specular{1.0f};
   float sg_glossiness = 1.0f;
 

@@ -19,10 +19,10 @@ namespace pb {
 // point into it, so a World is neither copied nor moved.
 class World {
  public:
-  // rough_transmission: rough glass is a GGX component (SPPM follows it); false renders it
+  // follows_transmission: rough glass is a GGX component (SPPM follows it); false renders it
   // smooth (PPM's fixed points cannot follow it; bsdf.h BsdfParams).
   explicit World(Scene scene, float mirror_roughness = float(kDefaultMirrorRoughness),
-                 bool rough_transmission = true);
+                 bool follows_transmission = true);
   World(const World&) = delete;
   World& operator=(const World&) = delete;
 
@@ -67,8 +67,9 @@ class World {
   // material has a lobe that smooth (the note the command line prints).
   std::string mirror_note() const;
   // The materials whose transmitting part is rough (roughness at or above the mirror's, or
-  // textured), as "materials 'a', 'b'"; empty when none. PPM renders them smooth (main.cpp).
-  std::string rough_glass_names() const;
+  // textured) or that transmit diffusely, as "materials 'a', 'b'"; empty when none. PPM renders
+  // them as smooth glass and diffuse reflection (main.cpp).
+  std::string followed_transmission_names() const;
 
   // Start point for a ray leaving surface point p (geometric normal ng, position error bound
   // `error` along it, Surface::error) toward dir's side (ray_offset.h). Nothing here depends on
@@ -153,7 +154,7 @@ class World {
   Lights lights_;
   float scene_size_;
   float mirror_roughness_;
-  bool rough_transmission_;
+  bool follows_transmission_;
 };
 
 }  // namespace pb
