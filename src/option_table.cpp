@@ -143,7 +143,8 @@ std::vector<OptionSpec> make_table() {
                    {kMinMirrorRoughness, 1, false, false, "", ""}));
   t.push_back(real(base("--follow-roughness", "follow_roughness", "R", render, K::Image,
                         "SPPM with next-event direct light: camera paths follow GGX lobes with a "
-                        "roughness below R, and gather photons at their diffuse base; 0: never"),
+                        "roughness below R, and gather photons at their diffuse base; 0: never "
+                        "(rough glass and diffuse transmission are followed at any R)"),
                    &RenderOptions::follow_roughness, {0, 1, false, false, "", ""}));
   t.push_back(resolution());
   t.push_back(text(base("--camera", "camera", "NAME", render, K::Image,
