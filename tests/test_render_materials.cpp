@@ -431,10 +431,18 @@ Scene masked_scene(bool masked) {
   return b.done();
 }
 
-// Equal to float rounding: 1e-5 relative (a few ulps through a path of products).
+// Equal to float rounding, 1e-5 relative (a few ulps through a path of products), in at least
+// 95% of the pixel-channels and within 10% in all: an ulp in a photon's power can flip a Russian
+// roulette decision (about 1e-7 per decision, 1e-3 over a render here; its hit rounding depends
+// on the CPU's Embree kernels), and that photon then lands elsewhere.
 void expect_close(const std::vector<float>& a, const std::vector<float>& b) {
   ASSERT_EQ(a.size(), b.size());
-  for (size_t k = 0; k < a.size(); ++k) EXPECT_NEAR(a[k], b[k], 1e-5f * std::fabs(b[k])) << k;
+  size_t off = 0;
+  for (size_t k = 0; k < a.size(); ++k) {
+    off += !(std::fabs(a[k] - b[k]) <= 1e-5f * std::fabs(b[k]));
+    EXPECT_NEAR(a[k], b[k], 0.1f * std::fabs(b[k])) << k;
+  }
+  EXPECT_LE(off, a.size() / 20);
 }
 
 TEST(MaterialRender, VertexColoursMultiplyTheBaseColourAndItsAlpha) {
