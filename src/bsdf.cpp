@@ -517,7 +517,8 @@ bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out,
 }
 
 float Bsdf::rest_albedo(const vec3& wo) const {
-  // This part's estimate without rough glass: its delta branches (All) and its non-delta terms.
+  // This part's estimate without rough glass and diffuse transmission: its delta branches (All)
+  // and its non-delta terms.
   float a = 0.0f;
   if (part_ == Part::All && has_delta()) {
     SpecularBranch b[kMaxDeltaBranches];
@@ -862,8 +863,8 @@ bool Bsdf::has_lobe_below(float below) const {
 }
 
 bool Bsdf::follows_lobe(float below) const {
-  // With rough glass, followed anyway, the base's lobe is followed too: a part then always
-  // splits as the lobes and the diffuse base.
+  // With rough glass or diffuse transmission, followed anyway, the base's lobe is followed too:
+  // a part then always splits as the lobes and the diffuse base.
   return base_non_delta_ && !smooth_ && (lobe_roughness() < below || rough_glass_ || dt_ > 0.0f) &&
          (brdf_.metallic > 0.0f || brdf_.specular > 0.0f);
 }

@@ -105,8 +105,7 @@ vec3 Bsdf::eval_glass(const vec3& wo, const vec3& wi, const vec3& v, Transport m
   const LocalFrame fr(front ? ns_ : -ns_);
   const vec3 lo = fr.local(wo), li = fr.local(wi);
   const vec3 f = glass_f(lo, li, front, mode, pdf);
-  // Under a sheen and a coat, as the delta branches: the sheen's scaling, 1 - k at the view.
-  return f * (sheen_scaling(lo.z, li.z) * (1.0f - coat_weight(v)));
+  return f * under_layers(lo.z, li.z, v);
 }
 
 bool Bsdf::glass_lit_directly() const {
@@ -126,7 +125,7 @@ vec3 Bsdf::eval_transmission(const vec3& wo, const vec3& wi, bool glass) const {
   if (dt_in_part()) {
     const LocalFrame fr(glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_);
     const vec3 lo = fr.local(wo), li = fr.local(wi);
-    f += dt_f(lo, li) * (sheen_scaling(lo.z, li.z) * (1.0f - coat_weight(wo)));
+    f += dt_f(lo, li) * under_layers(lo.z, li.z, wo);
   }
   return f;
 }
@@ -154,8 +153,7 @@ bool Bsdf::sample_dt(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) 
   const vec3 wi = sample_cosine_hemisphere(-fr.n, u1, u2);  // the other side
   if (!(glm::dot(wi, ng) < 0.0f)) return false;             // not through the true surface
   const vec3 li = fr.local(wi);
-  const float layer =
-      sheen_scaling(lo.z, li.z) * (1.0f - coat_weight(mode == Transport::Radiance ? wo : wi));
+  const float layer = under_layers(lo.z, li.z, mode == Transport::Radiance ? wo : wi);
   const float p = -li.z / kPi;
   if (!(p > 0.0f)) return false;
   out.wi = wi;
@@ -169,11 +167,8 @@ bool Bsdf::sample_dt(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) 
 float Bsdf::dt_albedo(const vec3& wo) const {
   const float c = std::fabs(glm::dot(wo, ns_));
   const float f0 = max_component(brdf_.dielectric_f0());
-  const float sm = sheen_max();
-  const float sheen =
-      sm > 0.0f ? std::max(0.0f, 1.0f - sm * sheen_albedo(c, sheen_roughness_)) : 1.0f;
   const float a = reflect_ * (1.0f - brdf_.metallic) * dt_ * (1.0f - f0) * max_component(dt_color_);
-  return std::max(a * sheen * (1.0f - coat_weight(wo)), 1e-3f * dt_);
+  return std::max(a * layers_albedo(wo, c), 1e-3f * dt_);
 }
 
 bool Bsdf::sample_glass(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const {
@@ -203,8 +198,7 @@ bool Bsdf::sample_glass(const vec3& wo, Rng& rng, Transport mode, BsdfSample& ou
   const vec3 wi = fr.world(li);
   // Reflected above the true surface, transmitted below it; else absorbed.
   if ((li.z > 0.0f) != (glm::dot(wi, ng) > 0.0f)) return false;
-  const float layer =
-      sheen_scaling(lo.z, li.z) * (1.0f - coat_weight(mode == Transport::Radiance ? wo : wi));
+  const float layer = under_layers(lo.z, li.z, mode == Transport::Radiance ? wo : wi);
   out.wi = wi;
   out.weight = f * (layer * std::fabs(li.z) / p);
   out.pdf = p;
@@ -219,11 +213,20 @@ float Bsdf::glass_albedo(const vec3& wo) const {
   const bool front = glm::dot(wo, ng_) > 0.0f;
   const float c = std::fabs(glm::dot(wo, ns_));
   const float f = max_component(glass_fresnel(c, front));
+  const float a = glass_ * (f + (1.0f - f) * max_component(brdf_.base_color));
+  return std::max(a * layers_albedo(wo, c), 1e-3f * glass_);
+}
+
+float Bsdf::under_layers(float cos_o, float cos_i, const vec3& v) const {
+  // As the delta branches: the sheen's albedo scaling, and 1 - k of the coat at the view v.
+  return sheen_scaling(cos_o, cos_i) * (1.0f - coat_weight(v));
+}
+
+float Bsdf::layers_albedo(const vec3& wo, float cos_o) const {
   const float sm = sheen_max();
   const float sheen =
-      sm > 0.0f ? std::max(0.0f, 1.0f - sm * sheen_albedo(c, sheen_roughness_)) : 1.0f;
-  const float a = glass_ * (f + (1.0f - f) * max_component(brdf_.base_color));
-  return std::max(a * sheen * (1.0f - coat_weight(wo)), 1e-3f * glass_);
+      sm > 0.0f ? std::max(0.0f, 1.0f - sm * sheen_albedo(cos_o, sheen_roughness_)) : 1.0f;
+  return sheen * (1.0f - coat_weight(wo));
 }
 
 }  // namespace pb

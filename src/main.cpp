@@ -99,7 +99,8 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   pb::ThreadLimit threads(options.threads);
   pb::Renderer renderer(std::move(scene), options);
   if (saved) renderer.restore(saved->render);
-  // PPM's points are fixed, so it cannot follow a rough lobe through a surface (bsdf.h).
+  // PPM's points are fixed, so it cannot follow rough glass or diffuse transmission through a
+  // surface (bsdf.h BsdfParams::follows_transmission).
   if (const std::string glass = renderer.world().followed_transmission_names();
       !glass.empty() && options.method == pb::Method::PPM)
     std::cerr << "photonbound: warning: " << options.scene << ": " << glass

@@ -284,6 +284,11 @@ class Bsdf {
   vec3 eval_glass(const vec3& wo, const vec3& wi, const vec3& v, Transport mode, float* pdf) const;
   bool sample_glass(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const;
   float glass_albedo(const vec3& wo) const;
+  // What the sheen and the coat above leave of a through (or glass) term: exactly, for
+  // directions at cosines cos_o, cos_i with the coat read at the view v, and as an estimate of
+  // albedo seen from wo.
+  float under_layers(float cos_o, float cos_i, const vec3& v) const;
+  float layers_albedo(const vec3& wo, float cos_o) const;
   float rest_albedo(const vec3& wo) const;
   float glass_reflection_bound(const vec3& wo) const;
 
