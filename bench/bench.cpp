@@ -3,12 +3,12 @@
 // figure and holds this machine's output. Timings are printed, never asserted.
 #include "bench.h"
 
-#include "photonbound/checkpoint_writer.h"
-#include "photonbound/driver.h"
-#include "photonbound/gltf_loader.h"
-#include "photonbound/parallel.h"
-#include "photonbound/pass_stages.h"
-#include "photonbound/renderer.h"
+#include "app/checkpoint_writer.h"
+#include "app/driver.h"
+#include "gltf/gltf_loader.h"
+#include "util/parallel.h"
+#include "render/pass_stages.h"
+#include "render/renderer.h"
 
 #include <unistd.h>
 

@@ -3,11 +3,11 @@
 // accumulate_pass, run_eye_pass), so every figure times exactly the code a render runs.
 #pragma once
 
-#include "photonbound/estimator.h"
-#include "photonbound/eye_pass.h"
-#include "photonbound/hash_grid.h"
-#include "photonbound/photon_pass.h"
-#include "photonbound/world.h"
+#include "estimator/estimator.h"
+#include "render/eye_pass.h"
+#include "render/hash_grid.h"
+#include "render/photon_pass.h"
+#include "world/world.h"
 
 #include <cstdint>
 #include <vector>

@@ -3,12 +3,12 @@
 #include "bench.h"
 #include "plain.h"
 
-#include "photonbound/camera.h"
-#include "photonbound/options.h"
-#include "photonbound/parallel.h"
-#include "photonbound/pass_stages.h"
-#include "photonbound/renderer.h"
-#include "photonbound/rng.h"
+#include "scene/camera.h"
+#include "options/options.h"
+#include "util/parallel.h"
+#include "render/pass_stages.h"
+#include "render/renderer.h"
+#include "util/rng.h"
 
 #include <algorithm>
 #include <cmath>

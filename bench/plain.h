@@ -5,7 +5,7 @@
 // out bit-identical to the full estimator's (the bench checks that).
 #pragma once
 
-#include "photonbound/estimator.h"
+#include "estimator/estimator.h"
 
 #include <cstdint>
 #include <vector>

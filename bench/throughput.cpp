@@ -1,9 +1,9 @@
 // Raw Embree ray rate, photon-pass rate, and the small helpers (median, peak RSS).
 #include "bench.h"
 
-#include "photonbound/bsdf.h"
-#include "photonbound/parallel.h"
-#include "photonbound/rng.h"
+#include "bsdf/bsdf.h"
+#include "util/parallel.h"
+#include "util/rng.h"
 
 #include <sys/resource.h>
 #include <time.h>

@@ -2,10 +2,10 @@
 // with the GLB magic) as a binary .glb, must either load into a Scene that the renderer can
 // prepare or be refused with a SceneError. Anything else (a crash, a sanitizer report, another
 // exception type, a hang) is a finding. tools/fuzz.sh builds and runs it.
-#include "photonbound/gltf_loader.h"
-#include "photonbound/scene_setup.h"
-#include "photonbound/view.h"
-#include "photonbound/world.h"
+#include "gltf/gltf_loader.h"
+#include "render/scene_setup.h"
+#include "render/view.h"
+#include "world/world.h"
 
 #include <cstdint>
 #include <cstdio>

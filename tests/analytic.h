@@ -2,10 +2,10 @@
 // pixels and bounds against them. Shared by the tests and the bounds study tool.
 #pragma once
 
-#include "photonbound/driver.h"
-#include "photonbound/film.h"
-#include "photonbound/gltf_loader.h"
-#include "photonbound/renderer.h"
+#include "app/driver.h"
+#include "estimator/film.h"
+#include "gltf/gltf_loader.h"
+#include "render/renderer.h"
 #include "render_fixture.h"
 
 #include <cmath>

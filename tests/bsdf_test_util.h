@@ -2,8 +2,8 @@
 // MetalRoughBrdf of a BsdfParams, and the chi-square test of sample()'s directions.
 #pragma once
 
-#include "photonbound/bsdf.h"
-#include "photonbound/rng.h"
+#include "bsdf/bsdf.h"
+#include "util/rng.h"
 
 #include <gtest/gtest.h>
 #include <boost/math/distributions/chi_squared.hpp>

@@ -7,10 +7,10 @@
 #include "analytic.h"
 #include "render_fixture.h"
 
-#include "photonbound/estimator.h"
-#include "photonbound/film.h"
-#include "photonbound/kernel.h"
-#include "photonbound/options.h"
+#include "estimator/estimator.h"
+#include "estimator/film.h"
+#include "estimator/kernel.h"
+#include "options/options.h"
 
 #include <gtest/gtest.h>
 

@@ -5,7 +5,7 @@
 #include "gltf_fixture.h"
 #include "process_fixture.h"
 
-#include "photonbound/gltf_loader.h"
+#include "gltf/gltf_loader.h"
 
 #include <gtest/gtest.h>
 

@@ -2,7 +2,7 @@
 // tests: integrals of D, of the visible normals, and directional albedos of the glTF BRDF.
 #pragma once
 
-#include "photonbound/microfacet.h"
+#include "bsdf/microfacet.h"
 
 #include <boost/math/quadrature/gauss.hpp>
 

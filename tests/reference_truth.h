@@ -4,12 +4,12 @@
 // study tool; analytic.h is the same for the scenes with an exact answer.
 #pragma once
 
-#include "photonbound/error_model.h"
-#include "photonbound/eye_pass.h"
-#include "photonbound/film.h"
-#include "photonbound/gltf_loader.h"
-#include "photonbound/image_io.h"
-#include "photonbound/renderer.h"
+#include "estimator/error_model.h"
+#include "render/eye_pass.h"
+#include "estimator/film.h"
+#include "gltf/gltf_loader.h"
+#include "io/image_io.h"
+#include "render/renderer.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,9 +1,9 @@
 // Shared helpers for tests that render the shipped scenes in-process.
 #pragma once
 
-#include "photonbound/driver.h"
-#include "photonbound/gltf_loader.h"
-#include "photonbound/renderer.h"
+#include "app/driver.h"
+#include "gltf/gltf_loader.h"
+#include "render/renderer.h"
 
 #include <string>
 

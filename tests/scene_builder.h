@@ -3,7 +3,7 @@
 // light directions) or need an exact answer.
 #pragma once
 
-#include "photonbound/scene.h"
+#include "scene/scene.h"
 
 #include <cmath>
 #include <string>

@@ -1,0 +1,124 @@
+#include "app/driver.h"
+
+#include "util/timer.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace pb {
+
+std::string stop_text(StopReason reason) {
+  switch (reason) {
+    case StopReason::None:
+      return "";
+    case StopReason::Passes:
+      return "passes";
+    case StopReason::Time:
+      return "time";
+    case StopReason::TargetError:
+      return "target-error";
+    case StopReason::Unreachable:
+      return "unreachable: the radius cannot shrink and the bias is above the target";
+    case StopReason::ModelRefuted:
+      return "unreachable: the bias model fails at this radius; start with a smaller --radius";
+    case StopReason::Interrupted:
+      return "interrupted";
+  }
+  return "";
+}
+
+double tested_quantity(const RenderOptions& o, const FilmSummary& s) {
+  switch (o.stop_rule) {
+    case StopRule::MeanError:
+      return s.predicted_error_upper;
+    case StopRule::MeanBound:
+      return s.unknown_pixels ? INFINITY : s.mean_bound;
+    case StopRule::Pixels:
+      return s.pixel_quantile_bound;
+  }
+  return INFINITY;
+}
+
+std::string tested_name(const RenderOptions& o) {
+  switch (o.stop_rule) {
+    case StopRule::MeanError:
+      return "mean error";
+    case StopRule::MeanBound:
+      return "mean bound";
+    case StopRule::Pixels:
+      return number_text(100.0 * o.stop_fraction) + "% of pixels";
+  }
+  return "";
+}
+
+Driver::Driver(Renderer& renderer, DriverState state) : renderer_(renderer), state_(state) {}
+
+RenderReport Driver::run(const std::atomic<bool>* interrupt,
+                         std::span<PassObserver* const> observers) {
+  const RenderOptions& o = renderer_.options();
+  const auto t0 = Clock::now();
+  const double seconds_before = state_.seconds;
+  if (state_.next_check == 0) state_.next_check = o.min_passes;
+  RenderReport report;
+  bool developed = false;
+  // A resumed render that already did its passes does not run another one.
+  if (o.passes && renderer_.passes() >= *o.passes) report.stop = StopReason::Passes;
+
+  while (report.stop == StopReason::None) {
+    const double before = seconds_since(t0);
+    std::vector<PointState>* snapshot = nullptr;
+    for (PassObserver* obs : observers)
+      if (!snapshot) snapshot = obs->snapshot_buffer(before);
+    renderer_.step(snapshot);
+    const uint64_t pass = renderer_.passes();
+    const double run_seconds = seconds_since(t0);
+    state_.seconds = seconds_before + run_seconds;
+
+    const bool check = o.target_error && pass >= state_.next_check;
+    bool want = check;
+    for (PassObserver* obs : observers) want = obs->wants_summary(pass, run_seconds) || want;
+    developed = want;
+    if (developed) report.summary = renderer_.develop();
+    if (check) {
+      // Sparse schedule (ESTIMATOR.md section 7): checks about 10% apart in pass count, so the
+      // criterion is not retried after every pass (optional stopping).
+      state_.next_check = pass + std::max<uint64_t>(1, pass / 10);
+      if (state_.early_pass == 0 || pass >= 2 * state_.early_pass) {
+        state_.early_pass = pass;
+        state_.early_value = tested_quantity(o, report.summary);
+      }
+    }
+
+    if (o.passes && pass >= *o.passes) report.stop = StopReason::Passes;
+    if (o.time_seconds && run_seconds >= *o.time_seconds) report.stop = StopReason::Time;
+    // Success needs every pixel's bound: pixels left out of a mean cannot be within a target
+    // (every tested quantity is +inf while a pixel is unknown).
+    if (check && tested_quantity(o, report.summary) <= *o.target_error)
+      report.stop = StopReason::TargetError;
+    // A target below the bias cannot be reached once the radii can no longer shrink (alpha = 1,
+    // or every radius at its floor): more passes only shrink the noise.
+    if (check && report.summary.mean_bias_metric >= *o.target_error && renderer_.radii_fixed())
+      report.stop = StopReason::Unreachable;
+    // Where the samples' drift with R^2 refutes the bias model (section 11b) every bound is
+    // unknown, and stays so for a long time: the disagreement grows with the passes, and the
+    // radius shrinks only as passes^-0.2 or so at the default alpha. Say so now rather than run
+    // to the budget.
+    if (check && report.summary.model_refuted) report.stop = StopReason::ModelRefuted;
+    if (interrupt && interrupt->load()) report.stop = StopReason::Interrupted;
+
+    if (report.stop != StopReason::None && !developed) {
+      report.summary = renderer_.develop();
+      developed = true;
+    }
+    const PassInfo info{renderer_, state_,         pass,       run_seconds,
+                        developed, report.summary, report.stop};
+    for (PassObserver* obs : observers) obs->after_pass(info);
+  }
+  for (PassObserver* obs : observers) obs->finish();
+  if (!developed) report.summary = renderer_.develop();
+  report.work = renderer_.work();
+  report.seconds = state_.seconds;
+  return report;
+}
+
+}  // namespace pb

@@ -1,0 +1,95 @@
+// The driver: owns the pass loop around a Renderer. It decides when to stop (StopReason, on the
+// check schedule of ESTIMATOR.md section 7) and tells its observers about every pass; progress
+// lines, the per-pass log and checkpoints are observers (progress.h, pass_log.h,
+// checkpoint_writer.h), so the Renderer itself only steps.
+#pragma once
+
+#include "estimator/film.h"
+#include "render/renderer.h"
+
+#include <atomic>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace pb {
+
+enum class StopReason : uint8_t {
+  None,
+  Passes,
+  Time,
+  TargetError,
+  Unreachable,   // the radii cannot shrink and the bias is above the target
+  ModelRefuted,  // the second-order bias model fails at this radius (ESTIMATOR.md 11b)
+  Interrupted
+};
+
+// As printed and stored in the EXR metadata ("passes", "time", "target-error", ...).
+std::string stop_text(StopReason reason);
+
+// The driver's own state, saved with the render so that a resumed render tests its target on
+// the same schedule.
+struct DriverState {
+  double seconds = 0.0;     // wall clock of all runs so far
+  uint64_t next_check = 0;  // pass of the next stop test; 0 = not scheduled yet
+  uint64_t early_pass = 0;  // an earlier test and its tested quantity, for the time left
+  double early_value = 0.0;
+};
+
+// What observers are told after each pass.
+struct PassInfo {
+  const Renderer& renderer;
+  const DriverState& schedule;
+  uint64_t pass = 0;
+  double run_seconds = 0.0;  // this run
+  bool developed = false;    // summary is of this pass (else of an earlier one, or empty)
+  const FilmSummary& summary;
+  StopReason stop = StopReason::None;  // None: more passes follow
+};
+
+class PassObserver {
+ public:
+  virtual ~PassObserver() = default;
+  // Before each pass: a buffer that pass should copy every point state into (a checkpoint's
+  // snapshot), or null.
+  virtual std::vector<PointState>* snapshot_buffer(double /*run_seconds*/) { return nullptr; }
+  // Whether this pass's summary is wanted (developing the image costs a fraction of a pass). The
+  // last pass is always developed.
+  virtual bool wants_summary(uint64_t /*pass*/, double /*run_seconds*/) { return false; }
+  virtual void after_pass(const PassInfo& /*info*/) {}
+  // Once, after the last pass; may rethrow what a background job threw.
+  virtual void finish() {}
+};
+
+struct RenderReport {
+  WorkCounters work;
+  double seconds = 0.0;  // wall clock of all runs
+  StopReason stop = StopReason::None;
+  FilmSummary summary;
+  RunInfo run() const { return {seconds, stop_text(stop)}; }
+};
+
+// What the stop rule of `options` compares with --target-error (README "Stopping"): the upper
+// confidence limit of the image's mean error (mean-error), the mean of the pixels' bounds
+// (mean-bound), or the bound that the share Q of the pixels is within (pixels:Q).
+double tested_quantity(const RenderOptions& options, const FilmSummary& summary);
+// A short name of it for the progress line ("mean error", "mean bound", "90% of pixels").
+std::string tested_name(const RenderOptions& options);
+
+class Driver {
+ public:
+  explicit Driver(Renderer& renderer, DriverState state = {});
+
+  // Runs passes until a stop condition of the renderer's options holds, or `interrupt` is set
+  // (polled after every pass: Ctrl-C finishes the pass).
+  RenderReport run(const std::atomic<bool>* interrupt = nullptr,
+                   std::span<PassObserver* const> observers = {});
+  const DriverState& state() const { return state_; }
+
+ private:
+  Renderer& renderer_;
+  DriverState state_;
+};
+
+}  // namespace pb

@@ -1,0 +1,44 @@
+// Driver observers that report: the progress line on a terminal and the per-pass JSON log.
+#pragma once
+
+#include "app/driver.h"
+#include "io/image_io.h"
+
+#include <ostream>
+
+namespace pb {
+
+// A progress line at most every 0.5 s and after the last pass: pass, photons, mean bound,
+// share of pixels below the target, unknown pixels, elapsed time and time left.
+class ProgressPrinter : public PassObserver {
+ public:
+  explicit ProgressPrinter(std::ostream& out) : out_(out) {}
+  bool wants_summary(uint64_t pass, double run_seconds) override;
+  void after_pass(const PassInfo& info) override;
+  static std::string line(const PassInfo& info);
+
+ private:
+  std::ostream& out_;
+  double last_print_ = -1.0;
+};
+
+// --log: one JSON object per logged pass (README "Measuring the trade"). Passes are logged while
+// the time spent logging stays within `max_overhead` of the run's time, so the log never slows
+// the pass loop by more than that; the last pass is always logged. With a reference image each
+// line also carries the actual error and coverage.
+class PassLogger : public PassObserver {
+ public:
+  PassLogger(std::ostream& out, const ExrImage* reference, double max_overhead = 0.03)
+      : out_(out), reference_(reference), max_overhead_(max_overhead) {}
+  bool wants_summary(uint64_t pass, double run_seconds) override;
+  void after_pass(const PassInfo& info) override;
+
+ private:
+  std::ostream& out_;
+  const ExrImage* reference_;
+  double max_overhead_;
+  double log_seconds_ = 0.0;
+  bool want_ = false;
+};
+
+}  // namespace pb

@@ -1,0 +1,235 @@
+#include "estimator/estimator.h"
+
+#include "estimator/kernel.h"
+
+#include <boost/math/distributions/chi_squared.hpp>
+#include <boost/math/distributions/normal.hpp>
+#include <boost/math/distributions/students_t.hpp>
+
+#include <algorithm>
+#include <limits>
+#include <vector>
+
+namespace pb {
+
+double ppm_radius_update(double& n, double& r2, double m, double alpha, double min_r2) {
+  const double r2_pass = r2;
+  double shrink = 1.0;
+  if (n + m > 0.0) {
+    shrink = (n + alpha * m) / (n + m);
+    n += alpha * m;
+  }
+  // At the radius floor the shrink actually applied is smaller; tau must follow R^2 exactly or
+  // tau / (pi R^2 i M_e) stops being the mean of the per-pass estimates.
+  r2 = std::max(r2_pass * shrink, min_r2);
+  return r2 / r2_pass;
+}
+
+void accumulate_pass(PointState& s, const PassGather& g, const EstimatorParams& params,
+                     uint64_t pass) {
+  const double r2_pass = s.r2;  // R_j: the radius every deposit of this pass was made with
+  const double inv_area = 1.0 / (kPiD * r2_pass * params.photons_per_pass);
+
+  // Where the disc reaches past the end of the surface (section 11): the kernel sum is divided
+  // by the kernel's mass c on the surface; the Laplacian sample loses the truncated Laplacian
+  // kernel's response l0 L / R^2 to the constant part and is rescaled by its second moment; and
+  // the bias, (R^2 / 4c) tr(M2) Lap for an isotropic Hessian, is 0.5 k2 Lap R_b^2 with the
+  // effective R_b^2 = R^2 tr(M2) / (2 k2 c), which the moments stream in place of R_j^2. The
+  // whole disc (every interior point) takes the plain path, bit for bit.
+  dvec3 phi = g.phi, lap = g.phi_lap_r2 / r2_pass;  // w_lap carries 1 / R_j^2
+  double r2_bias = r2_pass;
+  if (!g.disc.full) {
+    const double c = std::max(g.disc.mass, kMinKernelMass);
+    phi = g.phi / c;
+    // A disc cut to a sliver leaves the Laplacian kernel little sensitivity to curvature:
+    // its second moment is kept at least a sixteenth of the whole disc's.
+    lap = (lap - (g.disc.lap_mass / r2_pass) * phi) * (4.0 / std::max(g.disc.lap_second, 0.25));
+    r2_bias = r2_pass * g.disc.second / (2.0 * kernel::kSecondMoment * c);
+  }
+
+  // Per-pass sample X_j = D_j + phi_j / (pi R_j^2 M_e) (section 4), streamed into bivariate
+  // Welford moments with R_j^2: C_xy += (x - mean_x_old)(y - mean_y_new).
+  const dvec3 x = g.direct + phi * inv_area;
+  // Section 11c: the kernel at R_j / 2 over the same photons. Under E[X(R)] = L + a R^2 the
+  // difference of the two scales is 0.75 a R_j^2 (the direct part cancels), so Y_j below has
+  // mean 0; the R^4 terms the model leaves out give it a mean, with a noise of its own that the
+  // samples measure. Where the disc is cut by an edge the half disc's kernel mass would be
+  // needed too: those passes are left out.
+  if (g.disc.full) {
+    const dvec3 y3 =
+        (g.phi - 4.0 * g.phi_half - 0.375 * kernel::kSecondMoment * g.phi_lap_r2) * inv_area;
+    const double y = y3.x + y3.y + y3.z;
+    ++s.scale_passes;
+    const double dy = y - s.scale_mean;
+    s.scale_mean += dy / double(s.scale_passes);
+    s.scale_c2 += float(dy * (y - s.scale_mean));
+  }
+  const double inv_i = 1.0 / double(pass);
+  const dvec3 dx = x - s.mean_x;
+  const double dr = r2_bias - s.mean_r2;
+  s.mean_x += dx * inv_i;
+  s.mean_r2 += dr * inv_i;
+  s.c_xx += dx * (x - s.mean_x);
+  s.c_xr += dx * (r2_bias - s.mean_r2);
+  s.c_rr += dr * (r2_bias - s.mean_r2);
+  s.photons += g.count;
+  const double sign = (pass & 1u) ? 1.0 : -1.0;
+  s.alt_x += sign * x;
+  s.alt_r2 += sign * r2_bias;
+
+  // PPM update (section 3, HOJ08): only photons that could contribute shrink the radius.
+  const double applied = ppm_radius_update(s.n, s.r2, double(g.count), params.alpha, params.min_r2);
+  s.tau = (s.tau + phi) * applied;
+  s.tau_lap = (s.tau_lap + lap) * applied;
+}
+
+dvec3 photon_radiance(const PointState& s, uint64_t passes, double photons_per_pass) {
+  return s.tau / (kPiD * s.r2 * double(passes) * photons_per_pass);
+}
+
+PointEstimate estimate(const PointState& s, uint64_t passes, double photons_per_pass) {
+  PointEstimate e;
+  if (passes == 0) return e;
+  const double i = double(passes);
+  // L_i = mean_j X_j. Equal to D-bar + tau / (pi R^2 i M_e) by the key identity, but read from
+  // the streaming mean, so the state keeps no separate sum of the D_j.
+  e.radiance = s.mean_x;
+
+  // Bias (section 3): a = 0.5 k2 Lap_i with Lap_i = tauLap / (pi R^2 i M_e); B = a mean_j(R_j^2).
+  const dvec3 lap = s.tau_lap / (kPiD * s.r2 * i * photons_per_pass);
+  const dvec3 a = 0.5 * kernel::kSecondMoment * lap;
+  e.bias = a * s.mean_r2;
+
+  e.known = passes >= 2 && s.photons >= kMinPhotonsForBound;
+  if (passes >= 2) {
+    // Retroactive correction X'_j = X_j - a R_j^2 with the newest a (section 4).
+    const dvec3 s2 = glm::max(dvec3(0.0), (s.c_xx - 2.0 * a * s.c_xr + a * a * s.c_rr) / (i - 1.0));
+    e.variance = s2 / i;
+    // sum_j s_j (X'_j - mean X') / i with s_j = +1 on odd passes and -1 on even ones: the
+    // corrected samples' deviations with alternating signs. For independent samples its variance
+    // is (i - sbar^2 i) Var X / i^2 (sbar = sum s_j / i, 1 / i or 0), that of the mean's noise to
+    // within 1 / i^2, and its covariance with another point's replica is the noises' covariance
+    // to the same order; a slow drift of the mean cancels pairwise.
+    const double odd = (passes & 1u) ? 1.0 : 0.0;
+    e.replica = (s.alt_x - a * s.alt_r2 - odd * (s.mean_x - a * s.mean_r2)) / i;
+    // Var(B) from the variance of the mean by the kernels' noise ratio; the radius shrank over
+    // the passes, and the Laplacian's noise grows as 1/R^3 against the estimate's 1/R, so the
+    // ratio is scaled by (mean R^2 / R^2)^2 (section 6b). An upper estimate where next-event
+    // noise is part of the variance.
+    const double shrink = s.mean_r2 / s.r2;
+    e.bias_variance = kBiasNoiseRatio * shrink * shrink * e.variance;
+    // Section 11b: under the model E[X_j] = L + a R_j^2, the least-squares slope of the samples
+    // on R_j^2 estimates the same a as the Laplacian; a radius far above the scale on which the
+    // radiance varies bends E[X] in R^2, and the two part. The regression slope's variance is
+    // the residual variance over C_RR; the Laplacian's is Var(B) / mean(R^2)^2.
+    if (passes >= 3 && s.c_rr > 0.0 && s.mean_r2 > 0.0 && s.photons >= kMinPhotonsForBound)
+      for (int c = 0; c < 3; ++c) {
+        const double b = s.c_xr[c] / s.c_rr;
+        const double resid = std::max(0.0, s.c_xx[c] - s.c_xr[c] * b) / (i - 2.0);
+        const double var = resid / s.c_rr + e.bias_variance[c] / (s.mean_r2 * s.mean_r2);
+        // Rescaled like scale_z below: with i - 2 degrees of freedom a plain |z| > 3 fires for
+        // 9.5% of states after 4 passes under the model (6% of state-channels measured).
+        if (var > 0.0 && std::isfinite(var))
+          e.slope_z[c] = (b - a[c]) / std::sqrt(var) * (kSlopeZ / t_at_three_sd(passes - 2));
+      }
+  }
+  if (s.scale_passes >= 3 && s.scale_c2 > 0.0f && s.photons >= kMinPhotonsForBound) {
+    const double n = double(s.scale_passes);
+    const double t = s.scale_mean / std::sqrt(double(s.scale_c2) / ((n - 1.0) * n));
+    e.scale_z = t * (kSlopeZ / t_at_three_sd(s.scale_passes - 1));
+  }
+  return e;
+}
+
+double t_at_three_sd(uint64_t nu) {
+  // The Student-t quantile at the normal's 3-sd point, Phi(3), by degrees of freedom; the
+  // table ends where it is within 0.1% of 3.
+  static constexpr uint64_t kTable = 1024;
+  static const std::vector<double> table = [] {
+    const double p = boost::math::cdf(boost::math::normal_distribution<double>(), kSlopeZ);
+    std::vector<double> t(kTable + 1, kSlopeZ);
+    for (uint64_t k = 1; k <= kTable; ++k) t[k] = student_t_quantile(double(k), p);
+    return t;
+  }();
+  return nu == 0 ? std::numeric_limits<double>::infinity() : table[std::min(nu, kTable)];
+}
+
+namespace {
+
+// CDF and density of Student's t (normal beyond 1e7 degrees of freedom, like the quantile).
+struct StudentT {
+  double nu;
+  double cdf(double x) const {
+    if (nu > 1e7) return boost::math::cdf(boost::math::normal_distribution<double>(), x);
+    return boost::math::cdf(boost::math::students_t_distribution<double>(nu), x);
+  }
+  double pdf(double x) const {
+    if (nu > 1e7) return boost::math::pdf(boost::math::normal_distribution<double>(), x);
+    return boost::math::pdf(boost::math::students_t_distribution<double>(nu), x);
+  }
+};
+
+}  // namespace
+
+BoundQuantile::BoundQuantile(double nu, double confidence)
+    : t_two_(student_t_quantile(nu, 0.5 + 0.5 * confidence)) {
+  const StudentT t{nu};
+  const double t_one = student_t_quantile(nu, confidence);
+  for (int k = 0; k < kTable; ++k) {
+    const double x = double(k) / double(kTable - k);  // u / (1 - u) with u = k / kTable
+    // Solve P(|x + T| <= q) = F(q - x) - F(-q - x) = confidence for q. The root lies between
+    // the one- and two-sided bounds; Newton steps from the upper end, kept inside the bracket,
+    // with a bisection step whenever Newton would leave it.
+    // Warm start from the previous node: q - x changes slowly with x.
+    double lo = x + t_one, hi = x + t_two_;
+    double q = k == 0 ? hi : std::clamp(x + table_[k - 1], lo, hi);
+    for (int it = 0; it < 50; ++it) {
+      const double g = t.cdf(q - x) - t.cdf(-q - x) - confidence;
+      if (g > 0.0)
+        hi = q;
+      else
+        lo = q;
+      const double slope = t.pdf(q - x) + t.pdf(-q - x);
+      double next = slope > 0.0 ? q - g / slope : 0.5 * (lo + hi);
+      if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
+      if (std::fabs(next - q) <= 1e-10 * q || hi - lo <= 1e-10 * hi) {
+        q = next;
+        break;
+      }
+      q = next;
+    }
+    table_[k] = q - x;
+  }
+  table_[kTable] = t_one;  // x -> infinity: the far tail vanishes, one-sided quantile
+}
+
+double BoundQuantile::operator()(double bias, double sd) const {
+  const double b = std::fabs(bias);
+  if (!(sd > 0.0)) return b;
+  const double x = b / sd;
+  if (!std::isfinite(x)) return b + sd * table_[kTable];
+  const double pos = x / (1.0 + x) * kTable;
+  const int k = std::min(int(pos), kTable - 1);
+  const double f = pos - k;
+  return b + sd * (table_[k] * (1.0 - f) + table_[k + 1] * f);
+}
+
+double sparse_photon_bound(uint64_t photons, uint64_t passes, double cap, double confidence) {
+  if (passes == 0 || !(cap > 0.0)) return 0.0;
+  const double total =
+      photons == 0
+          ? -std::log1p(-confidence)
+          : 0.5 * boost::math::quantile(
+                      boost::math::chi_squared_distribution<double>(2.0 * double(photons) + 2.0),
+                      confidence);
+  return total / double(passes) * cap;
+}
+
+double student_t_quantile(double nu, double p) {
+  // Beyond 1e7 degrees of freedom the t and normal quantiles agree to ~1e-8 and Boost's t
+  // evaluation loses accuracy; use the normal there.
+  if (nu > 1e7) return boost::math::quantile(boost::math::normal_distribution<double>(), p);
+  return boost::math::quantile(boost::math::students_t_distribution<double>(nu), p);
+}
+
+}  // namespace pb

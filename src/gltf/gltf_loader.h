@@ -1,0 +1,26 @@
+// Loads the glTF 2.0 subset photonbound renders (README "Scenes") into plain Scene data.
+// Only the loader's own files (src/gltf_*.cpp) see tinygltf types.
+#pragma once
+
+#include "scene/scene.h"
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace pb {
+
+// Reads a .gltf (embedded or external buffers) or .glb file. Throws SceneError for anything
+// the renderer cannot use: missing or malformed file, out-of-range accessors or indices,
+// non-finite or absurd coordinates, unsupported primitive modes or light types, lights whose
+// power overflows float. No camera and no light are allowed (scene_setup.h and view.h add the
+// default view and sky); what is ignored (skins, morph targets, animations, unknown extensions)
+// is in Scene::warnings. Degenerate triangles are skipped and counted.
+Scene load_gltf(const std::string& path);
+
+// The same for a file already in memory (the fuzz target's entry point). `path` names the input
+// in messages, its extension picks .glb or JSON, and its folder is where external buffers are
+// looked up.
+Scene load_gltf_bytes(const std::string& path, const std::vector<unsigned char>& bytes);
+
+}  // namespace pb

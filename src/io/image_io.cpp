@@ -1,0 +1,208 @@
+#include "io/image_io.h"
+
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+
+#include "util/file_io.h"
+#include "util/text.h"
+
+namespace pb {
+
+namespace {
+
+// OpenImageIO writes the temporary file write_atomically names (it picks the format by the
+// extension, which the name keeps); its errors become one ImageError naming `path`.
+void write_image(const std::string& path, const OIIO::ImageSpec& spec, const void* data,
+                 OIIO::TypeDesc type) {
+  try {
+    write_atomically(
+        path,
+        [&](const std::string& tmp) {
+          auto out = OIIO::ImageOutput::create(tmp);
+          if (!out)
+            throw ImageError(path +
+                             ": cannot create an image writer: " + one_line(OIIO::geterror()));
+          bool ok = out->open(tmp, spec) && out->write_image(type, data);
+          ok = out->close() && ok;
+          if (!ok) throw ImageError(path + ": cannot write: " + one_line(out->geterror()));
+        },
+        ".exr");
+  } catch (const FileError& e) {
+    throw ImageError(e.what());
+  }
+}
+
+}  // namespace
+
+int ExrImage::channel_index(const std::string& name) const {
+  for (size_t c = 0; c < channels.size(); ++c)
+    if (channels[c] == name) return int(c);
+  return -1;
+}
+
+void write_exr(const std::string& path, const ExrImage& image, ExrCompression compression) {
+  OIIO::ImageSpec spec(image.width, image.height, int(image.channels.size()),
+                       OIIO::TypeDesc::FLOAT);
+  spec.channelnames = image.channels;
+  spec.alpha_channel = -1;
+  spec.attribute("compression", compression == ExrCompression::Zip ? "zip" : "none");
+  for (const auto& [key, value] : image.metadata) spec.attribute("photonbound:" + key, value);
+  write_image(path, spec, image.pixels.data(), OIIO::TypeDesc::FLOAT);
+}
+
+void write_png(const std::string& path, int width, int height,
+               const std::vector<unsigned char>& rgb) {
+  OIIO::ImageSpec spec(width, height, 3, OIIO::TypeDesc::UINT8);
+  write_image(path, spec, rgb.data(), OIIO::TypeDesc::UINT8);
+}
+
+ExrImage read_exr(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw ImageError(path + ": cannot read image: " + one_line(OIIO::geterror()));
+  const OIIO::ImageSpec& spec = in->spec();
+  ExrImage image;
+  image.width = spec.width;
+  image.height = spec.height;
+  image.channels = spec.channelnames;
+  image.pixels.resize(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
+    throw ImageError(path + ": cannot read pixels: " + one_line(in->geterror()));
+  for (const OIIO::ParamValue& p : spec.extra_attribs) {
+    const std::string name = p.name().string();
+    if (name.rfind("photonbound:", 0) == 0)
+      image.metadata.emplace_back(name.substr(12), spec.get_string_attribute(name));
+  }
+  in->close();
+  return image;
+}
+
+namespace {
+
+// A file name whose extension names the format the bytes are in: PNG and JPEG by their
+// signatures, otherwise whatever `name` says.
+std::string format_name(const unsigned char* d, size_t n, const std::string& name) {
+  if (n >= 8 && std::memcmp(d, "\x89PNG\r\n\x1a\n", 8) == 0) return "image.png";
+  if (n >= 3 && d[0] == 0xff && d[1] == 0xd8 && d[2] == 0xff) return "image.jpg";
+  if (n >= 12 && std::memcmp(d, "RIFF", 4) == 0 && std::memcmp(d + 8, "WEBP", 4) == 0)
+    return "image.webp";
+  return name;
+}
+
+}  // namespace
+
+bool is_ktx2(const unsigned char* data, size_t size) {
+  return size >= 12 && std::memcmp(data, "\xabKTX 20\xbb\r\n\x1a\n", 12) == 0;
+}
+
+namespace {
+
+// libpng's default error and warning handlers, which OpenImageIO's PNG reader keeps, write to
+// stderr themselves ("libpng error: IDAT: Read error", "libpng warning: iCCP: known incorrect
+// sRGB profile"): a line that names no file ahead of the one-line error that does, or noise on
+// a good texture. OpenImageIO passes the same text to geterror(), which the error below
+// carries, so stderr is pointed at /dev/null while a texture decodes (the loader decodes on
+// one thread, before any progress output).
+class QuietStderr {
+ public:
+  QuietStderr() {
+    std::fflush(stderr);
+    saved_ = ::dup(2);
+    const int null = ::open("/dev/null", O_WRONLY | O_CLOEXEC);
+    if (saved_ >= 0 && null >= 0) ::dup2(null, 2);
+    if (null >= 0) ::close(null);
+  }
+  ~QuietStderr() {
+    if (saved_ < 0) return;
+    std::fflush(stderr);
+    ::dup2(saved_, 2);
+    ::close(saved_);
+  }
+  QuietStderr(const QuietStderr&) = delete;
+  QuietStderr& operator=(const QuietStderr&) = delete;
+
+ private:
+  int saved_ = -1;
+};
+
+}  // namespace
+
+Image decode_image(const unsigned char* data, size_t size, const std::string& name) {
+  // KTX2 (KHR_texture_basisu's container) has no OpenImageIO reader; without this, OpenImageIO
+  // falls back to opening `name` as a path relative to the working directory and reports a
+  // missing file.
+  if (is_ktx2(data, size))
+    throw ImageError(name +
+                     ": cannot decode the image: it is KTX2 (Basis Universal), which "
+                     "photonbound does not read");
+  const QuietStderr quiet;
+  OIIO::Filesystem::IOMemReader memory(data, size);
+  OIIO::ImageSpec config;
+  config.attribute("oiio:UnassociatedAlpha", 1);  // keep colour as stored, not premultiplied
+  // With a configuration the readers take the proxy from it (ioproxy_retrieve_from_config).
+  OIIO::Filesystem::IOProxy* proxy = &memory;
+  config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
+  auto in = OIIO::ImageInput::open(format_name(data, size, name), &config, &memory);
+  if (!in) throw ImageError(name + ": cannot decode the image: " + one_line(OIIO::geterror()));
+  const OIIO::ImageSpec& spec = in->spec();
+  Image im;
+  im.name = name;
+  im.width = spec.width;
+  im.height = spec.height;
+  im.channels = std::min(spec.nchannels, 4);
+  const uint64_t texels = uint64_t(std::max(spec.width, 0)) * uint64_t(std::max(spec.height, 0));
+  if (spec.width <= 0 || spec.height <= 0 || im.channels <= 0 || texels > (uint64_t(1) << 28))
+    throw ImageError(name + ": the image is " + std::to_string(spec.width) + "x" +
+                     std::to_string(spec.height) + " with " + std::to_string(spec.nchannels) +
+                     " channels; photonbound reads 1 to 4 channels and up to 2^28 texels");
+  const size_t values = size_t(texels) * size_t(im.channels);
+  bool ok;
+  if (spec.format == OIIO::TypeDesc::UINT8) {
+    im.u8.resize(values);
+    ok = in->read_image(0, 0, 0, im.channels, OIIO::TypeDesc::UINT8, im.u8.data());
+  } else {
+    im.f32.resize(values);
+    ok = in->read_image(0, 0, 0, im.channels, OIIO::TypeDesc::FLOAT, im.f32.data());
+  }
+  if (!ok) throw ImageError(name + ": cannot decode the image: " + one_line(in->geterror()));
+  in->close();
+  return im;
+}
+
+RgbImage read_rgb_image(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw ImageError(path + ": cannot read image: " + one_line(OIIO::geterror()));
+  const OIIO::ImageSpec& spec = in->spec();
+  const size_t pixels = size_t(spec.width) * size_t(spec.height);
+  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 ||
+      pixels * size_t(std::max(spec.nchannels, 1)) > (size_t(1) << 29))
+    throw ImageError(path + ": " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                     " pixels of " + std::to_string(spec.nchannels) +
+                     " channels is not an environment map (at most 2^29 values)");
+  // R, G and B by name when the file has them (an EXR's channels need not come in that order),
+  // else the first three channels, or the one channel as grey.
+  int source[3] = {spec.channelindex("R"), spec.channelindex("G"), spec.channelindex("B")};
+  if (source[0] < 0 || source[1] < 0 || source[2] < 0)
+    for (int c = 0; c < 3; ++c) source[c] = std::min(c, spec.nchannels - 1);
+  const int channels = spec.nchannels;
+  std::vector<float> data(pixels * size_t(channels));
+  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, data.data()))
+    throw ImageError(path + ": cannot read pixels: " + one_line(in->geterror()));
+  in->close();
+  RgbImage out;
+  out.width = spec.width;
+  out.height = spec.height;
+  out.rgb.resize(3 * pixels);
+  for (size_t p = 0; p < pixels; ++p)
+    for (size_t c = 0; c < 3; ++c)
+      out.rgb[3 * p + c] = data[p * size_t(channels) + size_t(source[c])];
+  return out;
+}
+
+}  // namespace pb

@@ -1,0 +1,375 @@
+#include "lights/lights.h"
+
+#include "bsdf/microfacet.h"
+
+#include "bsdf/bsdf.h"
+#include "util/ray_offset.h"
+
+#include <algorithm>
+#include <stdexcept>
+
+namespace pb {
+
+namespace {
+
+// KHR_lights_punctual recommended spot attenuation: a linear ramp in cos between the cones,
+// squared.
+float spot_attenuation(const PunctualLight& l, float cos_angle) {
+  if (l.kind == PunctualKind::Point) return 1.0f;
+  const float span = std::max(l.cos_inner - l.cos_outer, 1e-4f);
+  const float t = std::clamp((cos_angle - l.cos_outer) / span, 0.0f, 1.0f);
+  return t * t;
+}
+
+// Receivers closer to a triangle's centroid than this many times its longest edge from vertex 0
+// (squared) sample it by solid angle.
+constexpr float kNearFactor2 = 4.0f * 4.0f;
+
+}  // namespace
+
+// How far from the emitter triangle t's plane, along its normal, rounding may put a point that
+// is on it, seen from `receiver`: the sample's own error (t.error) plus Embree's, whose distance
+// to the plane is computed from v0 - origin and so grows with the receiver's coordinates too
+// (ray_offset.h). A receiver closer than this lies in the plane (a point beside the emitter on
+// the same wall, lifted off it by World::spawn): it sees none of it, not a hemisphere.
+float Lights::plane_tolerance(const Triangle& t, const vec3& receiver) {
+  return t.error + gamma_bound(7) * glm::dot(glm::abs(t.normal), glm::abs(receiver));
+}
+
+// That distance along a shadow ray at cosine cos_light to t's normal: where the ray must stop.
+float Lights::shadow_margin(const Triangle& t, const vec3& receiver, float cos_light) {
+  return cos_light > 0.0f ? plane_tolerance(t, receiver) / cos_light : INFINITY;
+}
+
+Lights::Lights(const Scene& scene, double piece_budget)
+    : punctual_(scene.lights),
+      images_(scene.images),
+      centre_(0.5f * (scene.bounds.lo + scene.bounds.hi)),
+      radius_(emission_radius(scene.bounds)) {
+  if (scene.bounds.empty()) centre_ = vec3(0.0f);
+  if (scene.environment) environment_.emplace(*scene.environment);
+  double pieces = 0.0;  // what the textured triangles ask for
+  for (const Mesh& mesh : scene.meshes) {
+    const Material& mat = scene.materials[mesh.material];
+    if (!mat.emits() || !(mat.emissive_texture.present() || mat.masked())) continue;
+    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+      const double n = textured_split(mesh, mat, uint32_t(t / 3), nullptr);
+      pieces += n * n;
+    }
+  }
+  if (pieces > piece_budget) split_scale_ = float(std::sqrt(piece_budget / pieces));
+  for (const Mesh& mesh : scene.meshes) {
+    const Material& mat = scene.materials[mesh.material];
+    if (!mat.emits()) continue;
+    for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
+      Triangle tri;
+      tri.p0 = mesh.positions[mesh.indices[t]];
+      tri.e1 = mesh.positions[mesh.indices[t + 1]] - tri.p0;
+      tri.e2 = mesh.positions[mesh.indices[t + 2]] - tri.p0;
+      const vec3 c = glm::cross(tri.e1, tri.e2);
+      tri.area = 0.5f * glm::length(c);
+      if (!(tri.area > 0.0f)) continue;
+      tri.normal = c / (2.0f * tri.area);
+      tri.error = surface_error(tri.p0, tri.p0 + tri.e1, tri.p0 + tri.e2, tri.normal);
+      tri.radiance = mat.emission;
+      tri.select = average(tri.radiance);
+      tri.two_sided = mat.double_sided;
+      tri.coat = mat.clearcoat;
+      if (mat.emissive_texture.present() || mat.masked())
+        add_textured(mesh, mat, uint32_t(t / 3), tri);
+      else
+        triangles_.push_back(tri);
+    }
+  }
+  std::vector<double> weights;
+  auto add = [&](const vec3& power, double weight) {
+    total_power_ += power;
+    weights.push_back(weight);
+  };
+  for (const PunctualLight& l : punctual_) {
+    const vec3 p = punctual_power(l, radius_);
+    add(p, double(p.x) + p.y + p.z);
+  }
+  for (const Triangle& t : triangles_) {
+    const float sides = t.two_sided ? 2.0f : 1.0f;
+    const vec3 p = lambertian_emitter_power(t.area * sides, t.radiance);
+    // Chosen by power; a textured piece by its select radiance, which is never 0 where it emits.
+    add(p, t.source < 0 ? double(p.x) + p.y + p.z
+                        : 3.0 * double(lambertian_emitter_power(t.area * sides, t.select)));
+  }
+  if (environment_) {
+    const vec3 p = environment_power(*environment_, radius_);
+    add(p, double(p.x) + p.y + p.z);
+  }
+
+  double sum = 0.0;
+  for (double w : weights) sum += w;
+  if (!(sum > 0.0) || !std::isfinite(sum))
+    throw std::runtime_error("the scene's lights emit no finite positive power");
+  cdf_.resize(weights.size());
+  probability_.resize(weights.size());
+  double acc = 0.0;
+  for (size_t k = 0; k < weights.size(); ++k) {
+    acc += weights[k];
+    cdf_[k] = acc / sum;
+    probability_[k] = float(weights[k] / sum);
+  }
+  cdf_.back() = 1.0;
+  // Per emitter: flux per photon = power / probability (sample_photon); a spot's photons carry
+  // up to its intensity times the cone's solid angle, a directional light's pi r^2 E, an
+  // environment map's pi r^2 times its largest radiance over its sampling density.
+  for (size_t k = 0; k < weights.size(); ++k) {
+    if (!(probability_[k] > 0.0f)) continue;
+    vec3 peak(0.0f);
+    if (k == punctual_.size() + triangles_.size()) {
+      peak = vec3(kPi * radius_ * radius_ * environment_->max_radiance_over_pdf());
+    } else if (k < punctual_.size()) {
+      const PunctualLight& l = punctual_[k];
+      peak = l.kind == PunctualKind::Point ? 4.0f * kPi * l.intensity
+             : l.kind == PunctualKind::Directional
+                 ? punctual_power(l, radius_)
+                 : l.intensity * (2.0f * kPi * (1.0f - l.cos_outer));
+    } else {
+      const Triangle& t = triangles_[k - punctual_.size()];
+      // A textured piece's photons carry the radiance where they start: at most its peak.
+      const vec3 le = t.source < 0 ? t.radiance : vec3(t.peak);
+      peak = lambertian_emitter_power(t.area * (t.two_sided ? 2.0f : 1.0f), le);
+    }
+    max_photon_flux_ = std::max(max_photon_flux_, max_component(peak) / probability_[k]);
+  }
+}
+
+size_t Lights::pick(float u) const {
+  const auto it = std::upper_bound(cdf_.begin(), cdf_.end(), double(u));
+  size_t k = size_t(it - cdf_.begin());
+  k = std::min(k, cdf_.size() - 1);
+  // Skip zero-probability emitters that share a CDF value with their successor.
+  while (probability_[k] == 0.0f && k + 1 < cdf_.size()) ++k;
+  return k;
+}
+
+vec3 Lights::spot_falloff(const PunctualLight& l, const vec3& dir) const {
+  return l.intensity * spot_attenuation(l, glm::dot(dir, l.direction));
+}
+
+EmittedPhoton Lights::sample_photon(Rng& rng) const {
+  const size_t k = pick(rng.next_float());
+  const float p_pick = probability_[k];
+  EmittedPhoton ph;
+  const float u1 = rng.next_float(), u2 = rng.next_float();
+  if (k < punctual_.size()) {
+    const PunctualLight& l = punctual_[k];
+    if (l.kind == PunctualKind::Directional) {
+      ph = from_disc(l.direction, u1, u2);
+      ph.flux = l.intensity * (kPi * radius_ * radius_) / p_pick;
+      return ph;
+    }
+    ph.origin = l.position;
+    if (l.kind == PunctualKind::Point) {
+      ph.dir = sample_uniform_sphere(u1, u2);
+      ph.flux = l.intensity * (4.0f * kPi) / p_pick;
+    } else {
+      ph.dir = sample_uniform_cone(l.direction, l.cos_outer, u1, u2);
+      const float solid_angle = 2.0f * kPi * (1.0f - l.cos_outer);
+      ph.flux = spot_falloff(l, ph.dir) * solid_angle / p_pick;
+    }
+    return ph;
+  }
+  if (k == punctual_.size() + triangles_.size()) {
+    // The environment: a direction toward it by the map, entering through the disc facing it
+    // (pbrt-v4 ImageInfiniteLight::SampleLe): flux = Le pi r^2 / pdf.
+    float pdf = 0.0f;
+    const float v0 = rng.next_float(), v1 = rng.next_float();
+    const vec3 w = environment_->sample(u1, u2, v0, v1, pdf);
+    const float d0 = rng.next_float(), d1 = rng.next_float();
+    ph = from_disc(-w, d0, d1);
+    ph.flux = pdf > 0.0f ? environment_->radiance(w) * (kPi * radius_ * radius_) / (pdf * p_pick)
+                         : vec3(0.0f);
+    return ph;
+  }
+  const Triangle& t = triangles_[k - punctual_.size()];
+  // Uniform point on the triangle (pbrt-v4 SampleUniformTriangle, square-root mapping).
+  const float s = std::sqrt(u1);
+  const float b1 = 1.0f - s, b2 = u2 * s;
+  ph.origin = t.p0 + b1 * t.e1 + b2 * t.e2;
+  ph.normal = t.normal;
+  ph.error = t.error;
+  // Drawn in this order: the arguments of an earlier call, which GCC evaluated right to left
+  // (images stay bit-identical; the order is now explicit for every compiler).
+  const float v2 = rng.next_float(), v1 = rng.next_float();
+  float sides = 1.0f;
+  if (t.two_sided) {  // either side with probability 1/2
+    sides = 2.0f;
+    if (rng.next_float() < 0.5f) ph.normal = -ph.normal;
+  }
+  ph.dir = sample_cosine_hemisphere(ph.normal, v1, v2);
+  // Cosine-weighted direction and uniform area: flux = Le cos / (pdf_A pdf_w) = pi A Le.
+  const vec3 le = t.source < 0 ? t.radiance : radiance_at(t, b1, b2);
+  ph.flux = le * (kPi * t.area * sides) / p_pick;
+  if (t.coat > 0.0f) ph.flux *= 1.0f - clearcoat_fresnel(t.coat, glm::dot(ph.dir, ph.normal));
+  return ph;
+}
+
+EmittedPhoton Lights::from_disc(const vec3& travel, float u0, float u1) const {
+  // Uniform by area (radius r sqrt(u0), angle 2 pi u1) on the disc of radius r facing the light,
+  // r before the scene's centre: outside the bounding sphere, covering all of it.
+  vec3 t, b;
+  orthonormal_basis(travel, t, b);
+  const float rho = radius_ * std::sqrt(u0), phi = 2.0f * kPi * u1;
+  EmittedPhoton ph;
+  ph.origin = centre_ - radius_ * travel + rho * (std::cos(phi) * t + std::sin(phi) * b);
+  ph.dir = travel;
+  return ph;
+}
+
+float Lights::local_weight(size_t k, const vec3& receiver) const {
+  if (k == punctual_.size() + triangles_.size())       // the environment: pi x its mean radiance,
+    return average(environment_->integral()) * 0.25f;  // the irradiance it gives a free surface
+  if (k < punctual_.size()) {
+    const PunctualLight& l = punctual_[k];
+    if (l.kind == PunctualKind::Directional) return average(l.intensity);  // irradiance
+    const vec3 d = l.position - receiver;
+    const float dist2 = glm::dot(d, d);
+    if (!(dist2 > 0.0f)) return 0.0f;
+    return average(spot_falloff(l, -d / std::sqrt(dist2))) / dist2;
+  }
+  const Triangle& t = triangles_[k - punctual_.size()];
+  const vec3 a = t.p0 - receiver, b = a + t.e1, c = a + t.e2;
+  // Receiver behind a one-sided emitter, or in its plane.
+  const float side = -glm::dot(a, t.normal);
+  if ((t.two_sided ? std::fabs(side) : side) <= plane_tolerance(t, receiver)) return 0.0f;
+  // Solid angle (Van Oosterom & Strackee 1983): tan(omega / 2) = |a.(b x c)| / denominator.
+  const float la = glm::length(a), lb = glm::length(b), lc = glm::length(c);
+  const float num = std::fabs(glm::dot(a, glm::cross(b, c)));
+  const float den = la * lb * lc + glm::dot(a, b) * lc + glm::dot(a, c) * lb + glm::dot(b, c) * la;
+  const float omega = 2.0f * std::atan2(num, den);
+  return t.select * std::max(omega, 0.0f);
+}
+
+bool Lights::sample_environment(const vec3& normal, float p_pick, Rng& rng,
+                                DirectSample& out) const {
+  const float u1 = rng.next_float(), u2 = rng.next_float();
+  out.distance = INFINITY;
+  out.margin = 0.0f;
+  if (environment_->uniform()) {
+    // A uniform environment by the cosine about the receiver's normal: Li cos / pdf = pi Le for
+    // every sample the receiver's side sees (exact on a convex object).
+    out.wi = sample_cosine_hemisphere(normal, u1, u2);
+    const float cos = glm::dot(out.wi, normal);
+    if (!(cos > 0.0f)) return false;
+    out.li = environment_->radiance(out.wi) * (kPi / (cos * p_pick));
+  } else {
+    float pdf = 0.0f;
+    const float u3 = rng.next_float(), u4 = rng.next_float();
+    out.wi = environment_->sample(u1, u2, u3, u4, pdf);
+    if (!(pdf > 0.0f)) return false;
+    out.li = environment_->radiance(out.wi) / (pdf * p_pick);
+  }
+  return max_component(out.li) > 0.0f && is_finite(out.li);
+}
+
+bool Lights::sample_direct(const vec3& receiver, const vec3& normal, Rng& rng,
+                           DirectSample& out) const {
+  size_t k = 0;
+  float p_pick = 0.0f;
+  const float u0 = rng.next_float();
+  if (emitter_count() <= kLocalSelectionMax) {
+    // Few emitters: choose in proportion to radiance x solid angle (or intensity / d^2) seen
+    // from this receiver, so that an emitter close to the receiver is chosen as often as it
+    // matters. With power-proportional choice its rare picks carry huge weights, and the
+    // per-pass samples become heavy-tailed, which breaks the t-interval of the error bound.
+    float weights[kLocalSelectionMax];
+    float sum = 0.0f;
+    for (size_t j = 0; j < emitter_count(); ++j) sum += (weights[j] = local_weight(j, receiver));
+    if (!(sum > 0.0f) || !std::isfinite(sum)) return false;
+    float target = u0 * sum;
+    k = emitter_count() - 1;
+    for (size_t j = 0; j < emitter_count(); ++j) {
+      if (target < weights[j]) {
+        k = j;
+        break;
+      }
+      target -= weights[j];
+    }
+    while (weights[k] == 0.0f && k > 0) --k;  // rounding at the end of the list
+    p_pick = weights[k] / sum;
+    if (!(p_pick > 0.0f)) return false;
+  } else {
+    k = pick(u0);
+    p_pick = probability_[k];
+  }
+  if (k == punctual_.size() + triangles_.size())
+    return sample_environment(normal, p_pick, rng, out);
+  const float u1 = rng.next_float(), u2 = rng.next_float();
+  if (k < punctual_.size()) {
+    const PunctualLight& l = punctual_[k];
+    if (l.kind == PunctualKind::Directional) {  // a delta direction, unoccluded to infinity
+      out.wi = -l.direction;
+      out.distance = INFINITY;
+      out.margin = 0.0f;
+      out.li = l.intensity / p_pick;
+      return max_component(out.li) > 0.0f;
+    }
+    const vec3 d = l.position - receiver;
+    const float dist2 = glm::dot(d, d);
+    if (!(dist2 > 0.0f)) return false;
+    out.distance = std::sqrt(dist2);
+    out.wi = d / out.distance;
+    out.li = spot_falloff(l, -out.wi) / (dist2 * p_pick);
+    out.margin = 0.0f;
+    return max_component(out.li) > 0.0f;
+  }
+  const Triangle& t = triangles_[k - punctual_.size()];
+  const vec3 p1 = t.p0 + t.e1, p2 = t.p0 + t.e2;
+  // A receiver on a one-sided emitter's back side, or in its plane, sees no light from it.
+  const float side = glm::dot(receiver - t.p0, t.normal);
+  if ((t.two_sided ? std::fabs(side) : side) <= plane_tolerance(t, receiver)) return false;
+  vec3 dir;
+  float solid_angle = 0.0f;
+  // Solid-angle sampling only pays near the emitter: from farther than a few times its size,
+  // area sampling is already close to uniform in solid angle, and much cheaper.
+  const vec3 to_centroid = t.p0 + (t.e1 + t.e2) * (1.0f / 3.0f) - receiver;
+  const float size2 = std::max(glm::dot(t.e1, t.e1), glm::dot(t.e2, t.e2));
+  const bool near = glm::dot(to_centroid, to_centroid) < kNearFactor2 * size2;
+  if (near && sample_spherical_triangle(t.p0, p1, p2, receiver, u1, u2, dir, solid_angle)) {
+    // Uniform in solid angle: each sample carries Le times the solid angle, bounded even when
+    // the emitter nearly touches the receiver (area sampling is heavy-tailed there).
+    const float dist = glm::dot(t.p0 - receiver, t.normal) / glm::dot(dir, t.normal);
+    if (!(dist > 0.0f) || !std::isfinite(dist)) return false;
+    out.wi = dir;
+    out.distance = dist;
+    vec3 le = t.radiance;
+    if (t.source >= 0) {  // the point's barycentrics in the piece
+      const vec3 v = receiver + dist * dir - t.p0;
+      const float d00 = glm::dot(t.e1, t.e1), d01 = glm::dot(t.e1, t.e2);
+      const float d11 = glm::dot(t.e2, t.e2), d20 = glm::dot(v, t.e1), d21 = glm::dot(v, t.e2);
+      const float den = d00 * d11 - d01 * d01;
+      const float c1 = std::clamp((d11 * d20 - d01 * d21) / den, 0.0f, 1.0f);
+      const float c2 = std::clamp((d00 * d21 - d01 * d20) / den, 0.0f, 1.0f - c1);
+      le = radiance_at(t, c1, c2);
+    }
+    out.li = le * (solid_angle / p_pick);
+    if (t.coat > 0.0f) out.li *= 1.0f - clearcoat_fresnel(t.coat, glm::dot(dir, t.normal));
+    out.margin = shadow_margin(t, receiver, std::fabs(glm::dot(dir, t.normal)));
+    return max_component(out.li) > 0.0f;
+  }
+  // Tiny or degenerate solid angle: uniform area sampling (pbrt-v4 does the same).
+  const float s = std::sqrt(u1);
+  const vec3 y = t.p0 + (1.0f - s) * t.e1 + (u2 * s) * t.e2;
+  const vec3 d = y - receiver;
+  const float dist2 = glm::dot(d, d);
+  if (!(dist2 > 0.0f)) return false;
+  out.distance = std::sqrt(dist2);
+  out.wi = d / out.distance;
+  float cos_light = -glm::dot(out.wi, t.normal);
+  if (t.two_sided) cos_light = std::fabs(cos_light);
+  if (cos_light <= 0.0f) return false;  // one-sided emitter seen from behind
+  // Area sampling converted to solid angle: Le cos_l A / (d^2 p_pick).
+  const vec3 le = t.source < 0 ? t.radiance : radiance_at(t, 1.0f - s, u2 * s);
+  out.li = le * (cos_light * t.area / (dist2 * p_pick));
+  if (t.coat > 0.0f) out.li *= 1.0f - clearcoat_fresnel(t.coat, cos_light);
+  out.margin = shadow_margin(t, receiver, cos_light);
+  return t.source < 0 || max_component(out.li) > 0.0f;
+}
+
+}  // namespace pb

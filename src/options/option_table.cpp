@@ -1,0 +1,268 @@
+// The option table: every render option once, with its flag, member, range, default, help and
+// kind (options.h). Adding an option means a row here, a member in RenderOptions and the code
+// that uses it; parsing, validation, --help, metadata, the state file and resume follow.
+#include "options/options.h"
+
+#include "options/option_builders.h"
+
+#include <charconv>
+#include <cmath>
+#include <limits>
+
+namespace pb {
+
+namespace {
+
+using namespace option_builders;
+
+OptionSpec resolution() {
+  OptionSpec s =
+      base("--resolution", "resolution", "WxH", "rendering", OptionKind::Image, "image size");
+  const IntRange r{1, 16384};
+  s.range = r.text() + " each";
+  s.unset = "512 wide, camera aspect";
+  auto side = [](const std::string& t) -> long double {
+    if (t.empty() || t.find_first_not_of("0123456789") != std::string::npos) return -1;
+    return t.size() > 9 ? 1e30L : (long double)std::stoull(t);
+  };
+  const std::string bad = "width and height must be in " + r.text();
+  s.parse = [=](RenderOptions& o, const std::string& t) {
+    const size_t x = t.find('x');
+    if (x == std::string::npos) fail("--resolution", "'" + t + "' is not WIDTHxHEIGHT");
+    const long double w = side(t.substr(0, x)), h = side(t.substr(x + 1));
+    if (w < 0 || h < 0) fail("--resolution", "'" + t + "' is not WIDTHxHEIGHT");
+    if (!(w >= 1 && w <= 16384 && h >= 1 && h <= 16384)) fail("--resolution", bad);
+    o.width = int(w);
+    o.height = int(h);
+  };
+  s.check = [=](const RenderOptions& o) {
+    if ((o.width && !(*o.width >= 1 && *o.width <= 16384)) ||
+        (o.height && !(*o.height >= 1 && *o.height <= 16384)))
+      fail("--resolution", bad);
+  };
+  s.format = [](const RenderOptions& o) {
+    return o.width && o.height ? std::to_string(*o.width) + "x" + std::to_string(*o.height) : "";
+  };
+  s.reset = [](RenderOptions& o) {
+    o.width.reset();
+    o.height.reset();
+  };
+  s.accepted = {"1x1", "16384x16384"};
+  s.rejected = {"0x4", "4x16385", "4"};
+  return s;
+}
+
+OptionSpec stop_rule() {
+  OptionSpec s = base("--stop-rule", "stop_rule", "mean-error|mean-bound|pixels:Q", "error bounds",
+                      OptionKind::Adjust,
+                      "what --target-error tests: the image's mean error at the confidence, the "
+                      "mean of the per-pixel bounds (HJJ10), or the share Q of pixels whose bound "
+                      "meets the target");
+  const std::string bad = "is not one of mean-error, mean-bound, pixels:Q with Q in (0, 1]";
+  s.parse = [=](RenderOptions& o, const std::string& t) {
+    if (t == "mean-error") {
+      o.stop_rule = StopRule::MeanError;
+    } else if (t == "mean-bound") {
+      o.stop_rule = StopRule::MeanBound;
+    } else if (t.rfind("pixels:", 0) == 0) {
+      double q = 0.0;
+      const std::string v = t.substr(7);
+      const auto [ptr, ec] = std::from_chars(v.data(), v.data() + v.size(), q);
+      if (v.empty() || ec != std::errc() || ptr != v.data() + v.size() || !(q > 0.0 && q <= 1.0))
+        fail("--stop-rule", "'" + t + "' " + bad);
+      o.stop_rule = StopRule::Pixels;
+      o.stop_fraction = q;
+    } else {
+      fail("--stop-rule", "'" + t + "' " + bad);
+    }
+  };
+  s.check = [=](const RenderOptions& o) {
+    if (o.stop_rule == StopRule::Pixels && !(o.stop_fraction > 0.0 && o.stop_fraction <= 1.0))
+      fail("--stop-rule", "pixels:Q needs Q in (0, 1]");
+  };
+  s.format = [](const RenderOptions& o) -> std::string {
+    switch (o.stop_rule) {
+      case StopRule::MeanError:
+        return "mean-error";
+      case StopRule::MeanBound:
+        return "mean-bound";
+      case StopRule::Pixels:
+        return "pixels:" + number_text(o.stop_fraction);
+    }
+    return "mean-error";
+  };
+  s.reset = [](RenderOptions& o) {
+    o.stop_rule = RenderOptions{}.stop_rule;
+    o.stop_fraction = RenderOptions{}.stop_fraction;
+  };
+  s.accepted = {"mean-error", "mean-bound", "pixels:0.9", "pixels:1"};
+  s.rejected = {"", "mean", "pixels:0", "pixels:1.5", "pixels:", "pixels:x"};
+  return s;
+}
+
+std::vector<OptionSpec> make_table() {
+  using K = OptionKind;
+  const char* stop = "stop conditions (at least one; whichever is reached first)";
+  const char* render = "rendering";
+  const char* bounds = "error bounds";
+  const char* run = "running";
+  const char* ckpt = "checkpoints";
+  const char* measure = "measuring";
+  constexpr double kInf = std::numeric_limits<double>::infinity();
+  std::vector<OptionSpec> t;
+  t.push_back(text(base("-o", "output", "OUT.exr", run, K::Run, "the EXR to write"),
+                   &RenderOptions::output));
+  t.push_back(integer(base("--passes", "passes", "N", stop, K::Stop, "passes to run"),
+                      &RenderOptions::passes, {1, 1000000000000ULL}, "none"));
+  t.push_back(real(base("--time", "time", "S", stop, K::Stop,
+                        "wall-clock budget in seconds (steady clock), checked after each pass"),
+                   &RenderOptions::time_seconds, {0, 1e9, true, false, " seconds", ""}, "none"));
+  t.push_back(real(base("--target-error", "target_error", "E", stop, K::Stop,
+                        "stop when the image is within E (see --stop-rule), at --confidence"),
+                   &RenderOptions::target_error,
+                   {0, kInf, true, true, "", "must be a finite number greater than 0"}, "none"));
+  t.push_back(choice(base("--method", "method", "sppm|ppm", render, K::Image,
+                          "stochastic PPM, whose pixels are area averages (anti-aliased), or PPM "
+                          "with fixed pixel-centre points (HJJ10's setting)"),
+                     &RenderOptions::method, {{"sppm", Method::SPPM}, {"ppm", Method::PPM}}));
+  t.push_back(integer(base("--photons-per-pass", "photons_per_pass", "M", render, K::Image,
+                           "photons emitted per pass (M_e)"),
+                      &RenderOptions::photons_per_pass, {1, 1000000000ULL}));
+  t.push_back(real(base("--alpha", "alpha", "A", render, K::Image,
+                        "PPM radius reduction; 1 never shrinks the radius"),
+                   &RenderOptions::alpha, {0, 1, true, false, "", ""}));
+  t.push_back(real(
+      base("--radius", "radius", "R", render, K::Image, "initial search radius in scene units"),
+      &RenderOptions::radius, {0, 1e30, true, true, "", ""}, "4 pixel footprints"));
+  t.push_back(integer(base("--max-depth", "max_depth", "D", render, K::Image,
+                           "specular bounces a camera path may take"),
+                      &RenderOptions::max_depth, {0, 32}));
+  t.push_back(real(base("--mirror-roughness", "mirror_roughness", "R", render, K::Image,
+                        "GGX lobes with a glTF roughness below R are rendered as perfect mirrors"),
+                   &RenderOptions::mirror_roughness,
+                   {kMinMirrorRoughness, 1, false, false, "", ""}));
+  t.push_back(real(base("--follow-roughness", "follow_roughness", "R", render, K::Image,
+                        "SPPM with next-event direct light: camera paths follow GGX lobes with a "
+                        "roughness below R, and gather photons at their diffuse base; 0: never "
+                        "(rough glass and diffuse transmission are followed at any R)"),
+                   &RenderOptions::follow_roughness, {0, 1, false, false, "", ""}));
+  t.push_back(resolution());
+  t.push_back(text(base("--camera", "camera", "NAME", render, K::Image,
+                        "glTF camera name, \"camera N\" when unnamed"),
+                   &RenderOptions::camera, "first"));
+  constexpr double kWorld = 1e10;  // the loader's limit on world coordinates
+  t.push_back(triple(base("--look-from", "look_from", "X,Y,Z", render, K::Image,
+                          "camera position, replacing the camera's (or the default view's)"),
+                     &RenderOptions::look_from, kWorld, false, "the camera's"));
+  t.push_back(triple(base("--look-at", "look_at", "X,Y,Z", render, K::Image,
+                          "point the camera looks at (with --look-from alone: the bounds' centre)"),
+                     &RenderOptions::look_at, kWorld, false, "the camera's"));
+  t.push_back(
+      triple(base("--up", "up", "X,Y,Z", render, K::Image, "direction that is up in the image"),
+             &RenderOptions::up, kWorld, true, "the camera's, or +Y"));
+  t.push_back(real(base("--fov", "fov", "DEGREES", render, K::Image,
+                        "vertical field of view, replacing the camera's"),
+                   &RenderOptions::fov, {0, 180, true, true, "", ""}, "the camera's, or 45"));
+  t.push_back(
+      environment(base("--environment", "environment", "COLOR|FILE.exr|FILE.hdr", render, K::Image,
+                       "environment light: radiance V or R,G,B, or an equirectangular map "
+                       "(centre column -Z, top row +Y)"),
+                  "none; 1 without lights"));
+  t.push_back(real(base("--environment-scale", "environment_scale", "S", render, K::Image,
+                        "factor on the environment's radiance"),
+                   &RenderOptions::environment_scale, {0, 1e30, true, false, "", ""}));
+  t.push_back(integer(base("--threads", "threads", "T", run, K::Run,
+                           "worker threads, 0 = all; the image does not depend on it"),
+                      &RenderOptions::threads, {0, 1024}));
+  t.push_back(integer(base("--seed", "seed", "S", render, K::Image,
+                           "random seed; same seed, same image, bit for bit"),
+                      &RenderOptions::seed, {0, UINT64_MAX}));
+  t.push_back(choice(base("--direct", "direct", "nee|photons", render, K::Image,
+                          "direct light by next-event estimation, or from photons"),
+                     &RenderOptions::direct,
+                     {{"nee", DirectMode::NextEvent}, {"photons", DirectMode::Photons}}));
+  t.push_back(real(base("--confidence", "confidence", "C", bounds, K::Adjust,
+                        "confidence 1 - beta of the error bounds"),
+                   &RenderOptions::confidence, {0, 1, true, true, "", ""}));
+  t.push_back(integer(base("--min-passes", "min_passes", "N", bounds, K::Adjust,
+                           "passes before the first stop test"),
+                      &RenderOptions::min_passes, {2, 1000000000000ULL}));
+  t.push_back(choice(base("--error-metric", "error_metric", "absolute|relative", bounds, K::Adjust,
+                          "what --target-error measures; relative divides by max(L, 0.01 x "
+                          "image mean)"),
+                     &RenderOptions::metric,
+                     {{"absolute", ErrorMetric::Absolute}, {"relative", ErrorMetric::Relative}}));
+  t.push_back(stop_rule());
+  OptionSpec progress = choice(base("--progress", "progress", "", run, K::Run,
+                                    "progress lines on stderr (pass, photons, the tested quantity "
+                                    "against the target, unknown "
+                                    "pixels, elapsed, time left); auto = on a terminal"),
+                               &RenderOptions::progress,
+                               {{"auto", ProgressMode::Auto},
+                                {"always", ProgressMode::Always},
+                                {"never", ProgressMode::Never}});
+  progress.switches = {{"--progress", "always"}, {"--quiet", "never"}};
+  t.push_back(std::move(progress));
+  t.push_back(real(base("--checkpoint-every", "checkpoint_every", "S", ckpt, K::Run,
+                        "write the EXR and the state every S seconds"),
+                   &RenderOptions::checkpoint_every, {0, 1e9, true, false, " seconds", ""},
+                   "none"));
+  t.push_back(text(base("--state", "state", "FILE", ckpt, K::Run,
+                        "where the state goes (OUT with the extension .pbstate)"),
+                   &RenderOptions::state_path, "OUT.pbstate"));
+  t.push_back(text(base("--resume", "resume", "STATE", ckpt, K::Run,
+                        "continue the render saved in STATE (scene and image options must match)"),
+                   &RenderOptions::resume_from, "none"));
+  t.push_back(text(base("--log", "log", "FILE.jsonl", measure, K::Run,
+                        "per-pass JSON log (\"Measuring the trade\")"),
+                   &RenderOptions::log_path, "none"));
+  t.push_back(text(base("--reference", "reference", "REF.exr", measure, K::Run,
+                        "with --log: add the actual error and coverage against this image"),
+                   &RenderOptions::reference_path, "none"));
+  return t;
+}
+
+}  // namespace
+
+std::string OptionSpec::display(const RenderOptions& o) const {
+  const std::string v = format(o);
+  return v.empty() ? unset : v;
+}
+
+const std::vector<OptionSpec>& option_table() {
+  static const std::vector<OptionSpec> table = make_table();
+  return table;
+}
+
+const OptionSpec* find_option(std::string_view flag) {
+  for (const OptionSpec& s : option_table()) {
+    if (s.switches.empty() && s.flag == flag) return &s;
+    for (const auto& [f, v] : s.switches)
+      if (f == flag) return &s;
+  }
+  return nullptr;
+}
+
+const OptionSpec& option(std::string_view key) {
+  for (const OptionSpec& s : option_table())
+    if (s.key == key) return s;
+  throw std::logic_error("no option with key " + std::string(key));
+}
+
+bool environment_is_map(const std::string& text) { return is_map_file(text); }
+
+std::array<double, 3> environment_colour(const std::string& text) {
+  std::vector<double> v;
+  if (!parse_numbers(text, v) || (v.size() != 1 && v.size() != 3))
+    throw UsageError("--environment: '" + text + "' is not a colour");
+  return v.size() == 3 ? std::array<double, 3>{v[0], v[1], v[2]}
+                       : std::array<double, 3>{v[0], v[0], v[0]};
+}
+
+std::string number_text(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
+}  // namespace pb

@@ -1,0 +1,251 @@
+#include "render/pass_stages.h"
+
+#include "render/camera_paths.h"
+#include "render/next_event.h"
+
+#include "util/parallel.h"
+
+#include "estimator/kernel.h"
+
+#include <algorithm>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace pb {
+
+namespace {
+
+// A checkpoint snapshot is written once and read later by another thread: non-temporal stores
+// skip reading the destination's cache lines first and leave the cache to the pass's own data.
+// PointState is 208 bytes (16-byte multiple) and the vector's storage is 16-byte aligned.
+void stream_copy(PointState* dst, const PointState& src) {
+#if defined(__SSE2__)
+  static_assert(sizeof(PointState) % 16 == 0 && alignof(std::max_align_t) >= 16);
+  const __m128i* s = reinterpret_cast<const __m128i*>(&src);
+  __m128i* d = reinterpret_cast<__m128i*>(dst);
+  for (size_t i = 0; i < sizeof(PointState) / 16; ++i)
+    _mm_stream_si128(d + i, _mm_loadu_si128(s + i));
+#else
+  *dst = src;
+#endif
+}
+
+void store_fence() {
+#if defined(__SSE2__)
+  _mm_sfence();
+#endif
+}
+
+}  // namespace
+
+void build_photon_grid(const std::vector<PhotonHit>& hits, std::span<const float> radii,
+                       std::vector<vec3>& positions, HashGrid& grid) {
+  positions.resize(hits.size());
+  parallel_for(hits.size(), 16384, [&](size_t begin, size_t end) {
+    for (size_t k = begin; k < end; ++k) positions[k] = hits[k].position;
+  });
+  grid.build(positions, radii);
+}
+
+namespace {
+
+// The kernel sums of one point; photon_flux(h) is what a photon brings before the point's f:
+// its power (Lambertian points, whose constant f is multiplied once below) or its power times
+// f(wo, wi) (glossy points, whose f holds the path weight alone).
+template <bool kLaplacian, class PhotonFlux>
+void gather_kernel(const MeasurementPoint& point, double r2, const HashGrid& grid,
+                   const std::vector<PhotonHit>& hits, PhotonFlux&& photon_flux, PassGather& out) {
+  const float radius = search_radius(r2);
+  const double inv_r2 = 1.0 / r2;
+  dvec3 phi(0.0), lap(0.0), half(0.0);
+  uint64_t count = 0;
+  grid.query(point.position, radius, [&](uint32_t k, float dist2) {
+    const PhotonHit& h = hits[k];
+    // Same side only (ESTIMATOR.md section 3): the photon must arrive from the half-space the
+    // point is seen from, on a surface facing the same way (not the back of a thin wall).
+    const float cos_g = glm::dot(h.wi, point.normal);
+    if (cos_g <= 0.0f || glm::dot(h.normal, point.normal) <= 0.0f) return;
+    const float cos_s = glm::dot(h.wi, point.shading);
+    ++count;  // it could contribute, so it counts toward the radius reduction
+    if (cos_s <= 0.0f) return;
+    // Photon density is flux per area of the true surface; reflected radiance integrates
+    // against the shading cosine, hence cos_s / cos_g.
+    const dvec3 flux = photon_flux(h) * double(cos_s / cos_g);
+    const double t = std::min(1.0, std::sqrt(double(dist2) * inv_r2));
+    phi += kernel::weight(t) * flux;
+    if constexpr (kLaplacian) {
+      lap += kernel::laplacian_weight_r2(t) * flux;
+      if (t < 0.5) half += kernel::weight(2.0 * t) * flux;
+    }
+  });
+  const dvec3 f(point.f);
+  out.phi += f * phi;
+  if constexpr (kLaplacian) {
+    out.phi_lap_r2 += f * lap;
+    out.phi_half += f * half;
+  }
+  out.count += count;
+}
+
+// Walks a GlossyTable alongside the points of its span, in order.
+class GlossyCursor {
+ public:
+  GlossyCursor(const GlossyTable& t, size_t count) : t_(t), end_(t.base + count) {
+    it_ = std::lower_bound(t.entries.begin(), t.entries.end(), t.base,
+                           [](const GlossyPoint& g, size_t i) { return g.point < i; });
+  }
+  // The entry of point k of the span, or null when that point is Lambertian (k ascending).
+  const GlossyPoint* at(size_t k) {
+    const size_t i = t_.base + k;
+    while (it_ != t_.entries.end() && it_->point < i) ++it_;
+    return it_ != t_.entries.end() && it_->point == i && i < end_ ? &*it_ : nullptr;
+  }
+
+ private:
+  GlossyTable t_;
+  size_t end_;
+  std::span<const GlossyPoint>::iterator it_;
+};
+
+}  // namespace
+
+template <bool kLaplacian>
+void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& grid,
+                    const std::vector<PhotonHit>& hits, PassGather& out) {
+  gather_kernel<kLaplacian>(
+      point, r2, grid, hits, [](const PhotonHit& h) { return dvec3(h.flux); }, out);
+}
+
+template <bool kLaplacian>
+void gather_photons(const MeasurementPoint& point, const GlossyPoint& glossy, double r2,
+                    const HashGrid& grid, const std::vector<PhotonHit>& hits, PassGather& out) {
+  gather_kernel<kLaplacian>(
+      point, r2, grid, hits,
+      [&](const PhotonHit& h) { return dvec3(h.flux * glossy.bsdf.eval(glossy.wo, h.wi)); }, out);
+}
+
+template void gather_photons<true>(const MeasurementPoint&, double, const HashGrid&,
+                                   const std::vector<PhotonHit>&, PassGather&);
+template void gather_photons<false>(const MeasurementPoint&, double, const HashGrid&,
+                                    const std::vector<PhotonHit>&, PassGather&);
+template void gather_photons<true>(const MeasurementPoint&, const GlossyPoint&, double,
+                                   const HashGrid&, const std::vector<PhotonHit>&, PassGather&);
+template void gather_photons<false>(const MeasurementPoint&, const GlossyPoint&, double,
+                                    const HashGrid&, const std::vector<PhotonHit>&, PassGather&);
+
+void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
+                 const HashGrid& grid, const std::vector<PhotonHit>& hits,
+                 const BoundaryIndex* boundary, GlossyTable glossy, std::span<PassGather> out,
+                 std::span<const float> clearance) {
+  GlossyCursor cursor(glossy, points.size());
+  for (size_t k = 0; k < points.size(); ++k) {
+    const MeasurementPoint& p = points[k];
+    if (!(max_component(p.f) > 0.0f)) continue;  // SPPM: a pixel without a visible point
+    if (const GlossyPoint* g = cursor.at(k))
+      gather_photons(p, *g, states[k].r2, grid, hits, out[k]);
+    else
+      gather_photons(p, states[k].r2, grid, hits, out[k]);
+    const float r = search_radius(states[k].r2);
+    if (boundary && (clearance.empty() || r > clearance[k]))
+      out[k].disc = boundary->moments(p.triangle, p.position, p.normal, r);
+  }
+}
+
+void next_event_pass(const World& world, std::span<const MeasurementPoint> points,
+                     GlossyTable glossy, uint64_t seed, uint64_t pass, size_t first,
+                     std::span<PassGather> out) {
+  GlossyCursor cursor(glossy, points.size());
+  for (size_t k = 0; k < points.size(); ++k) {
+    if (!(max_component(points[k].f) > 0.0f)) continue;
+    const GlossyPoint* g = cursor.at(k);
+    if (g && g->bsdf.is_base_part()) continue;  // its camera path counted its direct light
+    Rng rng(seed, pass, first + k, Stream::DirectLight);
+    out[k].direct += direct_light(world, points[k], g, rng);
+  }
+}
+
+void fold_pass(std::span<PointState> states, std::span<const PassGather> sums,
+               const EstimatorParams& params, uint64_t pass, std::span<float> radii,
+               PointState* copy) {
+  for (size_t k = 0; k < states.size(); ++k) {
+    accumulate_pass(states[k], sums[k], params, pass);
+    radii[k] = search_radius(states[k].r2);
+    if (copy) stream_copy(copy + k, states[k]);
+  }
+  if (copy) store_fence();  // the streamed stores are visible before the writer reads them
+}
+
+void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> points,
+                     std::span<PointState> states, std::span<float> radii,
+                     std::span<PassGather> sums, PointState* copy) {
+  constexpr size_t kGrain = 256;  // points per parallel task inside a block
+  const size_t n = states.size(), block = sums.size();
+  for (size_t first = 0; first < n; first += block) {
+    const size_t count = std::min(block, n - first);
+    parallel_for(count, kGrain, [&](size_t b, size_t e) {
+      const std::span<PassGather> out = sums.subspan(b, e - b);
+      std::fill(out.begin(), out.end(), PassGather{});
+      const GlossyTable glossy{in.glossy, first + b};
+      gather_pass(points.subspan(first + b, e - b),
+                  std::span<const PointState>(states).subspan(first + b, e - b), in.grid, in.hits,
+                  in.boundary, glossy, out,
+                  in.clearance.empty() ? in.clearance : in.clearance.subspan(first + b, e - b));
+      if (in.next_event)
+        next_event_pass(in.world, points.subspan(first + b, e - b), glossy, in.seed, in.pass,
+                        first + b, out);
+    });
+    // A distributed render reduces sums[0, count) across machines here.
+    parallel_for(count, kGrain, [&](size_t b, size_t e) {
+      fold_pass(states.subspan(first + b, e - b),
+                std::span<const PassGather>(sums).subspan(b, e - b), in.params, in.pass,
+                radii.subspan(first + b, e - b), copy ? copy + first + b : nullptr);
+    });
+  }
+}
+
+void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
+                          std::span<PointState> states, std::span<float> radii,
+                          std::span<uint32_t> visible, std::span<float> min_mass,
+                          std::span<float> glossy_f, std::span<MeasurementPoint> points,
+                          std::span<GlossyPoint> glossy, std::span<PassGather> sums,
+                          PointState* copy) {
+  constexpr size_t kGrain = 256;  // pixels per parallel task inside a block
+  const size_t n = states.size(), block = sums.size();
+  for (size_t first = 0; first < n; first += block) {
+    const size_t count = std::min(block, n - first);
+    parallel_for(count, kGrain, [&](size_t b, size_t e) {
+      const std::span<MeasurementPoint> pts = points.subspan(b, e - b);
+      const std::span<PassGather> out = sums.subspan(b, e - b);
+      const std::span<GlossyPoint> scratch = glossy.subspan(b, e - b);
+      const std::span<const float> r = std::span<const float>(radii).subspan(first + b, e - b);
+      const size_t n_glossy = trace_visible_points(camera, first + b, r, pts, scratch, out);
+      const GlossyTable table{scratch.first(n_glossy), 0};  // indices into pts
+      // The camera paths left each visible point's disc moments in out (boundary null here).
+      gather_pass(pts, std::span<const PointState>(states).subspan(first + b, e - b), in.grid,
+                  in.hits, nullptr, table, out);
+      if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, first + b, out);
+      for (size_t k = 0; k < pts.size(); ++k) {
+        if (!(max_component(pts[k].f) > 0.0f)) continue;
+        const size_t pixel = first + b + k;
+        if (visible[pixel] != UINT32_MAX) ++visible[pixel];  // saturating: far beyond use
+        min_mass[pixel] = std::min(min_mass[pixel], float(out[k].disc.mass));
+      }
+      for (const GlossyPoint& g : table.entries) {  // only while the cap can still matter
+        const size_t pixel = first + b + g.point;
+        if (states[pixel].photons >= kMinPhotonsForBound) continue;
+        const float f = max_component(pts[g.point].f * g.bsdf.max_f(g.wo));
+        glossy_f[pixel] = std::max(glossy_f[pixel], f);
+      }
+    });
+    // A distributed render reduces sums[0, count) across machines here.
+    parallel_for(count, kGrain, [&](size_t b, size_t e) {
+      fold_pass(states.subspan(first + b, e - b),
+                std::span<const PassGather>(sums).subspan(b, e - b), in.params, in.pass,
+                radii.subspan(first + b, e - b), copy ? copy + first + b : nullptr);
+    });
+  }
+}
+
+}  // namespace pb

@@ -1,0 +1,69 @@
+// Renderer::image: the EXR layout (channels.def) and its metadata.
+#include "render/renderer.h"
+
+#include "estimator/channels.h"
+
+namespace pb {
+
+ExrImage pack_channels(const FilmImage& film) {
+  ExrImage out;
+  out.width = film.width;
+  out.height = film.height;
+  out.channels = channel_names();
+  const size_t pixels = size_t(film.width) * size_t(film.height);
+  const size_t nc = out.channels.size();
+  out.pixels.resize(pixels * nc);
+  size_t first = 0;  // first channel of the group
+  for (const ChannelGroup& g : kChannelGroups) {
+    const std::vector<float>& plane = film.plane(g.id);
+    const size_t n = g.kind == ChannelKind::RGB ? 3 : 1;
+    for (size_t p = 0; p < pixels; ++p)
+      for (size_t k = 0; k < n; ++k) out.pixels[p * nc + first + k] = plane[n * p + k];
+    first += n;
+  }
+  return out;
+}
+
+ExrImage Renderer::image(const RunInfo& run) const { return image(run, view()); }
+
+ExrImage Renderer::image(const RunInfo& run, const RenderState& state) const {
+  return image(run, view(state));
+}
+
+ExrImage Renderer::image(const RunInfo& run, const View& v) const {
+  FilmImage film;
+  const FilmSummary summary = develop(v, &film);
+  ExrImage out = pack_channels(film);
+  out.metadata = describe(options_);
+  out.metadata.insert(out.metadata.end(),
+                      {
+                          {"version", PHOTONBOUND_VERSION},
+                          {"command_line", options_.command_line},
+                          {"passes_done", std::to_string(v.work.passes)},
+                          {"photons_emitted", std::to_string(v.work.photons)},
+                          {"seconds", number_text(run.seconds)},
+                          {"stop_reason", run.stop_reason},
+                          {"initial_radius", number_text(v.initial_radius)},
+                          {"mean_error_bound", number_text(summary.mean_bound)},
+                          {"unknown_pixels", std::to_string(summary.unknown_pixels)},
+                          {"estimator_states", std::to_string(v.states.size())},
+                      });
+  // The view rendered, in the file's coordinates: the values of --look-from, --look-at, --up
+  // and --fov that reproduce it here or frame it in another renderer (the entries above say
+  // only how it was chosen, e.g. "the camera's, or 45").
+  const Camera& c = camera_.camera();
+  const dvec3 origin = world_.scene().origin;
+  auto triple = [](const dvec3& p) {
+    return number_text(p.x) + "," + number_text(p.y) + "," + number_text(p.z);
+  };
+  out.metadata.insert(out.metadata.end(),
+                      {
+                          {"view_from", triple(dvec3(c.position) + origin)},
+                          {"view_at", triple(dvec3(c.position + c.forward) + origin)},
+                          {"view_up", triple(dvec3(c.up))},
+                          {"view_fov", number_text(double(c.yfov) * 180.0 / kPiD)},
+                      });
+  return out;
+}
+
+}  // namespace pb

@@ -1,0 +1,91 @@
+// Where the surface under a kernel disc ends (ESTIMATOR.md section 11). At a point a distance d
+// from an edge of its surface, the disc of radius R reaches past the edge, where no photon can
+// land; the kernel estimate is then about c L, with c the share of the kernel's mass on the
+// surface, and the Laplacian kernel no longer integrates to zero. Only the geometry can give c
+// (photons cannot tell "no surface" from "no light"), so the index below finds, once per scene,
+// every segment where a surface ends as the gather sees it:
+//  - border edges of a triangle (no neighbour shares them) and creases whose neighbour faces
+//    away (normals at 90 degrees or more: the gather's same-side test rejects its photons);
+//  - blockers: other geometry rising from a surface (a block standing on a floor), cut with the
+//    surface's plane;
+// and lists, per triangle, the segments within the largest radius of it. moments() then
+// integrates the kernel over the part of the disc visible from the point within those
+// segments, in polar coordinates about the point (the star-shaped region of the disc the point
+// sees along its surface).
+#pragma once
+
+#include "estimator/disc_moments.h"
+#include "util/math.h"
+
+#include <cstdint>
+#include <vector>
+
+namespace pb {
+
+class World;
+
+
+class BoundaryIndex {
+ public:
+  BoundaryIndex() = default;
+  // Segments of `world` and, per triangle, those within max_radius of it.
+  BoundaryIndex(const World& world, float max_radius);
+
+  // The disc of radius r about p, a point of triangle `triangle` whose normal on the side it is
+  // seen from is n. r must not exceed the index's max_radius.
+  DiscMoments moments(uint32_t triangle, const vec3& p, const vec3& n, float r) const;
+  // A radius up to which moments(triangle, p, n, radius) is the whole disc: the distance from p
+  // to the nearest segment within r, rounded down, or r when none is. PPM's points are fixed
+  // and their radii only shrink, so one call per point at the initial radius spares every later
+  // pass the segment scan of the points far from an edge.
+  float clearance(uint32_t triangle, const vec3& p, float r) const;
+
+  size_t segment_count() const { return segments_.size(); }
+  // The index was given up (more than kPairBudget + 16 per triangle segment-triangle pairs
+  // within the radius): every disc counts as whole.
+  bool truncated() const { return truncated_; }
+  static constexpr size_t kPairBudget = size_t(1) << 24;
+  size_t memory_bytes() const;
+
+  // Directions of the polar quadrature.
+  static constexpr int kDirections = 64;
+
+ private:
+  struct Segment {
+    vec3 a, b;
+    // Its bounding sphere (midpoint, half length): moments() rejects the far segments of a
+    // large triangle's list with it before the exact distance.
+    vec3 mid{0.0f};
+    float half = 0.0f;
+  };
+  std::vector<Segment> segments_;
+  std::vector<uint32_t> start_;  // triangle t's segments: list_[start_[t], start_[t + 1])
+  std::vector<uint32_t> list_;
+  // The list in runs of kGroup entries, each with a bounding sphere of its segments, and the
+  // runs in runs of kGroup again (kGroup^2 entries): a floor under a tessellated sphere lists
+  // hundreds of short cuts of the sphere's foot, and a point far from them skips each run with
+  // one test. Triangle t's runs of level l: groups_[l][group_start_[l][t], ...).
+  static constexpr uint32_t kGroup = 8;
+  struct Group {
+    vec3 centre{0.0f};
+    float radius = 0.0f;
+  };
+  std::vector<uint32_t> group_start_[2];
+  std::vector<Group> groups_[2];
+  // Calls visit(segment) for triangle t's listed segments in list order, skipping every run
+  // (of kGroup^2, then of kGroup) whose bounding sphere skip(group) rejects, until visit returns
+  // false. moments() and clearance() both scan this way.
+  template <class Skip, class Visit>
+  void scan(uint32_t triangle, Skip&& skip, Visit&& visit) const;
+  std::vector<vec3> centre_;  // of triangles with segments (zero elsewhere)
+  bool truncated_ = false;
+};
+
+// The radial integrals of moments(), in closed form (kernel.h's quintic), for 0 <= a <= 1:
+// G(a) = integral from 0 to a of g(t) t dt for g = kappa, |u|^2 kappa, lap kappa, |u|^2 lap kappa.
+double kernel_mass_to(double a);
+double kernel_second_to(double a);
+double laplacian_mass_to(double a);
+double laplacian_second_to(double a);
+
+}  // namespace pb

@@ -1,0 +1,370 @@
+// Checkpoints, resume and interruption (README "Checkpoints").
+#include "process_fixture.h"
+#include "render_fixture.h"
+
+#include "app/checkpoint.h"
+#include "app/checkpoint_writer.h"
+#include "io/image_io.h"
+
+#include <gtest/gtest.h>
+
+#include <fcntl.h>
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <thread>
+#include <vector>
+
+extern char** environ;
+
+namespace pb {
+namespace {
+
+namespace fs = std::filesystem;
+
+class Checkpoints : public test::TempDirTest {};
+
+RenderOptions small_options() {
+  RenderOptions o = test::quick_options("cornell.gltf", 32, 8);
+  o.photons_per_pass = 10000;
+  return o;
+}
+
+SavedRender saved_after(const RenderOptions& o, uint64_t passes) {
+  const Scene scene = load_gltf(o.scene);
+  Renderer r(scene, o);
+  while (r.passes() < passes) r.step();
+  return {o, scene.content_hash, r.snapshot(), DriverState{}};
+}
+
+// Continuing from a state file gives the image of an uninterrupted render, bit for bit.
+void expect_resume_bit_identical(const RenderOptions& o, const std::string& state_path);
+
+TEST_F(Checkpoints, ResumeIsBitIdentical) {
+  expect_resume_bit_identical(small_options(), path("half.pbstate"));
+}
+
+// SPPM: the per-pixel states, visible-pass counters and kernel masses go through the state file
+// too, and the camera paths after the resume are keyed by the same (seed, pass, pixel).
+TEST_F(Checkpoints, ResumeIsBitIdenticalWithSppm) {
+  RenderOptions o = small_options();
+  o.method = Method::SPPM;
+  expect_resume_bit_identical(o, path("half.pbstate"));
+}
+
+void expect_resume_bit_identical(const RenderOptions& o, const std::string& state_path) {
+  const Scene scene = load_gltf(o.scene);
+  Renderer straight(scene, o);
+  const RenderReport full = test::run_to_stop(straight);
+
+  save_state(state_path, saved_after(o, 3));
+  const SavedRender loaded = load_state(state_path);
+  Renderer resumed(scene, o);
+  resumed.restore(loaded.render);
+  EXPECT_EQ(resumed.passes(), 3u);
+  const RenderReport rest = test::run_to_stop(resumed, loaded.schedule);
+  EXPECT_EQ(rest.work.passes, full.work.passes);
+  EXPECT_EQ(rest.work.photons, full.work.photons);
+  ASSERT_EQ(resumed.states().size(), straight.states().size());
+  EXPECT_EQ(std::memcmp(resumed.states().data(), straight.states().data(),
+                        straight.states().size() * sizeof(PointState)),
+            0);
+  const ExrImage a = straight.image(full.run()), b = resumed.image(rest.run());
+  EXPECT_EQ(std::memcmp(a.pixels.data(), b.pixels.data(), a.pixels.size() * sizeof(float)), 0);
+}
+
+// Checkpoints written on the background thread: each snapshot is the render exactly as one pass
+// left it (its states equal a render stepped to that pass), checkpointing does not change the
+// render, and resuming from any snapshot finishes bit-identical to the uninterrupted render.
+TEST_F(Checkpoints, BackgroundSnapshotsAreExactAndResumeBitIdentical) {
+  RenderOptions o = small_options();
+  o.passes = 10;
+  const Scene scene = load_gltf(o.scene);
+  Renderer straight(scene, o);
+  test::run_to_stop(straight);
+  const size_t bytes = straight.states().size() * sizeof(PointState);
+
+  std::mutex m;
+  std::vector<SavedRender> snaps;
+  // Every 1e-9 s: whenever the writer is idle.
+  CheckpointWriter writer(1e-9, o, 0, [&](const SavedRender& s) {
+    std::lock_guard<std::mutex> lock(m);
+    snaps.push_back(s);
+  });
+  Renderer checkpointed(scene, o);
+  PassObserver* observers[] = {&writer};
+  Driver(checkpointed).run(nullptr, observers);
+  EXPECT_EQ(std::memcmp(checkpointed.states().data(), straight.states().data(), bytes), 0);
+  // The writer is idle at pass 1, so there is at least that snapshot; how many more depends on
+  // scheduling, and each is checked the same way.
+  ASSERT_GE(snaps.size(), 1u);
+  EXPECT_EQ(snaps.front().render.work.passes, 1u);
+  EXPECT_EQ(writer.checkpoints(), snaps.size());
+
+  for (const SavedRender& s : snaps) {
+    SCOPED_TRACE("snapshot after pass " + std::to_string(s.render.work.passes));
+    ASSERT_LT(s.render.work.passes, *o.passes);      // the last pass is the caller's to write
+    EXPECT_EQ(s.schedule.next_check, o.min_passes);  // the driver's schedule is saved too
+    Renderer stepped(scene, o);
+    while (stepped.passes() < s.render.work.passes) stepped.step();
+    EXPECT_EQ(std::memcmp(s.render.states.data(), stepped.states().data(), bytes), 0);
+    Renderer resumed(scene, o);
+    resumed.restore(s.render);
+    test::run_to_stop(resumed, s.schedule);
+    EXPECT_EQ(std::memcmp(resumed.states().data(), straight.states().data(), bytes), 0);
+  }
+}
+
+// A write that fails is reported by run(), not lost on the background thread.
+TEST_F(Checkpoints, FailedBackgroundWriteIsRethrown) {
+  RenderOptions o = small_options();
+  o.passes = 6;
+  const Scene scene = load_gltf(o.scene);
+  CheckpointWriter writer(1e-9, o, 0, [](const SavedRender&) {
+    throw StateError("out.pbstate: cannot write (No space left on device)");
+  });
+  Renderer r(scene, o);
+  PassObserver* observers[] = {&writer};
+  try {
+    Driver(r).run(nullptr, observers);
+    ADD_FAILURE() << "run() returned";
+  } catch (const StateError& e) {
+    EXPECT_NE(std::string(e.what()).find("No space left"), std::string::npos);
+  }
+}
+
+TEST_F(Checkpoints, StateRoundTripsExactly) {
+  const SavedRender s = saved_after(small_options(), 2);
+  save_state(path("s.pbstate"), s);
+  const SavedRender t = load_state(path("s.pbstate"));
+  EXPECT_EQ(t.render.work.passes, 2u);
+  EXPECT_EQ(t.scene_hash, s.scene_hash);
+  EXPECT_EQ(t.options.seed, s.options.seed);
+  EXPECT_EQ(t.options.width, s.options.width);
+  ASSERT_EQ(t.render.states.size(), s.render.states.size());
+  EXPECT_EQ(std::memcmp(t.render.states.data(), s.render.states.data(),
+                        s.render.states.size() * sizeof(PointState)),
+            0);
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const StateError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST_F(Checkpoints, BadStateFilesAreRefusedWithTheirReason) {
+  save_state(path("good.pbstate"), saved_after(small_options(), 1));
+  std::ifstream in(path("good.pbstate"), std::ios::binary);
+  const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  auto write = [&](const std::string& name, const std::string& content) {
+    std::ofstream(path(name), std::ios::binary) << content;
+    return path(name);
+  };
+  const std::string truncated = write("truncated.pbstate", bytes.substr(0, bytes.size() / 2));
+  EXPECT_NE(error_of([&] { load_state(truncated); }).find("truncated"), std::string::npos);
+  const std::string stub = write("stub.pbstate", bytes.substr(0, 20));
+  EXPECT_NE(error_of([&] { load_state(stub); }).find("truncated"), std::string::npos);
+
+  std::string flipped = bytes;
+  flipped[bytes.size() / 2] ^= 0x10;
+  const std::string corrupted = write("corrupted.pbstate", flipped);
+  EXPECT_NE(error_of([&] { load_state(corrupted); }).find("checksum"), std::string::npos);
+
+  std::string other_version = bytes;
+  other_version[8] = char(kStateVersion + 1);
+  const std::string version = write("version.pbstate", other_version);
+  EXPECT_NE(error_of([&] { load_state(version); }).find("version"), std::string::npos);
+
+  const std::string text = write("text.pbstate", "hello, I am not a state file at all\n");
+  EXPECT_NE(error_of([&] { load_state(text); }).find("not a photonbound state"), std::string::npos);
+  EXPECT_NE(error_of([&] { load_state(path("missing.pbstate")); }).find("cannot open"),
+            std::string::npos);
+  // Every message names the file.
+  EXPECT_NE(error_of([&] { load_state(corrupted); }).find("corrupted.pbstate"), std::string::npos);
+}
+
+TEST_F(Checkpoints, MismatchedSceneAndOptionsAreNamed) {
+  const RenderOptions o = small_options();
+  const SavedRender s = saved_after(o, 1);
+  EXPECT_TRUE(differences(s, o, s.scene_hash).empty());
+  RenderOptions changed = o;
+  changed.alpha = 0.5;
+  changed.seed = 9;
+  const auto d = differences(s, changed, s.scene_hash);
+  ASSERT_EQ(d.size(), 2u);
+  EXPECT_EQ(d[0], "alpha: 0.7 in the state, 0.5 now");
+  EXPECT_EQ(d[1], "seed: 1 in the state, 9 now");
+  const auto scene = differences(s, o, s.scene_hash + 1);
+  ASSERT_EQ(scene.size(), 1u);
+  EXPECT_NE(scene[0].find("scene"), std::string::npos);
+  // Options that do not change the image may differ.
+  RenderOptions harmless = o;
+  harmless.threads = 1;
+  harmless.passes = 1000;
+  harmless.confidence = 0.5;
+  EXPECT_TRUE(differences(s, harmless, s.scene_hash).empty());
+  // A state whose points do not fit the camera is refused by restore.
+  RenderOptions other = o;
+  other.width = 16;
+  other.height = 16;
+  const Scene sc = load_gltf(o.scene);
+  Renderer r(sc, other);
+  EXPECT_THROW(r.restore(s.render), StateError);
+}
+
+// ---- The executable under signals -------------------------------------------------------
+
+pid_t spawn(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  pid_t pid = -1;
+  posix_spawn(&pid, PHOTONBOUND_EXE, &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  return pid;
+}
+
+// Waits (at most 60 s) for a file to appear; false if it never does.
+bool wait_for(const std::string& file) {
+  for (int k = 0; k < 600; ++k) {
+    if (fs::exists(file)) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return false;
+}
+
+// Waits until process pid catches `sig` (its handler is installed: the SigCgt mask of
+// /proc/PID/status), so that a signal sent then is the program's to handle, however slowly a
+// loaded machine starts it.
+bool wait_for_handler(pid_t pid, int sig) {
+  for (int k = 0; k < 600; ++k) {
+    std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+    for (std::string line; std::getline(status, line);)
+      if (line.rfind("SigCgt:", 0) == 0 &&
+          (std::stoull(line.substr(7), nullptr, 16) >> (sig - 1)) & 1u)
+        return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
+}
+
+std::string meta(const ExrImage& img, const std::string& key) {
+  for (const auto& [k, v] : img.metadata)
+    if (k == key) return v;
+  return "";
+}
+
+std::vector<std::string> long_render(const std::string& out, double every) {
+  std::vector<std::string> a = {"photonbound",
+                                "render",
+                                test::scene_path("cornell.gltf"),
+                                "-o",
+                                out,
+                                "--passes",
+                                "1000000",
+                                "--resolution",
+                                "48x48",
+                                "--photons-per-pass",
+                                "20000",
+                                "--quiet"};
+  if (every > 0.0) {
+    a.push_back("--checkpoint-every");
+    a.push_back(std::to_string(every));
+  }
+  return a;
+}
+
+// kill -9 at arbitrary moments never leaves a half-written image or state: each is renamed
+// into place complete, and the state never claims passes the image lacks.
+TEST_F(Checkpoints, KillNineLeavesLoadableFiles) {
+  const std::string out = path("k.exr"), state = path("k.pbstate");
+  for (int trial = 0; trial < 5; ++trial) {
+    // A fresh start each trial: the previous trial's state would satisfy wait_for() at once
+    // and would be compared with this trial's (younger) image.
+    fs::remove(out);
+    fs::remove(state);
+    const pid_t pid = spawn(long_render(out, 0.02));
+    ASSERT_GT(pid, 0);
+    ASSERT_TRUE(wait_for(state));
+    // A different moment in each trial: 0 to 400 ms after the first checkpoint.
+    std::this_thread::sleep_for(std::chrono::milliseconds(37 + 91 * trial));
+    kill(pid, SIGKILL);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    const SavedRender s = load_state(state);
+    const ExrImage img = read_exr(out);
+    EXPECT_GE(std::stoull(meta(img, "passes_done")), s.render.work.passes) << "trial " << trial;
+    EXPECT_GT(s.render.work.passes, 0u);
+  }
+}
+
+TEST_F(Checkpoints, CtrlCWritesImageAndStateAndExitsZero) {
+  const std::string out = path("i.exr"), state = path("i.pbstate");
+  const pid_t pid = spawn(long_render(out, 0.0));
+  ASSERT_GT(pid, 0);
+  ASSERT_TRUE(wait_for_handler(pid, SIGINT));
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  const ExrImage img = read_exr(out);
+  EXPECT_EQ(meta(img, "stop_reason"), "interrupted");
+  const SavedRender s = load_state(state);
+  EXPECT_EQ(std::to_string(s.render.work.passes), meta(img, "passes_done"));
+}
+
+TEST_F(Checkpoints, SecondSignalLeavesAtOnceAndKeepsTheLastFiles) {
+  const std::string out = path("d.exr"), state = path("d.pbstate");
+  const pid_t pid = spawn(long_render(out, 0.05));
+  ASSERT_GT(pid, 0);
+  ASSERT_TRUE(wait_for(state));
+  std::this_thread::sleep_for(std::chrono::milliseconds(200));
+  kill(pid, SIGTERM);
+  kill(pid, SIGTERM);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  // Either the second signal arrived during the last pass (exit 128 + SIGTERM) or the first
+  // already finished the pass and its files (exit 0); in both cases the files on disk load.
+  EXPECT_TRUE(WEXITSTATUS(status) == 128 + SIGTERM || WEXITSTATUS(status) == 0)
+      << WEXITSTATUS(status);
+  EXPECT_NO_THROW(load_state(state));
+  EXPECT_NO_THROW(read_exr(out));
+}
+
+// A render started with a relative scene path resumes from another working directory: the
+// state keeps the scene's absolute path.
+TEST_F(Checkpoints, ResumeFromAnotherFolderFindsTheScene) {
+  fs::create_directories(dir_ / "a");
+  fs::copy_file(test::scene_path("cornell.gltf"), dir_ / "a" / "cornell.gltf");
+  const test::Outcome first = test::run_photonbound(
+      "render cornell.gltf -o ../r.exr --passes 3 --resolution 16x16 --photons-per-pass 1000 "
+      "--checkpoint-every 1000 --quiet",
+      (dir_ / "a").string());
+  ASSERT_EQ(first.code, 0) << first.err;
+  const SavedRender s = load_state(path("r.pbstate"));
+  EXPECT_TRUE(fs::path(s.options.scene).is_absolute()) << s.options.scene;
+  const test::Outcome second =
+      test::run_photonbound("resume r.pbstate -o r2.exr --passes 5 --quiet", dir_.string());
+  ASSERT_EQ(second.code, 0) << second.err;
+  EXPECT_EQ(meta(read_exr(path("r2.exr")), "passes_done"), "5");
+}
+
+}  // namespace
+}  // namespace pb
