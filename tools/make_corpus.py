@@ -2,12 +2,13 @@
 material feature of README "Materials": python3 -m tools.make_corpus OUTDIR.
 
 Needs numpy and OpenImageIO (tools/install-deps.sh), which write the textures (PNG and JPEG);
-the files are written by tools/gltf_writer.py, the tools' one glTF writer. Deterministic. Like Blender's exporter: y up; one buffer; FLOAT attributes NORMAL, TEXCOORD_0
-(and TANGENT where "export tangents" is on); UNSIGNED_SHORT indices; a material per object with
+the files are written by tools/gltf_writer.py, the tools' one glTF writer. Deterministic. Like
+Blender's exporter: y up; one buffer; FLOAT attributes NORMAL, TEXCOORD_0 (and TANGENT where
+"export tangents" is on); UNSIGNED_SHORT indices; a material per object with
 pbrMetallicRoughness (Principled BSDF defaults where unset: roughness 0.5, metallic 0) or none
 at all; samplers with LINEAR / LINEAR_MIPMAP_LINEAR filters; KHR_texture_transform from a
-Mapping node; KHR_materials_emissive_strength above strength 1; .glb files embed their images
-in bufferViews, the .gltf file references external .png / .jpg files.
+Mapping node; KHR_materials_emissive_strength above strength 1; .glb files embed their images in
+bufferViews, the .gltf file references external .png / .jpg files.
 
 CORPUS lists every file with the warnings photonbound must print for it (exactly these) and
 the range its mean radiance (at 48x48, tests/tools_test.py corpus) must fall into. Files:

@@ -1,12 +1,13 @@
-"""Generates the glTF 2.0 scenes in scenes/ (from the repository root: python3 -m tools.make_scenes).
+"""Generates the glTF 2.0 scenes in scenes/ (python3 -m tools.make_scenes from the repo root).
 
-Standard library only, deterministic (identical bytes on every run); the files are written
-by tools/gltf_writer.py, the tools' one glTF writer. After writing, every file is read back
-with tools/gltf_scene.py (the tools' one glTF reader, also standard library only) and validated (JSON / GLB container, accessors, min/max, index ranges, winding against
-normals, closed glass meshes, extensions), and one summary line per scene is printed.
-Conventions: y up, metres, counter-clockwise winding = front face. Diffuse surfaces are pure
-Lambertian: metallicFactor 0 and KHR_materials_specular specularFactor 0 (glTF's way to say "no
-specular layer"), which the analytic answers below assume and validate() checks.
+Standard library only, deterministic (identical bytes on every run); the files are written by
+tools/gltf_writer.py, the tools' one glTF writer. After writing, every file is read back with
+tools/gltf_scene.py (the tools' one glTF reader, also standard library only) and validated (JSON or
+GLB container, accessors, min/max, index ranges, winding against normals, closed glass meshes,
+extensions), and one summary line per scene is printed. Conventions: y up, metres,
+counter-clockwise winding = front face. Diffuse surfaces are pure Lambertian: metallicFactor 0
+and KHR_materials_specular specularFactor 0 (glTF's way to say "no specular layer"), which the
+analytic answers below assume and validate() checks.
 
 Scenes (analytic answers are radiances in the renderer's units):
 

@@ -27,7 +27,8 @@ def sky(width):
 
 
 def main():
-    ap = argparse.ArgumentParser(prog="python3 -m tools.make_sky", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python3 -m tools.make_sky",
+                                 description=__doc__.split("\n\n")[0])
     ap.add_argument("output")
     ap.add_argument("--width", type=int, default=256)
     args = ap.parse_args()

@@ -110,7 +110,8 @@ def sweep_plot(plt, rows, path):
 
 
 def main():
-    ap = argparse.ArgumentParser(prog="python3 -m tools.plot_logs", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python3 -m tools.plot_logs",
+                                 description=__doc__.split("\n\n")[0])
     ap.add_argument("logs", nargs="*", metavar="LOG.jsonl[=LABEL]")
     ap.add_argument("-o", "--output", required=True, help="folder for the PNGs (created)")
     ap.add_argument("--name", default="convergence", help="file name prefix")

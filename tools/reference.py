@@ -8,10 +8,10 @@
 
 `exact` writes the analytic answer (tools/analytic.py) of scenes/plane_point.gltf ("plane") or
 scenes/closed_box.gltf ("box"), with the camera, light, reflectance and emission read from the
-glTF file (.gltf or .glb, through tools/gltf_scene.py): with `--pixel area` (the default) each pixel's average over
-its area, from N x N stratified sub-pixel rays (`--sub`, default 16), what `--method sppm`
-estimates; with `--pixel centre` the value at the pixel-centre measurement point `--method ppm`
-uses (src/camera.cpp). It has every channel of photonbound's layout
+glTF file (.gltf or .glb, through tools/gltf_scene.py): with `--pixel area` (the default) each
+pixel's average over its area, from N x N stratified sub-pixel rays (`--sub`, default 16), what
+`--method sppm` estimates; with `--pixel centre` the value at the pixel-centre measurement point
+`--method ppm` uses (src/camera.cpp). It has every channel of photonbound's layout
 (include/photonbound/channels.def); all but the radiance are 0.
 
 `render` runs a long photonbound render (its own error bound channels included) and prints
@@ -93,7 +93,8 @@ def main():
     if "--" in argv:
         k = argv.index("--")
         argv, extra = argv[:k], argv[k + 1:]
-    ap = argparse.ArgumentParser(prog="python3 -m tools.reference", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python3 -m tools.reference",
+                                 description=__doc__.split("\n\n")[0])
     sub = ap.add_subparsers(dest="command", required=True)
     ex = sub.add_parser("exact", help="the analytic answer of the plane or the closed box")
     ex.add_argument("kind", choices=sorted(DEFAULT_SCENES))

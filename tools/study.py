@@ -246,7 +246,8 @@ def write_views(plt, rows, exrs, refs, outdir):
 
 
 def main():
-    ap = argparse.ArgumentParser(prog="python3 -m tools.study", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python3 -m tools.study",
+                                 description=__doc__.split("\n\n")[0])
     ap.add_argument("outdir")
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--confidences", default="0.5,0.9")

@@ -203,7 +203,8 @@ def confidence_text(exr):
 
 
 def main():
-    ap = argparse.ArgumentParser(prog="python3 -m tools.views", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python3 -m tools.views",
+                                 description=__doc__.split("\n\n")[0])
     ap.add_argument("input", help="a photonbound EXR")
     ap.add_argument("-o", "--output", required=True, help="folder for the PNGs (created)")
     ap.add_argument("--reference", help="reference EXR of the same size: adds PREFIX_bounded.png")
