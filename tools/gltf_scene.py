@@ -1,7 +1,8 @@
 """The one glTF 2.0 reader of the Python tools: a .gltf or .glb file in world space.
 
 Standard library only: tools/make_scenes.py (standard-library Python) validates the scenes it
-writes with it, and tools/pbtools.py wraps it in numpy arrays for the other tools.
+writes with it, and tools/analytic.py (Gltf) wraps it in numpy arrays for the other tools;
+tools/gltf_writer.py is its counterpart that writes.
 
   scene = gltf_scene.load(path)     # reads and checks the whole file; GltfError when it cannot
   scene.cameras     [Camera]        every camera instance: position, forward, right, up, yfov,
@@ -34,6 +35,8 @@ import struct
 import urllib.parse
 from functools import cached_property
 
+from .common import ToolError
+
 # glTF constants
 BYTE, UNSIGNED_BYTE, SHORT, UNSIGNED_SHORT, UNSIGNED_INT, FLOAT = 5120, 5121, 5122, 5123, 5125, 5126
 TRIANGLES = 4
@@ -56,10 +59,6 @@ TYPES = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4}
 INDEX_COMPONENTS = (UNSIGNED_BYTE, UNSIGNED_SHORT, UNSIGNED_INT)
 DATA_URI_PREFIXES = ("data:application/octet-stream;base64,",
                      "data:application/gltf-buffer;base64,")
-
-
-class ToolError(Exception):
-    """A user-facing failure: one line, no traceback (pbtools re-exports it)."""
 
 
 class GltfError(ToolError):

@@ -1,14 +1,14 @@
-#!/usr/bin/env python3
 """Writes a corpus of glTF files laid out the way Blender's glTF exporter writes them, one per
-material feature of README "Materials": python3 tools/make_corpus.py OUTDIR.
+material feature of README "Materials": python3 -m tools.make_corpus OUTDIR.
 
-Needs numpy and OpenImageIO (tools/install-deps.sh), which write the textures (PNG and JPEG).
-Deterministic. Like Blender's exporter: y up; one buffer; FLOAT attributes NORMAL, TEXCOORD_0
-(and TANGENT where "export tangents" is on); UNSIGNED_SHORT indices; a material per object with
+Needs numpy and OpenImageIO (tools/install-deps.sh), which write the textures (PNG and JPEG);
+the files are written by tools/gltf_writer.py, the tools' one glTF writer. Deterministic. Like
+Blender's exporter: y up; one buffer; FLOAT attributes NORMAL, TEXCOORD_0 (and TANGENT where
+"export tangents" is on); UNSIGNED_SHORT indices; a material per object with
 pbrMetallicRoughness (Principled BSDF defaults where unset: roughness 0.5, metallic 0) or none
 at all; samplers with LINEAR / LINEAR_MIPMAP_LINEAR filters; KHR_texture_transform from a
-Mapping node; KHR_materials_emissive_strength above strength 1; .glb files embed their images
-in bufferViews, the .gltf file references external .png / .jpg files.
+Mapping node; KHR_materials_emissive_strength above strength 1; .glb files embed their images in
+bufferViews, the .gltf file references external .png / .jpg files.
 
 CORPUS lists every file with the warnings photonbound must print for it (exactly these) and
 the range its mean radiance (at 48x48, tests/tools_test.py corpus) must fall into. Files:
@@ -32,22 +32,21 @@ the range its mean radiance (at 48x48, tests/tools_test.py corpus) must fall int
                         alphaMode BLEND, rendered opaque with the one warning of the corpus.
 """
 
-import json
+import argparse
 import math
 import os
-import struct
-import sys
 import tempfile
 from pathlib import Path
 
 import numpy as np
-import OpenImageIO as oiio
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from make_scenes import look_rotation, quaternion  # noqa: E402
+from . import gltf_writer
+from .common import ToolError, run_main
+from .exr import need_oiio
+from .gltf_scene import FLOAT
+from .gltf_scene import UNSIGNED_SHORT as USHORT
+from .gltf_writer import ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, look_rotation, quaternion
 
-FLOAT, USHORT = 5126, 5123
-ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
 REPEAT, CLAMP, MIRRORED = 10497, 33071, 33648
 LINEAR, NEAREST, LINEAR_MIPMAP_LINEAR = 9729, 9728, 9987
 GENERATOR = "Khronos glTF Blender I/O v3.6.27 (photonbound tools/make_corpus.py)"
@@ -71,6 +70,7 @@ CORPUS = {
 
 def encode(pixels, ext, quality=92):
     """The bytes of an image file (PNG or JPEG) of an (h, w, c) uint8 array."""
+    oiio = need_oiio()
     h, w, c = pixels.shape
     with tempfile.TemporaryDirectory() as tmp:
         name = os.path.join(tmp, "image" + ext)
@@ -79,7 +79,7 @@ def encode(pixels, ext, quality=92):
         if ext == ".jpg":
             spec.attribute("Compression", f"jpeg:{quality}")
         if not (out.open(name, spec) and out.write_image(np.ascontiguousarray(pixels))):
-            raise SystemExit(f"make_corpus: cannot write {ext}: {oiio.geterror()}")
+            raise ToolError(f"cannot write {ext}: {oiio.geterror()}")
         out.close()
         return Path(name).read_bytes()
 
@@ -186,39 +186,30 @@ class Doc:
     """One glTF document with a single buffer, built as Blender's exporter lays it out."""
 
     def __init__(self, glb):
-        self.glb, self.bin, self.files = glb, bytearray(), {}
+        self.glb, self.buffer, self.files = glb, gltf_writer.Buffer(), {}
         self.j = {"asset": {"generator": GENERATOR, "version": "2.0"}, "scene": 0,
                   "scenes": [{"name": "Scene", "nodes": []}], "nodes": [], "meshes": [],
-                  "materials": [], "accessors": [], "bufferViews": []}
+                  "materials": [], "accessors": self.buffer.accessors,
+                  "bufferViews": self.buffer.views}
         self.used = set()
 
     def add(self, kind, item):
         self.j.setdefault(kind, []).append(item)
         return len(self.j[kind]) - 1
 
-    def view(self, data, target=None):
-        while len(self.bin) % 4:
-            self.bin.append(0)
-        v = {"buffer": 0, "byteOffset": len(self.bin), "byteLength": len(data)}
-        if target:
-            v["target"] = target
-        self.bin += data
-        return self.add("bufferViews", v)
-
     def accessor(self, array, kind, bounds=False):
         comp = USHORT if kind == "SCALAR" else FLOAT
         data = array.astype(np.uint16 if comp == USHORT else np.float32)
-        view = self.view(data.tobytes(), ELEMENT_ARRAY_BUFFER if comp == USHORT else ARRAY_BUFFER)
-        acc = {"bufferView": view, "componentType": comp, "count": len(data), "type": kind}
-        if bounds:
-            acc["min"], acc["max"] = data.min(0).tolist(), data.max(0).tolist()
-        return self.add("accessors", acc)
+        return self.buffer.accessor(
+            data.tobytes(), comp, len(data), kind,
+            ELEMENT_ARRAY_BUFFER if comp == USHORT else ARRAY_BUFFER,
+            (data.min(0).tolist(), data.max(0).tolist()) if bounds else None)
 
     def image(self, name, pixels, ext=".png"):
         data = encode(pixels, ext)
         mime = "image/png" if ext == ".png" else "image/jpeg"
         if self.glb:
-            return self.add("images", {"bufferView": self.view(data), "mimeType": mime,
+            return self.add("images", {"bufferView": self.buffer.view(data), "mimeType": mime,
                                        "name": name})
         self.files[name + ext] = data
         return self.add("images", {"mimeType": mime, "name": name, "uri": name + ext})
@@ -287,20 +278,12 @@ class Doc:
             del self.j["extensionsUsed"]
         for k in [k for k, v in self.j.items() if v == []]:
             del self.j[k]
-        buf = bytes(self.bin) + b"\0" * (-len(self.bin) % 4)
         if self.glb:
-            self.j["buffers"] = [{"byteLength": len(buf)}]
-            js = json.dumps(self.j, separators=(",", ":")).encode()
-            js += b" " * (-len(js) % 4)
-            path.write_bytes(struct.pack("<III", 0x46546C67, 2, 28 + len(js) + len(buf)) +
-                             struct.pack("<II", len(js), 0x4E4F534A) + js +
-                             struct.pack("<II", len(buf), 0x004E4942) + buf)
+            gltf_writer.write_glb(path, self.j, self.buffer.data)
         else:
-            self.j["buffers"] = [{"byteLength": len(buf), "uri": path.stem + ".bin"}]
-            (path.parent / (path.stem + ".bin")).write_bytes(buf)
             for name, data in self.files.items():
                 (path.parent / name).write_bytes(data)
-            path.write_text(json.dumps(self.j, indent=2) + "\n")
+            gltf_writer.write_gltf_external(path, self.j, self.buffer.data, indent=2)
 
 
 # ----------------------------------------------------------------------------- scenes
@@ -417,9 +400,10 @@ BUILDERS = {"default_material.glb": default_material, "rough_metals.glb": rough_
 
 
 def main():
-    if len(sys.argv) != 2:
-        raise SystemExit("usage: make_corpus.py OUTDIR")
-    out = Path(sys.argv[1])
+    ap = argparse.ArgumentParser(prog="python3 -m tools.make_corpus",
+                                 description=__doc__.split("\n\n")[0])
+    ap.add_argument("outdir", help="folder for the files (created)")
+    out = Path(ap.parse_args().outdir)
     out.mkdir(parents=True, exist_ok=True)
     for name in CORPUS:
         d = Doc(glb=name.endswith(".glb"))
@@ -430,4 +414,4 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    run_main("make_corpus", main)

@@ -1,13 +1,13 @@
-#!/usr/bin/env python3
-"""Generates the glTF 2.0 scenes in scenes/ (run from anywhere: python3 tools/make_scenes.py).
+"""Generates the glTF 2.0 scenes in scenes/ (python3 -m tools.make_scenes from the repo root).
 
-Standard library only, deterministic (identical bytes on every run). After writing, every
-file is read back with tools/gltf_scene.py (the tools' one glTF reader, also standard library
-only) and validated (JSON / GLB container, accessors, min/max, index ranges, winding against
-normals, closed glass meshes, extensions), and one summary line per scene is printed.
-Conventions: y up, metres, counter-clockwise winding = front face. Diffuse surfaces are pure
-Lambertian: metallicFactor 0 and KHR_materials_specular specularFactor 0 (glTF's way to say "no
-specular layer"), which the analytic answers below assume and validate() checks.
+Standard library only, deterministic (identical bytes on every run); the files are written by
+tools/gltf_writer.py, the tools' one glTF writer. After writing, every file is read back with
+tools/gltf_scene.py (the tools' one glTF reader, also standard library only) and validated (JSON or
+GLB container, accessors, min/max, index ranges, winding against normals, closed glass meshes,
+extensions), and one summary line per scene is printed. Conventions: y up, metres,
+counter-clockwise winding = front face. Diffuse surfaces are pure Lambertian: metallicFactor 0
+and KHR_materials_specular specularFactor 0 (glTF's way to say "no specular layer"), which the
+analytic answers below assume and validate() checks.
 
 Scenes (analytic answers are radiances in the renderer's units):
 
@@ -73,7 +73,7 @@ tests/make_gltf_corpus's Draco, meshopt, quantised and sparse files):
   huge_ground.gltf   a 1-unit box and sphere on a 2e5 x 2e5 ground under a sun, a close camera.
 
 Not in scenes/ (25 MB; generated on demand, by the benchmark on first use, or with
-python3 tools/make_scenes.py --heavy DIR):
+python3 -m tools.make_scenes --heavy DIR):
 
   cornell_heavy.glb  The default scene with the mirror sphere replaced by a displaced
                      clay-coloured Lambertian sphere of 1,046,528 triangles (1024 x 512 UV
@@ -81,94 +81,29 @@ python3 tools/make_scenes.py --heavy DIR):
                      Benchmark scene (at least 1 M triangles); no analytic answer.
 """
 
-import base64
-import json
+import argparse
 import math
 import os
 import struct
 import sys
 from pathlib import Path
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import gltf_scene  # noqa: E402  (the tools' one glTF reader; standard library only)
-from gltf_scene import (EXT_IOR, EXT_LIGHTS, EXT_SPECULAR, EXT_STRENGTH,  # noqa: E402
-                        EXT_TRANSMISSION, EXT_VOLUME, FLOAT, GLB_BIN, GLB_JSON, GLB_MAGIC,
-                        TRIANGLES)
-from gltf_scene import UNSIGNED_INT as UINT  # noqa: E402
+if __name__ == "__main__" and not __package__:
+    # Run by path (python3 tools/make_scenes.py), as tests/test_corpus.cpp and bench/bench.cpp
+    # call it: run again as the module tools.make_scenes, in the same folder with the same
+    # arguments, importing from the repository root (-P: not from the current folder).
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    path = os.pathsep.join(filter(None, (root, os.environ.get("PYTHONPATH"))))
+    os.execve(sys.executable, [sys.executable, "-P", "-m", "tools.make_scenes", *sys.argv[1:]],
+              {**os.environ, "PYTHONPATH": path})
 
-ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER = 34962, 34963
-
-# ----------------------------------------------------------------------------- vector math
-
-
-def add(a, b):
-    return tuple(x + y for x, y in zip(a, b))
-
-
-def sub(a, b):
-    return tuple(x - y for x, y in zip(a, b))
-
-
-def scale(a, s):
-    return tuple(x * s for x in a)
-
-
-def dot(a, b):
-    return sum(x * y for x, y in zip(a, b))
-
-
-def cross(a, b):
-    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
-
-
-def length(a):
-    return math.sqrt(dot(a, a))
-
-
-def normalize(a):
-    return scale(a, 1.0 / length(a))
-
-
-def f32(x):
-    """x rounded to float32, the precision the buffers store."""
-    return struct.unpack("<f", struct.pack("<f", x))[0]
-
-
-def look_rotation(eye, target, up_hint=(0.0, 1.0, 0.0)):
-    """3x3 rotation (rows) whose local -Z looks from eye to target with local +Y up."""
-    forward = normalize(sub(target, eye))
-    right = normalize(cross(forward, up_hint))
-    up = cross(right, forward)
-    back = scale(forward, -1.0)
-    return [[right[i], up[i], back[i]] for i in range(3)]
-
-
-def quaternion(m):
-    """Unit quaternion [x, y, z, w] (w >= 0) of the 3x3 rotation matrix m (rows)."""
-    t = m[0][0] + m[1][1] + m[2][2]
-    if t > 0:
-        s = 2.0 * math.sqrt(t + 1.0)
-        q = [(m[2][1] - m[1][2]) / s, (m[0][2] - m[2][0]) / s, (m[1][0] - m[0][1]) / s, s / 4]
-    elif m[0][0] >= m[1][1] and m[0][0] >= m[2][2]:
-        s = 2.0 * math.sqrt(1.0 + m[0][0] - m[1][1] - m[2][2])
-        q = [s / 4, (m[0][1] + m[1][0]) / s, (m[0][2] + m[2][0]) / s, (m[2][1] - m[1][2]) / s]
-    elif m[1][1] >= m[2][2]:
-        s = 2.0 * math.sqrt(1.0 + m[1][1] - m[0][0] - m[2][2])
-        q = [(m[0][1] + m[1][0]) / s, s / 4, (m[1][2] + m[2][1]) / s, (m[0][2] - m[2][0]) / s]
-    else:
-        s = 2.0 * math.sqrt(1.0 + m[2][2] - m[0][0] - m[1][1])
-        q = [(m[0][2] + m[2][0]) / s, (m[1][2] + m[2][1]) / s, s / 4, (m[1][0] - m[0][1]) / s]
-    q = [x if abs(x) > 1e-15 else 0.0 for x in q]  # no -0.0 / 1e-17 noise in the files
-    return q if q[3] >= 0 else [-x for x in q]
-
-
-def matrix_columns(rotation_rows, translation):
-    """glTF node "matrix": column-major 4x4 from a 3x3 rotation (rows) and a translation."""
-    cols = []
-    for c in range(3):
-        cols += [rotation_rows[r][c] for r in range(3)] + [0.0]
-    return [x if abs(x) > 1e-15 else 0.0 for x in cols] + list(translation) + [1.0]
-
+from . import gltf_scene, gltf_writer  # noqa: E402  (after the re-run above)
+from .common import REPO  # noqa: E402
+from .gltf_scene import (EXT_IOR, EXT_LIGHTS, EXT_SPECULAR, EXT_STRENGTH,  # noqa: E402
+                         EXT_TRANSMISSION, EXT_VOLUME, FLOAT, TRIANGLES, cross, dot)
+from .gltf_scene import UNSIGNED_INT as UINT  # noqa: E402
+from .gltf_writer import (ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER, add, length,  # noqa: E402
+                          look_rotation, matrix_columns, normalize, quaternion, scale, sub)
 
 # ----------------------------------------------------------------------------- geometry
 
@@ -308,8 +243,7 @@ class GltfBuilder:
     """Accumulates one glTF document: a single binary buffer plus the JSON objects."""
 
     def __init__(self):
-        self.bin = bytearray()
-        self.buffer_views, self.accessors = [], []
+        self.buffer = gltf_writer.Buffer()
         self.materials, self.meshes, self.nodes = [], [], []
         self.cameras, self.lights, self.roots = [], [], []
         self.extensions = set()
@@ -317,20 +251,12 @@ class GltfBuilder:
 
     # -- buffers
     def _accessor(self, fmt, values, count, component, kind, target, bounds=False):
-        while len(self.bin) % 4:
-            self.bin.append(0)
         data = struct.pack("<" + fmt * len(values), *values)
-        self.buffer_views.append({"buffer": 0, "byteOffset": len(self.bin),
-                                  "byteLength": len(data), "target": target})
-        self.bin += data
-        acc = {"bufferView": len(self.buffer_views) - 1, "componentType": component,
-               "count": count, "type": kind}
+        minmax = None
         if bounds:  # min/max of the float32 values actually stored
             stored = struct.unpack("<" + fmt * len(values), data)
-            acc["min"] = [min(stored[c::3]) for c in range(3)]
-            acc["max"] = [max(stored[c::3]) for c in range(3)]
-        self.accessors.append(acc)
-        return len(self.accessors) - 1
+            minmax = [min(stored[c::3]) for c in range(3)], [max(stored[c::3]) for c in range(3)]
+        return self.buffer.accessor(data, component, count, kind, target, minmax)
 
     def _vec3(self, vectors, bounds=False):
         flat = [x for v in vectors for x in v]
@@ -400,9 +326,9 @@ class GltfBuilder:
 
     def scalars(self, values):
         """A FLOAT SCALAR accessor with min/max (animation times)."""
-        acc = self._accessor("f", values, len(values), FLOAT, "SCALAR", ARRAY_BUFFER)
-        self.accessors[acc]["min"], self.accessors[acc]["max"] = [min(values)], [max(values)]
-        return acc
+        data = struct.pack(f"<{len(values)}f", *values)
+        return self.buffer.accessor(data, FLOAT, len(values), "SCALAR", ARRAY_BUFFER,
+                                    ([min(values)], [max(values)]))
 
     def animate_translation(self, node, times, translations):
         """One LINEAR translation channel on a node (as exporters write object motion)."""
@@ -469,10 +395,8 @@ class GltfBuilder:
         return self.node(name, camera=self.camera(name, yfov, aspect), **xform)
 
     # -- output
-    def document(self, uri=None):
-        buf = {"byteLength": len(self.bin)}
-        if uri is not None:
-            buf["uri"] = uri
+    def document(self):
+        """The JSON; gltf_writer fills in "buffers" (the buffer's length and where it is)."""
         doc = {"asset": {"version": "2.0", "generator": "photonbound tools/make_scenes.py"}}
         if self.extensions:
             doc["extensionsUsed"] = sorted(self.extensions)
@@ -484,27 +408,18 @@ class GltfBuilder:
             doc["extensions"] = {EXT_LIGHTS: {"lights": self.lights}}
         if self.animations:
             doc["animations"] = self.animations
-        doc.update({"buffers": [buf], "bufferViews": self.buffer_views,
-                    "accessors": self.accessors})
+        doc.update({"buffers": [], "bufferViews": self.buffer.views,
+                    "accessors": self.buffer.accessors})
         return doc
 
     def write_gltf(self, path):
-        uri = "data:application/octet-stream;base64," + base64.b64encode(self.bin).decode()
-        path.write_text(json.dumps(self.document(uri), indent=1) + "\n")
+        gltf_writer.write_gltf(path, self.document(), self.buffer.data)
 
     def write_gltf_external(self, path):
-        bin_path = path.with_suffix(".bin")
-        bin_path.write_bytes(bytes(self.bin))
-        path.write_text(json.dumps(self.document(bin_path.name), indent=1) + "\n")
+        gltf_writer.write_gltf_external(path, self.document(), self.buffer.data)
 
     def write_glb(self, path):
-        js = json.dumps(self.document(), separators=(",", ":")).encode()
-        js += b" " * (-len(js) % 4)
-        bn = bytes(self.bin) + b"\0" * (-len(self.bin) % 4)
-        total = 12 + 8 + len(js) + 8 + len(bn)
-        path.write_bytes(struct.pack("<III", GLB_MAGIC, 2, total)
-                         + struct.pack("<II", len(js), GLB_JSON) + js
-                         + struct.pack("<II", len(bn), GLB_BIN) + bn)
+        gltf_writer.write_glb(path, self.document(), self.buffer.data)
 
 
 # ----------------------------------------------------------------------------- scenes
@@ -970,12 +885,17 @@ def write_into(out_dir, outputs):
 
 
 def main():
-    if len(sys.argv) == 3 and sys.argv[1] in ("--heavy", "--corpus"):
-        write_into(Path(sys.argv[2]), [HEAVY] if sys.argv[1] == "--heavy" else CORPUS)
+    ap = argparse.ArgumentParser(prog="python3 -m tools.make_scenes",
+                                 description=__doc__.split("\n\n")[0])
+    where = ap.add_mutually_exclusive_group()
+    where.add_argument("--heavy", metavar="DIR", help="write only cornell_heavy.glb, into DIR")
+    where.add_argument("--corpus", metavar="DIR", help="write only the exporter-style files of "
+                       "tests/test_corpus.cpp, into DIR")
+    args = ap.parse_args()
+    if args.heavy or args.corpus:
+        write_into(Path(args.heavy or args.corpus), [HEAVY] if args.heavy else CORPUS)
         return
-    if len(sys.argv) != 1:
-        raise SystemExit("usage: make_scenes.py [--heavy DIR | --corpus DIR]")
-    out_dir = Path(__file__).resolve().parent.parent / "scenes"
+    out_dir = Path(REPO) / "scenes"
     out_dir.mkdir(exist_ok=True)
     for name, build, write in OUTPUTS:
         write(build(), out_dir / name)

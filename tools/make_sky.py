@@ -1,18 +1,15 @@
-#!/usr/bin/env python3
 """Writes a small equirectangular sky map (EXR) for README pictures and tests by hand:
 a blue gradient above the horizon, a dim ground below and a small sun of radiance 60.
 
-  python3 tools/make_sky.py OUT.exr [--width 256]
+  python3 -m tools.make_sky OUT.exr [--width 256]
 """
 
 import argparse
-import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import pbtools  # noqa: E402
+from .common import ToolError, run_main
+from .exr import write_exr
 
 
 def sky(width):
@@ -30,14 +27,15 @@ def sky(width):
 
 
 def main():
-    ap = argparse.ArgumentParser(prog="make_sky.py", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python3 -m tools.make_sky",
+                                 description=__doc__.split("\n\n")[0])
     ap.add_argument("output")
     ap.add_argument("--width", type=int, default=256)
     args = ap.parse_args()
     if args.width < 2:
-        raise pbtools.ToolError("--width must be at least 2")
-    pbtools.write_exr(args.output, sky(args.width), {})
+        raise ToolError("--width must be at least 2")
+    write_exr(args.output, sky(args.width), {})
 
 
 if __name__ == "__main__":
-    pbtools.run_main("make_sky", main)
+    run_main("make_sky", main)

@@ -1,8 +1,8 @@
-#!/usr/bin/python3
 """Plots of photonbound's convergence logs and of a sweep of target errors.
 
-  tools/plot_logs.py -o OUTDIR [--name PREFIX] LOG.jsonl[=LABEL] ...
-  tools/plot_logs.py -o OUTDIR [--name PREFIX] --sweep RESULTS.json [LOG.jsonl[=LABEL] ...]
+  python3 -m tools.plot_logs -o OUTDIR [--name PREFIX] LOG.jsonl[=LABEL] ...
+  python3 -m tools.plot_logs -o OUTDIR [--name PREFIX] --sweep RESULTS.json
+                             [LOG.jsonl[=LABEL] ...]
 
 From `photonbound render --log LOG.jsonl [--reference REF.exr]` logs it writes
 PREFIX_time.png and PREFIX_passes.png: the image mean error bound (dashed) and, when the log
@@ -12,17 +12,15 @@ passes, log-log. A LABEL of the form PANEL:SERIES puts the log in the panel PANE
 
 With --sweep it also writes PREFIX_sweep.png: specified target against actual mean error,
 log-log, from a JSON list of objects with the keys scene, confidence, target and actual (as
-tools/study.py writes in results.json). PREFIX defaults to "convergence".
+python3 -m tools.study writes in results.json). PREFIX defaults to "convergence".
 """
 
 import argparse
 import json
 import os
-import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import pbtools  # noqa: E402
-from pbtools import ToolError  # noqa: E402
+from .cli import read_log
+from .common import ToolError, run_main, save_figure, use_agg
 
 SERIES_COLOURS = ["tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange", "tab:brown"]
 
@@ -33,7 +31,7 @@ def parse_log_args(items):
         path, _, label = item.partition("=")
         label = label or os.path.splitext(os.path.basename(path))[0]
         panel, _, series = label.rpartition(":")
-        logs.append((panel, series, pbtools.read_log(path)))
+        logs.append((panel, series, read_log(path)))
     return logs
 
 
@@ -62,7 +60,7 @@ def convergence_plot(plt, logs, x_key, x_label, path):
         ax.set_title(panel or "convergence", fontsize=10)
         ax.legend(fontsize=7)
     axes[0][0].set_ylabel("mean over pixels and RGB")
-    pbtools.save_figure(fig, path)
+    save_figure(fig, path)
 
 
 def read_sweep(path):
@@ -108,22 +106,23 @@ def sweep_plot(plt, rows, path):
     ax.set_xlabel("specified target error (--target-error)")
     ax.set_ylabel("actual mean absolute error")
     ax.legend(fontsize=7, ncol=2)
-    pbtools.save_figure(fig, path)
+    save_figure(fig, path)
 
 
 def main():
-    ap = argparse.ArgumentParser(prog="plot_logs.py", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python3 -m tools.plot_logs",
+                                 description=__doc__.split("\n\n")[0])
     ap.add_argument("logs", nargs="*", metavar="LOG.jsonl[=LABEL]")
     ap.add_argument("-o", "--output", required=True, help="folder for the PNGs (created)")
     ap.add_argument("--name", default="convergence", help="file name prefix")
-    ap.add_argument("--sweep", help="results JSON of a sweep of targets (tools/study.py)")
+    ap.add_argument("--sweep", help="results JSON of a sweep of targets (python3 -m tools.study)")
     args = ap.parse_args()
     if not args.logs and not args.sweep:
         raise ToolError("nothing to plot: give logs, --sweep, or both")
     logs = parse_log_args(args.logs)
     rows = read_sweep(args.sweep) if args.sweep else None
     os.makedirs(args.output, exist_ok=True)
-    plt = pbtools.use_agg()
+    plt = use_agg()
     written = []
     if logs:
         for key, label, kind in (("seconds", "seconds", "time"), ("pass", "passes", "passes")):
@@ -138,4 +137,4 @@ def main():
 
 
 if __name__ == "__main__":
-    pbtools.run_main("plot_logs", main)
+    run_main("plot_logs", main)

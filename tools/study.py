@@ -1,14 +1,13 @@
-#!/usr/bin/python3
 """The speed-accuracy study: renders to a sweep of target errors, measured against references.
 
-  tools/study.py OUTDIR [--scenes plane,box,cornell] [--confidences 0.5,0.9]
-                 [--targets T1,T2,...] [--resolution WxH] [--run-time-limit S]
-                 [--method ppm|sppm] [--stop-rule RULE] [--photonbound EXE]
+  python3 -m tools.study OUTDIR [--scenes plane,box,cornell] [--confidences 0.5,0.9]
+                         [--targets T1,T2,...] [--resolution WxH] [--run-time-limit S]
+                         [--method ppm|sppm] [--stop-rule RULE] [--photonbound EXE]
 
 For each scene, each confidence and each target (four halving targets per scene by default),
 `photonbound render` runs to --target-error with --log and --reference (seed 1). Each final
 image is then measured with `photonbound compare --json` against the scene's reference: the
-exact answer for the analytic plane and closed box (tools/reference.py exact), a committed
+exact answer for the analytic plane and closed box (tools/analytic.py), a committed
 long render for the Cornell box (tools/study/cornell_64x64_reference.exr, PPM at the pixel
 centres; cornell_64x64_sppm_reference.exr, SPPM's pixel-area average). OUTDIR gets:
 
@@ -36,24 +35,18 @@ import datetime
 import json
 import os
 import platform
-import subprocess
 import sys
 import time
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import pbtools  # noqa: E402
-import plot_logs  # noqa: E402
-import reference  # noqa: E402
-import views  # noqa: E402
-from pbtools import ToolError  # noqa: E402
+from . import analytic, cli, exr, plot_logs, views
+from .common import REPO, ToolError, parse_resolution, run_main, use_agg, write_text
 
 SEED = 1
-CORNELL_REFERENCE = os.path.join(pbtools.REPO, "tools", "study", "cornell_64x64_reference.exr")
+CORNELL_REFERENCE = os.path.join(REPO, "tools", "study", "cornell_64x64_reference.exr")
 # The same scene's long SPPM render (README "Coverage": how it was made), for --method sppm.
-CORNELL_SPPM_REFERENCE = os.path.join(pbtools.REPO, "tools", "study",
-                                      "cornell_64x64_sppm_reference.exr")
+CORNELL_SPPM_REFERENCE = os.path.join(REPO, "tools", "study", "cornell_64x64_sppm_reference.exr")
 
 # Targets halve in turn. They are chosen so that the tightest run at 90% takes one to three
 # minutes on 2 cores. The Cornell box needs more care: a long render is its reference, and the
@@ -97,52 +90,48 @@ def make_reference(name, cfg, resolution, folder, method="ppm"):
     if cfg["reference"] == "exact":
         suffix = "exact" if method == "ppm" else "exact_area"
         path = os.path.join(folder, f"{name}_{resolution}_{suffix}.exr")
-        w, h = pbtools.parse_resolution(resolution)
-        gltf = pbtools.Gltf(os.path.join(pbtools.REPO, "scenes", cfg["file"]))
+        w, h = parse_resolution(resolution)
+        gltf = analytic.Gltf(os.path.join(REPO, "scenes", cfg["file"]))
         sub = 1 if method == "ppm" else 16
-        reference.write_reference(path, reference.exact_image(name, gltf, w, h, sub),
-                                  {"photonbound:reference": f"exact {name}"})
+        exr.write_reference(path, analytic.exact_image(name, gltf, w, h, sub),
+                            {"photonbound:reference": f"exact {name}"})
         return path
     path = cfg["reference"] if method == "ppm" else cfg["sppm_reference"]
-    ref = pbtools.read_exr(path)
+    ref = exr.read_exr(path)
     h, w = ref.shape
     if f"{w}x{h}" != resolution:
         raise ToolError(f"{name}: the reference {path} is {w}x{h}, not {resolution}: render one "
-                        "with tools/reference.py render (see README)")
+                        "with python3 -m tools.reference render (see README)")
     return path
 
 
 def reference_quality(path):
     """The reference's mean bound (0 when exact), its confidence, and the mean absolute error
-    its noise alone is expected to have, sqrt(2/pi) x mean sd (normal noise)."""
-    ref = pbtools.read_exr(path)
-    if pbtools.channel("ErrorBound", "R") not in ref.planes:
+    its noise alone is expected to have (analytic.expected_abs_noise of its sd)."""
+    ref = exr.read_exr(path)
+    if exr.channel("ErrorBound", "R") not in ref.planes:
         return 0.0, None, 0.0
     bound = ref.rgb("ErrorBound")
     known = np.isfinite(bound) & (bound > 0)
     if not known.any():
         return 0.0, None, 0.0
-    noise = float(np.mean(np.sqrt(2.0 / np.pi * ref.rgb("Variance")[known])))
+    noise = float(np.mean(analytic.expected_abs_noise(np.sqrt(ref.rgb("Variance")[known]))))
     return float(np.mean(bound[np.isfinite(bound)])), ref.meta("photonbound:confidence"), noise
 
 
 def run_one(exe, name, cfg, resolution, confidence, target, ref, runs, limit, method="ppm",
             rule="mean-bound"):
     stem = f"{name}_c{round(100 * confidence)}_t{target:g}"
-    exr, log = os.path.join(runs, stem + ".exr"), os.path.join(runs, stem + ".jsonl")
-    cmd = [exe, "render", os.path.join(pbtools.REPO, "scenes", cfg["file"]), "-o", exr,
-           "--resolution", resolution, "--direct", cfg["direct"], "--photons-per-pass",
-           str(cfg["photons"]), "--confidence",
-           f"{confidence:g}", "--target-error", f"{target:g}", "--time", f"{limit:g}", "--seed",
-           str(SEED), "--log", log, "--reference", ref, "--quiet",
-           "--method", method, "--stop-rule", rule]
+    exr_path, log = os.path.join(runs, stem + ".exr"), os.path.join(runs, stem + ".jsonl")
+    options = ["--resolution", resolution, "--direct", cfg["direct"], "--photons-per-pass",
+               str(cfg["photons"]), "--confidence", f"{confidence:g}", "--target-error",
+               f"{target:g}", "--time", f"{limit:g}", "--seed", str(SEED), "--log", log,
+               "--reference", ref, "--quiet", "--method", method, "--stop-rule", rule]
     start = time.monotonic()
-    p = subprocess.run(cmd, capture_output=True, text=True)
+    cli.render(exe, os.path.join(REPO, "scenes", cfg["file"]), exr_path, options)
     wall = time.monotonic() - start
-    if p.returncode != 0:
-        raise ToolError(f"{stem}: photonbound render failed: {p.stderr.strip()}")
-    meta = pbtools.read_exr(exr).metadata
-    c = pbtools.compare_json(exe, exr, ref)
+    meta = exr.read_exr(exr_path).metadata
+    c = cli.compare_json(exe, exr_path, ref)
     row = {
         "scene": name, "confidence": confidence, "target": target,
         "actual": c["mean_abs_error"], "coverage": c["coverage"],
@@ -154,12 +143,12 @@ def run_one(exe, name, cfg, resolution, confidence, target, ref, runs, limit, me
         "stop": meta["photonbound:stop_reason"],
         "mean_bound": float(meta["photonbound:mean_error_bound"]),
         "resolution": resolution, "direct": cfg["direct"], "photons_per_pass": cfg["photons"],
-        "exr": os.path.relpath(exr, runs),
+        "exr": os.path.relpath(exr_path, runs),
         "log": os.path.relpath(log, runs), "compare": c,
     }
     print(f"study: {stem}: {row['passes']} passes, {row['seconds']:.1f} s, actual "
           f"{row['actual']:.4g}, coverage {row['coverage']:.3f}, stop {row['stop']}", flush=True)
-    return row, exr, log
+    return row, exr_path, log
 
 
 def format_row(r):
@@ -222,14 +211,14 @@ def reference_warning(scene, bound, smallest):
     if bound > 0.0 and smallest < REFERENCE_MARGIN * bound:
         return (f"{scene}: the reference's mean bound {bound:.3g} is not {REFERENCE_MARGIN:g}x "
                 f"below the smallest actual error {smallest:.3g}: its own error is part of the "
-                "measured errors; render a longer reference (tools/reference.py render)")
+                "measured errors; render a longer reference (python3 -m tools.reference render)")
     return None
 
 
 def write_plots(rows, logs, outdir):
-    plt = pbtools.use_agg()
+    plt = use_agg()
     tightest = tightest_runs(rows, logs)
-    chosen = [(scene, f"{100 * c:g}%", pbtools.read_log(log))
+    chosen = [(scene, f"{100 * c:g}%", cli.read_log(log))
               for (scene, c), (_, log) in sorted(tightest.items(),
                                                  key=lambda kv: (list(SCENES).index(kv[0][0])
                                                                  if kv[0][0] in SCENES else 99,
@@ -245,9 +234,9 @@ def write_plots(rows, logs, outdir):
 def write_views(plt, rows, exrs, refs, outdir):
     folder = os.path.join(outdir, "views")
     os.makedirs(folder, exist_ok=True)
-    for (scene, conf), (target, exr) in tightest_runs(rows, exrs).items():
-        img, ref = pbtools.read_exr(exr), pbtools.read_exr(refs[scene][0])
-        name = os.path.splitext(os.path.basename(exr))[0]
+    for (scene, conf), (target, path) in tightest_runs(rows, exrs).items():
+        img, ref = exr.read_exr(path), exr.read_exr(refs[scene][0])
+        name = os.path.splitext(os.path.basename(path))[0]
         label = f"{scene}, target {target:g} at {100 * conf:g}%"
         out = lambda kind: os.path.join(folder, f"{name}_{kind}.png")  # noqa: E731
         views.radiance_view(plt, img, out("radiance"), 0.0)
@@ -257,7 +246,8 @@ def write_views(plt, rows, exrs, refs, outdir):
 
 
 def main():
-    ap = argparse.ArgumentParser(prog="study.py", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python3 -m tools.study",
+                                 description=__doc__.split("\n\n")[0])
     ap.add_argument("outdir")
     ap.add_argument("--scenes", default=",".join(SCENES))
     ap.add_argument("--confidences", default="0.5,0.9")
@@ -267,10 +257,10 @@ def main():
                     help="--time of each render, a safety net (default 600 s)")
     ap.add_argument("--method", choices=["ppm", "sppm"], default="ppm")
     ap.add_argument("--stop-rule", default="mean-bound")
-    ap.add_argument("--photonbound", default=pbtools.default_photonbound())
+    ap.add_argument("--photonbound", default=cli.default_photonbound())
     args = ap.parse_args()
     start = time.monotonic()
-    exe = pbtools.check_photonbound(args.photonbound)
+    exe = cli.check_photonbound(args.photonbound)
     names = [s.strip() for s in args.scenes.split(",") if s.strip()]
     unknown = [s for s in names if s not in SCENES]
     if unknown or not names:
@@ -280,10 +270,10 @@ def main():
         raise ToolError(f"--confidences {args.confidences}: each must be in (0, 1)")
     targets = float_list(args.targets, "--targets") if args.targets else None
     if args.resolution:
-        pbtools.parse_resolution(args.resolution)
+        parse_resolution(args.resolution)
     if not args.run_time_limit > 0:
         raise ToolError("--run-time-limit must be positive")
-    version = subprocess.run([exe, "--version"], capture_output=True, text=True).stdout.strip()
+    version = cli.version(exe)
 
     outdir = args.outdir
     runs, ref_dir = os.path.join(outdir, "runs"), os.path.join(outdir, "references")
@@ -307,15 +297,15 @@ def main():
                 rows.append(row)
                 exrs.append(exr)
                 logs.append(log)
-    pbtools.write_text(os.path.join(outdir, "results.json"), json.dumps(rows, indent=1) + "\n")
+    write_text(os.path.join(outdir, "results.json"), json.dumps(rows, indent=1) + "\n")
     plt = write_plots(rows, logs, outdir)
     write_views(plt, rows, exrs, refs, outdir)
     total = time.monotonic() - start
-    argv = ["tools/study.py"] + sys.argv[1:]
+    argv = ["python3 -m tools.study"] + sys.argv[1:]
     warnings = {name: reference_warning(name, refs[name][1], smallest_actual(rows, name))
                 for name in names}
     doc = table_document(rows, refs, warnings, argv, total, version)
-    pbtools.write_text(os.path.join(outdir, "table.md"), doc)
+    write_text(os.path.join(outdir, "table.md"), doc)
     print(doc)
     for warning in filter(None, warnings.values()):
         print(f"study: warning: {warning}", file=sys.stderr)
@@ -324,4 +314,4 @@ def main():
 
 
 if __name__ == "__main__":
-    pbtools.run_main("study", main)
+    run_main("study", main)

@@ -1,7 +1,7 @@
-#!/usr/bin/python3
 """PNG views of a photonbound EXR.
 
-  tools/views.py IN.exr -o OUTDIR [--reference REF.exr] [--name PREFIX] [--exposure STOPS]
+  python3 -m tools.views IN.exr -o OUTDIR [--reference REF.exr] [--name PREFIX]
+                         [--exposure STOPS]
 
 writes into OUTDIR (PREFIX defaults to IN's file name without .exr):
 
@@ -25,13 +25,11 @@ Pixels with bound 0 (background, exact emission) are grey and pixels with an unk
 import argparse
 import math
 import os
-import sys
 
 import numpy as np
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-import pbtools  # noqa: E402
-from pbtools import ToolError  # noqa: E402
+from . import exr as exr_io
+from .common import ToolError, run_main, save_figure, save_png, use_agg
 
 EXACT_COLOUR = (0.62, 0.62, 0.62, 1.0)
 UNKNOWN_COLOUR = (0.0, 0.0, 0.0, 1.0)
@@ -85,14 +83,7 @@ def paint(colours, exact, unknown):
 
 
 def radiance_view(plt, exr, path, exposure):
-    rgb = srgb(exr.rgb() * 2.0**exposure)
-    tmp = pbtools.temp_beside(path, ".png")
-    try:
-        plt.imsave(tmp, enlarge(rgb), format="png")
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
+    save_png(path, enlarge(srgb(exr.rgb() * 2.0**exposure)))
 
 
 def finish_map(plt, fig, ax, image, norm, cmap, bar_label, exact, unknown, path):
@@ -103,7 +94,7 @@ def finish_map(plt, fig, ax, image, norm, cmap, bar_label, exact, unknown, path)
                        shrink=0.9)
     bar.set_label(bar_label)
     add_class_legend(ax, exact, unknown)
-    pbtools.save_figure(fig, path)
+    save_figure(fig, path)
 
 
 def bound_view(plt, exr, path, label):
@@ -201,7 +192,7 @@ def bounded_view(plt, exr, ref, path, label):
     ax.set_facecolor((0.3, 0.3, 0.3))
     extra = [Patch(facecolor=c, edgecolor="0.3", label=t) for c, t in levels]
     add_class_legend(ax, ~has & ~unknown, unknown & ~has, extra)
-    pbtools.save_figure(fig, path)
+    save_figure(fig, path)
 
 
 def confidence_text(exr):
@@ -212,7 +203,8 @@ def confidence_text(exr):
 
 
 def main():
-    ap = argparse.ArgumentParser(prog="views.py", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="python3 -m tools.views",
+                                 description=__doc__.split("\n\n")[0])
     ap.add_argument("input", help="a photonbound EXR")
     ap.add_argument("-o", "--output", required=True, help="folder for the PNGs (created)")
     ap.add_argument("--reference", help="reference EXR of the same size: adds PREFIX_bounded.png")
@@ -220,16 +212,16 @@ def main():
     ap.add_argument("--exposure", type=float, default=0.0, help="radiance scale in stops")
     ap.add_argument("--label", help="title of the maps (default: the prefix)")
     args = ap.parse_args()
-    exr = pbtools.read_exr(args.input)
+    exr = exr_io.read_exr(args.input)
     for group in ("Radiance", "ErrorBound", "Bias", "Noise"):
         exr.rgb(group)  # fails, naming the channel, before anything is written
-    ref = pbtools.read_exr(args.reference) if args.reference else None
+    ref = exr_io.read_exr(args.reference) if args.reference else None
     if ref is not None:
         ref.rgb()
     name = args.name or os.path.splitext(os.path.basename(args.input))[0]
     label = args.label or name
     os.makedirs(args.output, exist_ok=True)
-    plt = pbtools.use_agg()
+    plt = use_agg()
     out = lambda kind: os.path.join(args.output, f"{name}_{kind}.png")  # noqa: E731
     radiance_view(plt, exr, out("radiance"), args.exposure)
     bound_view(plt, exr, out("bound"), label)
@@ -242,4 +234,4 @@ def main():
 
 
 if __name__ == "__main__":
-    pbtools.run_main("views", main)
+    run_main("views", main)
