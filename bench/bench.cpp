@@ -68,10 +68,10 @@ std::string heavy_scene() {
   const std::string dir = std::string(PHOTONBOUND_BENCH_DIR) + "/scenes";
   const std::string path = dir + "/cornell_heavy.glb";
   if (!std::filesystem::exists(path)) {
-    std::printf("generating %s (tools/make_scenes.py --heavy, ~10 s)\n", path.c_str());
+    std::printf("generating %s (python3 -m tools.make_scenes --heavy, ~10 s)\n", path.c_str());
     std::fflush(stdout);
-    const std::string cmd = "python3 '" + std::string(PHOTONBOUND_SOURCE_DIR) +
-                            "/tools/make_scenes.py' --heavy '" + dir + "' >/dev/null";
+    const std::string cmd = "cd '" + std::string(PHOTONBOUND_SOURCE_DIR) +
+                            "' && python3 -m tools.make_scenes --heavy '" + dir + "' >/dev/null";
     if (std::system(cmd.c_str()) != 0) throw std::runtime_error("cannot generate " + path);
   }
   return path;

@@ -37,13 +37,7 @@ import sys
 import tempfile
 
 REPO = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-if __name__ == "__main__" and REPO not in os.environ.get("PYTHONPATH", "").split(os.pathsep):
-    # Run by path without the repository root as an import root (ctest runs it so from the
-    # build folder): run again with it, where `python3 -m tools.<name>` finds the package.
-    path = os.pathsep.join(filter(None, (REPO, os.environ.get("PYTHONPATH"))))
-    os.execve(sys.executable, [sys.executable, *sys.argv], {**os.environ, "PYTHONPATH": path})
-
-import numpy as np  # noqa: E402
+import numpy as np
 
 from tools import analytic, cli, exr, gltf_scene, gltf_writer, make_corpus, study  # noqa: E402
 from tools.common import ToolError  # noqa: E402

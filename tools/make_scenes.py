@@ -88,16 +88,7 @@ import struct
 import sys
 from pathlib import Path
 
-if __name__ == "__main__" and not __package__:
-    # Run by path (python3 tools/make_scenes.py), as tests/test_corpus.cpp and bench/bench.cpp
-    # call it: run again as the module tools.make_scenes, in the same folder with the same
-    # arguments, importing from the repository root (-P: not from the current folder).
-    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    path = os.pathsep.join(filter(None, (root, os.environ.get("PYTHONPATH"))))
-    os.execve(sys.executable, [sys.executable, "-P", "-m", "tools.make_scenes", *sys.argv[1:]],
-              {**os.environ, "PYTHONPATH": path})
-
-from . import gltf_scene, gltf_writer  # noqa: E402  (after the re-run above)
+from . import gltf_scene, gltf_writer
 from .common import REPO  # noqa: E402
 from .gltf_scene import (EXT_IOR, EXT_LIGHTS, EXT_SPECULAR, EXT_STRENGTH,  # noqa: E402
                          EXT_TRANSMISSION, EXT_VOLUME, FLOAT, TRIANGLES, cross, dot)
