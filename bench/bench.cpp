@@ -106,7 +106,7 @@ double big_render_at(const std::string& path, uint64_t photons, bool goals) {
   // photons, the renderer's current radii) beside it, after the RSS reading.
   pb::PhotonTracer tracer(r.world(), false);
   std::vector<pb::PhotonHit> hits;
-  tracer.run(kSeed, 3, photons, hits);
+  tracer.run(kSeed, 3, 0, photons, hits);
   std::vector<pb::vec3> positions(hits.size());
   for (size_t k = 0; k < hits.size(); ++k) positions[k] = hits[k].position;
   std::vector<float> radii(points);

@@ -7,6 +7,7 @@
 #include "options/options.h"
 #include "util/parallel.h"
 #include "render/pass_stages.h"
+#include "render/ppm.h"
 #include "render/renderer.h"
 #include "util/rng.h"
 
@@ -26,13 +27,13 @@ struct Phase {
   double median() const { return bench::median(t); }
 };
 
-// Renderer::step's stages 3-5: pb::gather_and_fold over fold blocks of 16384 points.
+// Renderer::step's stages 3-5 for PPM: pb::ppm_pass over fold blocks of 16384 points.
 void gather_on(const pb::World& world, const pb::EyePassResult& eye, const pb::HashGrid& grid,
                const std::vector<pb::PhotonHit>& hits, const pb::EstimatorParams& params,
                uint64_t pass, std::vector<pb::PointState>& states, std::vector<float>& radii,
-               std::vector<pb::PassGather>& sums) {
+               std::vector<pb::PassSums>& sums, std::vector<pb::OwnerValues>& owner) {
   const pb::PassInputs in{world, grid, hits, params, nullptr, kSeed, pass, true};
-  pb::gather_and_fold(in, eye.points, states, radii, sums, nullptr);
+  pb::ppm_pass(in, eye.points, {}, {}, states, radii, sums, owner, nullptr);
 }
 
 // The same without error estimation: no Laplacian sum (gather_photons<false>) and the PPM update
@@ -42,11 +43,11 @@ void gather_off(const pb::World& world, const pb::EyePassResult& eye, const pb::
                 uint64_t pass, std::vector<PlainState>& states) {
   pb::parallel_for(states.size(), kGrain, [&](size_t begin, size_t end) {
     for (size_t k = begin; k < end; ++k) {
-      pb::PassGather g;
+      pb::PassSums g;
       pb::gather_photons<false>(eye.points[k], states[k].r2, grid, hits, g);
       pb::Rng rng(kSeed, pass, k, pb::Stream::DirectLight);
-      g.direct = pb::direct_light(world, eye.points[k], rng);
-      accumulate_plain(states[k], g, params.alpha, params.min_r2);
+      const pb::dvec3 direct = pb::direct_light(world, eye.points[k], rng);
+      accumulate_plain(states[k], g, direct, params.alpha, params.min_r2);
     }
   });
 }
@@ -85,7 +86,8 @@ PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photo
   std::vector<pb::PhotonHit> hits;
   std::vector<pb::vec3> positions;
   std::vector<float> radii(n, pb::search_radius(initial.r2));
-  std::vector<pb::PassGather> sums(std::min<size_t>(n, 16384));
+  std::vector<pb::PassSums> sums(std::min<size_t>(n, 16384));
+  std::vector<pb::OwnerValues> owner(sums.size());
   std::vector<pb::dvec3> direct(n);  // the next-event-only timing writes here
   Phase trace, build, t_on, t_off, t_nee;
   double stored = 0.0;
@@ -93,7 +95,7 @@ PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photo
   for (int p = 1; p <= passes; ++p) {
     const uint64_t pass = uint64_t(p);
     double t0 = now();
-    tracer.run(kSeed, pass, photons, hits);
+    tracer.run(kSeed, pass, 0, photons, hits);
     trace.add(t0);
     stored += double(hits.size());
 
@@ -105,7 +107,7 @@ PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photo
     for (int v = 0; v < 2; ++v) {
       t0 = now();
       if ((v == 0) == (p % 2 == 1)) {
-        gather_on(world, eye, grid, hits, params, pass, on, radii, sums);
+        gather_on(world, eye, grid, hits, params, pass, on, radii, sums, owner);
         t_on.add(t0);
       } else {
         gather_off(world, eye, grid, hits, params, pass, off);
@@ -161,7 +163,8 @@ PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photo
     std::vector<pb::PointState> scratch = on;
     std::vector<float> scratch_radii = radii;
     const double t0 = now();
-    gather_on(world, eye, grid, hits, params, uint64_t(passes + 1), scratch, scratch_radii, sums);
+    gather_on(world, eye, grid, hits, params, uint64_t(passes + 1), scratch, scratch_radii, sums,
+              owner);
     sgather.add(t0);
   }
   r.shrunk_grid_build = sbuild.median();

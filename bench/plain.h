@@ -21,6 +21,7 @@ struct PlainState {
   uint64_t photons = 0;
 };
 
-void accumulate_plain(PlainState& s, const pb::PassGather& g, double alpha, double min_r2);
+void accumulate_plain(PlainState& s, const pb::PassSums& g, const pb::dvec3& direct, double alpha,
+                      double min_r2);
 
 }  // namespace bench

@@ -80,11 +80,11 @@ PhotonRate photon_pass_rate(const pb::World& world, int threads, uint64_t photon
   pb::ThreadLimit limit(threads);
   pb::PhotonTracer tracer(world, false);  // --direct nee, the default
   std::vector<pb::PhotonHit> hits;
-  tracer.run(kSeed, 1000, photons / 8, hits);  // warm-up: buffers, TBB workers, page faults
+  tracer.run(kSeed, 1000, 0, photons / 8, hits);  // warm-up: buffers, TBB workers, page faults
   std::vector<double> times, ray_rates, rays, stored, order;
   for (int p = 1; p <= passes; ++p) {
     const double t0 = now();
-    const pb::PhotonPassStats s = tracer.run(kSeed, uint64_t(p), photons, hits);
+    const pb::PhotonPassStats s = tracer.run(kSeed, uint64_t(p), 0, photons, hits);
     times.push_back(seconds_since(t0));
     ray_rates.push_back(double(s.rays) / times.back());
     rays.push_back(double(s.rays));

@@ -4,6 +4,7 @@
 // bounds exactly where a point never received a photon, positive radii at or above the floor).
 #pragma once
 
+#include "pass_sample.h"
 #include "analytic.h"
 #include "render_fixture.h"
 
@@ -287,7 +288,7 @@ struct UniformPoint {
   uint64_t last_photon_pass = 0;  // 0 = none yet
   UniformPoint() { state.r2 = 1.0; }
   void step(std::mt19937_64& rng, double mu0, const EstimatorParams& params) {
-    PassGather g;
+    PassSample g;
     const double mu = mu0 * state.r2;
     const uint64_t m = mu > 0.0 ? std::poisson_distribution<uint64_t>(mu)(rng) : 0;
     std::uniform_real_distribution<double> u01(0.0, 1.0);
@@ -404,7 +405,7 @@ inline void single_photon_then_zeros(uint64_t j0, double t, const std::vector<ui
   s.r2 = 1.0;
   size_t next = 0;
   for (uint64_t j = 1; j <= checks.back(); ++j) {
-    PassGather g;
+    PassSample g;
     if (j == j0) {
       g.count = 1;
       g.phi = dvec3(kernel::weight(t) * 1000.0);

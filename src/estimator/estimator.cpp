@@ -25,8 +25,8 @@ double ppm_radius_update(double& n, double& r2, double m, double alpha, double m
   return r2 / r2_pass;
 }
 
-void accumulate_pass(PointState& s, const PassGather& g, const EstimatorParams& params,
-                     uint64_t pass) {
+void accumulate_pass(PointState& s, const PassSums& g, const OwnerValues& o,
+                     const EstimatorParams& params, uint64_t pass) {
   const double r2_pass = s.r2;  // R_j: the radius every deposit of this pass was made with
   const double inv_area = 1.0 / (kPiD * r2_pass * params.photons_per_pass);
 
@@ -38,24 +38,24 @@ void accumulate_pass(PointState& s, const PassGather& g, const EstimatorParams& 
   // whole disc (every interior point) takes the plain path, bit for bit.
   dvec3 phi = g.phi, lap = g.phi_lap_r2 / r2_pass;  // w_lap carries 1 / R_j^2
   double r2_bias = r2_pass;
-  if (!g.disc.full) {
-    const double c = std::max(g.disc.mass, kMinKernelMass);
+  if (!o.disc.full) {
+    const double c = std::max(o.disc.mass, kMinKernelMass);
     phi = g.phi / c;
     // A disc cut to a sliver leaves the Laplacian kernel little sensitivity to curvature:
     // its second moment is kept at least a sixteenth of the whole disc's.
-    lap = (lap - (g.disc.lap_mass / r2_pass) * phi) * (4.0 / std::max(g.disc.lap_second, 0.25));
-    r2_bias = r2_pass * g.disc.second / (2.0 * kernel::kSecondMoment * c);
+    lap = (lap - (o.disc.lap_mass / r2_pass) * phi) * (4.0 / std::max(o.disc.lap_second, 0.25));
+    r2_bias = r2_pass * o.disc.second / (2.0 * kernel::kSecondMoment * c);
   }
 
   // Per-pass sample X_j = D_j + phi_j / (pi R_j^2 M_e) (section 4), streamed into bivariate
   // Welford moments with R_j^2: C_xy += (x - mean_x_old)(y - mean_y_new).
-  const dvec3 x = g.direct + phi * inv_area;
+  const dvec3 x = o.direct + phi * inv_area;
   // Section 11c: the kernel at R_j / 2 over the same photons. Under E[X(R)] = L + a R^2 the
   // difference of the two scales is 0.75 a R_j^2 (the direct part cancels), so Y_j below has
   // mean 0; the R^4 terms the model leaves out give it a mean, with a noise of its own that the
   // samples measure. Where the disc is cut by an edge the half disc's kernel mass would be
   // needed too: those passes are left out.
-  if (g.disc.full) {
+  if (o.disc.full) {
     const dvec3 y3 =
         (g.phi - 4.0 * g.phi_half - 0.375 * kernel::kSecondMoment * g.phi_lap_r2) * inv_area;
     const double y = y3.x + y3.y + y3.z;
@@ -72,13 +72,13 @@ void accumulate_pass(PointState& s, const PassGather& g, const EstimatorParams& 
   s.c_xx += dx * (x - s.mean_x);
   s.c_xr += dx * (r2_bias - s.mean_r2);
   s.c_rr += dr * (r2_bias - s.mean_r2);
-  s.photons += g.count;
+  s.photons += uint64_t(g.count);
   const double sign = (pass & 1u) ? 1.0 : -1.0;
   s.alt_x += sign * x;
   s.alt_r2 += sign * r2_bias;
 
   // PPM update (section 3, HOJ08): only photons that could contribute shrink the radius.
-  const double applied = ppm_radius_update(s.n, s.r2, double(g.count), params.alpha, params.min_r2);
+  const double applied = ppm_radius_update(s.n, s.r2, g.count, params.alpha, params.min_r2);
   s.tau = (s.tau + phi) * applied;
   s.tau_lap = (s.tau_lap + lap) * applied;
 }

@@ -10,14 +10,25 @@
 
 namespace pb {
 
-// What one pass gathered at one point (ESTIMATOR.md section 3, "During pass j").
-struct PassGather {
+// What one pass's photons add at one point (ESTIMATOR.md section 3, "During pass j"): sums
+// over photons, so the sums over two disjoint sets of a pass's photons add up to the sums over
+// their union. A pass split across threads or machines reduces arrays of these (ten doubles,
+// nothing else) before the fold.
+struct PassSums {
   dvec3 phi{0.0};         // sum of w(t) f Phi
   dvec3 phi_lap_r2{0.0};  // sum of w_lap(t) R_j^2 f Phi (divided by R_j^2 in the update)
   dvec3 phi_half{0.0};    // sum of w(2t) f Phi over t < 1/2: the same kernel at radius R_j / 2
-  uint64_t count = 0;     // M_j: photons that landed within R_j on the point's side
-  dvec3 direct{0.0};      // D_j: next-event estimate of direct light (0 with --direct photons)
-  DiscMoments disc;       // the kernel's moments over the reachable part of the disc (section 11)
+  double count = 0.0;     // M_j: photons that landed within R_j on the point's side (exact)
+};
+static_assert(sizeof(PassSums) == 10 * sizeof(double), "a reduction moves plain doubles");
+
+// What the owner of a point computes once per pass, whatever the photons: these are not summed
+// over photon subsets, and a split pass computes them once.
+struct OwnerValues {
+  // D_j: the light the camera path saw (SPPM: emission along it, followed lobes' light) plus
+  // the point's next-event estimate (0 with --direct photons).
+  dvec3 direct{0.0};
+  DiscMoments disc;  // the kernel's moments over the reachable part of the disc (section 11)
 };
 
 // Everything the estimator keeps for one point, in double (ESTIMATOR.md section 8).
@@ -70,9 +81,10 @@ struct EstimatorParams {
 // actually changed by, which tau and tauLap must follow exactly.
 double ppm_radius_update(double& n, double& r2, double m, double alpha, double min_r2);
 
-// Folds pass number `pass` (1-based) into the state. state.r2 must be the radius the pass used.
-void accumulate_pass(PointState& state, const PassGather& gather, const EstimatorParams& params,
-                     uint64_t pass);
+// Folds pass number `pass` (1-based) into the state: its photons' sums and its owner's values.
+// state.r2 must be the radius the pass used.
+void accumulate_pass(PointState& state, const PassSums& sums, const OwnerValues& owner,
+                     const EstimatorParams& params, uint64_t pass);
 
 // The point's estimate after `passes` passes.
 struct PointEstimate {

@@ -28,7 +28,7 @@ bool survives(vec3& weight, Rng& rng) {
 
 size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
                             std::span<MeasurementPoint> points, std::span<GlossyPoint> glossy,
-                            std::span<PassGather> out) {
+                            std::span<OwnerValues> out) {
   const int width = in.camera.width();
   size_t glossy_count = 0;
   for (size_t k = 0; k < points.size(); ++k) {
@@ -185,9 +185,7 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
       dir = b.wi;
     }
     points[k] = point;
-    out[k] = PassGather{};
-    out[k].direct = emission;
-    out[k].disc = disc;
+    out[k] = OwnerValues{emission, disc};
   }
   return glossy_count;
 }

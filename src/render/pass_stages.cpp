@@ -1,6 +1,5 @@
 #include "render/pass_stages.h"
 
-#include "render/camera_paths.h"
 #include "render/next_event.h"
 
 #include "util/parallel.h"
@@ -56,7 +55,7 @@ namespace {
 // f(wo, wi) (glossy points, whose f holds the path weight alone).
 template <bool kLaplacian, class PhotonFlux>
 void gather_kernel(const MeasurementPoint& point, double r2, const HashGrid& grid,
-                   const std::vector<PhotonHit>& hits, PhotonFlux&& photon_flux, PassGather& out) {
+                   const std::vector<PhotonHit>& hits, PhotonFlux&& photon_flux, PassSums& out) {
   const float radius = search_radius(r2);
   const double inv_r2 = 1.0 / r2;
   dvec3 phi(0.0), lap(0.0), half(0.0);
@@ -86,7 +85,7 @@ void gather_kernel(const MeasurementPoint& point, double r2, const HashGrid& gri
     out.phi_lap_r2 += f * lap;
     out.phi_half += f * half;
   }
-  out.count += count;
+  out.count += double(count);
 }
 
 // Walks a GlossyTable alongside the points of its span, in order.
@@ -113,32 +112,32 @@ class GlossyCursor {
 
 template <bool kLaplacian>
 void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& grid,
-                    const std::vector<PhotonHit>& hits, PassGather& out) {
+                    const std::vector<PhotonHit>& hits, PassSums& out) {
   gather_kernel<kLaplacian>(
       point, r2, grid, hits, [](const PhotonHit& h) { return dvec3(h.flux); }, out);
 }
 
 template <bool kLaplacian>
 void gather_photons(const MeasurementPoint& point, const GlossyPoint& glossy, double r2,
-                    const HashGrid& grid, const std::vector<PhotonHit>& hits, PassGather& out) {
+                    const HashGrid& grid, const std::vector<PhotonHit>& hits, PassSums& out) {
   gather_kernel<kLaplacian>(
       point, r2, grid, hits,
       [&](const PhotonHit& h) { return dvec3(h.flux * glossy.bsdf.eval(glossy.wo, h.wi)); }, out);
 }
 
 template void gather_photons<true>(const MeasurementPoint&, double, const HashGrid&,
-                                   const std::vector<PhotonHit>&, PassGather&);
+                                   const std::vector<PhotonHit>&, PassSums&);
 template void gather_photons<false>(const MeasurementPoint&, double, const HashGrid&,
-                                    const std::vector<PhotonHit>&, PassGather&);
+                                    const std::vector<PhotonHit>&, PassSums&);
 template void gather_photons<true>(const MeasurementPoint&, const GlossyPoint&, double,
-                                   const HashGrid&, const std::vector<PhotonHit>&, PassGather&);
+                                   const HashGrid&, const std::vector<PhotonHit>&, PassSums&);
 template void gather_photons<false>(const MeasurementPoint&, const GlossyPoint&, double,
-                                    const HashGrid&, const std::vector<PhotonHit>&, PassGather&);
+                                    const HashGrid&, const std::vector<PhotonHit>&, PassSums&);
 
 void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
-                 const HashGrid& grid, const std::vector<PhotonHit>& hits,
-                 const BoundaryIndex* boundary, GlossyTable glossy, std::span<PassGather> out,
-                 std::span<const float> clearance) {
+                 const HashGrid& grid, const std::vector<PhotonHit>& hits, GlossyTable glossy,
+                 std::span<PassSums> out) {
+  std::fill(out.begin(), out.end(), PassSums{});
   GlossyCursor cursor(glossy, points.size());
   for (size_t k = 0; k < points.size(); ++k) {
     const MeasurementPoint& p = points[k];
@@ -147,6 +146,15 @@ void gather_pass(std::span<const MeasurementPoint> points, std::span<const Point
       gather_photons(p, *g, states[k].r2, grid, hits, out[k]);
     else
       gather_photons(p, states[k].r2, grid, hits, out[k]);
+  }
+}
+
+void disc_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
+               const BoundaryIndex* boundary, std::span<const float> clearance,
+               std::span<OwnerValues> out) {
+  for (size_t k = 0; k < points.size(); ++k) {
+    const MeasurementPoint& p = points[k];
+    if (!(max_component(p.f) > 0.0f)) continue;
     const float r = search_radius(states[k].r2);
     if (boundary && (clearance.empty() || r > clearance[k]))
       out[k].disc = boundary->moments(p.triangle, p.position, p.normal, r);
@@ -155,7 +163,7 @@ void gather_pass(std::span<const MeasurementPoint> points, std::span<const Point
 
 void next_event_pass(const World& world, std::span<const MeasurementPoint> points,
                      GlossyTable glossy, uint64_t seed, uint64_t pass, size_t first,
-                     std::span<PassGather> out) {
+                     std::span<OwnerValues> out) {
   GlossyCursor cursor(glossy, points.size());
   for (size_t k = 0; k < points.size(); ++k) {
     if (!(max_component(points[k].f) > 0.0f)) continue;
@@ -166,86 +174,15 @@ void next_event_pass(const World& world, std::span<const MeasurementPoint> point
   }
 }
 
-void fold_pass(std::span<PointState> states, std::span<const PassGather> sums,
-               const EstimatorParams& params, uint64_t pass, std::span<float> radii,
-               PointState* copy) {
+void fold_pass(std::span<PointState> states, std::span<const PassSums> sums,
+               std::span<const OwnerValues> owner, const EstimatorParams& params, uint64_t pass,
+               std::span<float> radii, PointState* copy) {
   for (size_t k = 0; k < states.size(); ++k) {
-    accumulate_pass(states[k], sums[k], params, pass);
+    accumulate_pass(states[k], sums[k], owner[k], params, pass);
     radii[k] = search_radius(states[k].r2);
     if (copy) stream_copy(copy + k, states[k]);
   }
   if (copy) store_fence();  // the streamed stores are visible before the writer reads them
-}
-
-void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> points,
-                     std::span<PointState> states, std::span<float> radii,
-                     std::span<PassGather> sums, PointState* copy) {
-  constexpr size_t kGrain = 256;  // points per parallel task inside a block
-  const size_t n = states.size(), block = sums.size();
-  for (size_t first = 0; first < n; first += block) {
-    const size_t count = std::min(block, n - first);
-    parallel_for(count, kGrain, [&](size_t b, size_t e) {
-      const std::span<PassGather> out = sums.subspan(b, e - b);
-      std::fill(out.begin(), out.end(), PassGather{});
-      const GlossyTable glossy{in.glossy, first + b};
-      gather_pass(points.subspan(first + b, e - b),
-                  std::span<const PointState>(states).subspan(first + b, e - b), in.grid, in.hits,
-                  in.boundary, glossy, out,
-                  in.clearance.empty() ? in.clearance : in.clearance.subspan(first + b, e - b));
-      if (in.next_event)
-        next_event_pass(in.world, points.subspan(first + b, e - b), glossy, in.seed, in.pass,
-                        first + b, out);
-    });
-    // A distributed render reduces sums[0, count) across machines here.
-    parallel_for(count, kGrain, [&](size_t b, size_t e) {
-      fold_pass(states.subspan(first + b, e - b),
-                std::span<const PassGather>(sums).subspan(b, e - b), in.params, in.pass,
-                radii.subspan(first + b, e - b), copy ? copy + first + b : nullptr);
-    });
-  }
-}
-
-void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
-                          std::span<PointState> states, std::span<float> radii,
-                          std::span<uint32_t> visible, std::span<float> min_mass,
-                          std::span<float> glossy_f, std::span<MeasurementPoint> points,
-                          std::span<GlossyPoint> glossy, std::span<PassGather> sums,
-                          PointState* copy) {
-  constexpr size_t kGrain = 256;  // pixels per parallel task inside a block
-  const size_t n = states.size(), block = sums.size();
-  for (size_t first = 0; first < n; first += block) {
-    const size_t count = std::min(block, n - first);
-    parallel_for(count, kGrain, [&](size_t b, size_t e) {
-      const std::span<MeasurementPoint> pts = points.subspan(b, e - b);
-      const std::span<PassGather> out = sums.subspan(b, e - b);
-      const std::span<GlossyPoint> scratch = glossy.subspan(b, e - b);
-      const std::span<const float> r = std::span<const float>(radii).subspan(first + b, e - b);
-      const size_t n_glossy = trace_visible_points(camera, first + b, r, pts, scratch, out);
-      const GlossyTable table{scratch.first(n_glossy), 0};  // indices into pts
-      // The camera paths left each visible point's disc moments in out (boundary null here).
-      gather_pass(pts, std::span<const PointState>(states).subspan(first + b, e - b), in.grid,
-                  in.hits, nullptr, table, out);
-      if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, first + b, out);
-      for (size_t k = 0; k < pts.size(); ++k) {
-        if (!(max_component(pts[k].f) > 0.0f)) continue;
-        const size_t pixel = first + b + k;
-        if (visible[pixel] != UINT32_MAX) ++visible[pixel];  // saturating: far beyond use
-        min_mass[pixel] = std::min(min_mass[pixel], float(out[k].disc.mass));
-      }
-      for (const GlossyPoint& g : table.entries) {  // only while the cap can still matter
-        const size_t pixel = first + b + g.point;
-        if (states[pixel].photons >= kMinPhotonsForBound) continue;
-        const float f = max_component(pts[g.point].f * g.bsdf.max_f(g.wo));
-        glossy_f[pixel] = std::max(glossy_f[pixel], f);
-      }
-    });
-    // A distributed render reduces sums[0, count) across machines here.
-    parallel_for(count, kGrain, [&](size_t b, size_t e) {
-      fold_pass(states.subspan(first + b, e - b),
-                std::span<const PassGather>(sums).subspan(b, e - b), in.params, in.pass,
-                radii.subspan(first + b, e - b), copy ? copy + first + b : nullptr);
-    });
-  }
 }
 
 }  // namespace pb

@@ -1,13 +1,13 @@
-// The stages of one pass, each a function of plain inputs and outputs, in the order the
-// renderer runs them (the bench times the same functions):
-//   0. SPPM only: camera paths trace_visible_points (camera_paths.h) -> visible points, emission
-//   1. trace photons          PhotonTracer::run (photon_pass.h)      -> hits
-//   2. build the grid         build_photon_grid                      -> grid over the hits
-//   3. gather                 gather_pass: photons within each radius -> pass sums (phi, lap, M)
-//   4. next-event samples     next_event_pass                        -> pass sums (D)
-//   5. fold                   fold_pass: sums into the estimator     -> states, radii
-// The pass sums of a block of points exist as an array (PassGather, estimator.h) between 4 and
-// 5: a distributed render reduces exactly that array across machines before folding it.
+// The stages of one pass, each a function of plain inputs and outputs; the methods (ppm.h,
+// sppm.h) run them in this order over blocks of points:
+//   0. SPPM only: camera paths trace_visible_points (camera_paths.h) -> visible points, owner values
+//   1. trace photons          PhotonTracer::run (photon_pass.h)       -> hits of a photon range
+//   2. build the grid         build_photon_grid                       -> grid over the hits
+//   3. gather                 gather_pass: photons within each radius  -> PassSums (phi, lap, M)
+//   4. owner values           disc_pass (PPM), next_event_pass         -> OwnerValues (D, disc)
+//   5. fold                   fold_pass: sums and values into states   -> states, radii
+// Stage 3 runs on any set of photon hits, and its PassSums (estimator.h) add over disjoint sets:
+// a pass split across machines reduces a block's PassSums array between 4 and 5.
 #pragma once
 
 #include "world/boundary.h"
@@ -16,9 +16,11 @@
 #include "render/hash_grid.h"
 #include "render/next_event.h"
 #include "render/photon_pass.h"
+#include "util/parallel.h"
 #include "util/rng.h"
 #include "world/world.h"
 
+#include <algorithm>
 #include <cmath>
 #include <span>
 #include <vector>
@@ -40,12 +42,12 @@ void build_photon_grid(const std::vector<PhotonHit>& hits, std::span<const float
 // multiplied once.
 template <bool kLaplacian = true>
 void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& grid,
-                    const std::vector<PhotonHit>& hits, PassGather& out);
+                    const std::vector<PhotonHit>& hits, PassSums& out);
 // The same for a point on a non-Lambertian surface: each photon's power times f(wo, wi_photon),
 // the path weight point.f once.
 template <bool kLaplacian = true>
 void gather_photons(const MeasurementPoint& point, const GlossyPoint& glossy, double r2,
-                    const HashGrid& grid, const std::vector<PhotonHit>& hits, PassGather& out);
+                    const HashGrid& grid, const std::vector<PhotonHit>& hits, PassSums& out);
 
 // The glossy side table of a span of points: entries sorted by GlossyPoint::point, which counts
 // from the span's first point at `base` (entries outside the span are skipped).
@@ -54,34 +56,38 @@ struct GlossyTable {
   size_t base = 0;
 };
 
-// Stage 3: adds the photons of the pass at points[k] into out[k] (phi, phi_lap_r2, count).
-// states[k].r2 is the radius of the pass. A point with f = 0 (SPPM: no visible point this
-// pass) gathers nothing and so does not shrink its radius. Points in `glossy` evaluate their
-// Bsdf per photon. With `boundary`, also the kernel's moments over the reachable part of each
-// point's disc (ESTIMATOR.md section 11); without, every disc counts as whole. `clearance`
-// (PPM; empty otherwise) holds per point BoundaryIndex::clearance: the radius up to which its
-// disc is whole without asking.
+// Stage 3: out[k] = the sums of the photons `hits` brings to points[k] (phi, phi_lap_r2,
+// phi_half, count) at the pass's radius states[k].r2. A point with f = 0 (SPPM: no visible point
+// this pass) gathers nothing and so does not shrink its radius. Points in `glossy` evaluate
+// their Bsdf per photon.
 void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
-                 const HashGrid& grid, const std::vector<PhotonHit>& hits,
-                 const BoundaryIndex* boundary, GlossyTable glossy, std::span<PassGather> out,
-                 std::span<const float> clearance = {});
+                 const HashGrid& grid, const std::vector<PhotonHit>& hits, GlossyTable glossy,
+                 std::span<PassSums> out);
 
-// Stage 4: adds one next-event sample at points[k] to out[k].direct, drawn from
-// Rng(seed, pass, first + k, Stream::DirectLight): point (or pixel) first + k's own stream.
+// Stage 4, PPM: out[k].disc = the kernel's moments over the reachable part of points[k]'s disc
+// at the pass's radius (ESTIMATOR.md section 11); without `boundary` every disc counts as whole.
+// `clearance` holds per point BoundaryIndex::clearance: the radius up to which its disc is whole
+// without asking.
+void disc_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
+               const BoundaryIndex* boundary, std::span<const float> clearance,
+               std::span<OwnerValues> out);
+
+// Stage 4: adds one next-event sample (ESTIMATOR.md section 4) to out[k].direct for every
+// point with f > 0, Rng keyed by (seed, pass, first + k, DirectLight). A point on a GGX lobe's
+// diffuse base (Bsdf::is_base_part) is skipped: its camera path took its sample.
 void next_event_pass(const World& world, std::span<const MeasurementPoint> points,
                      GlossyTable glossy, uint64_t seed, uint64_t pass, size_t first,
-                     std::span<PassGather> out);
+                     std::span<OwnerValues> out);
 
-// Stage 5: folds sums[k] into states[k] (accumulate_pass), writes the radius the next grid is
-// built for into radii[k], and with `copy` streams each new state into copy[k] (a checkpoint's
-// snapshot, written while the state is in cache).
-void fold_pass(std::span<PointState> states, std::span<const PassGather> sums,
-               const EstimatorParams& params, uint64_t pass, std::span<float> radii,
-               PointState* copy);
+// Stage 5: folds sums[k] and owner[k] into states[k] (accumulate_pass), writes the radius the
+// next grid is built for into radii[k], and with `copy` streams each new state into copy[k]
+// (a checkpoint's snapshot, written while the state is in cache).
+void fold_pass(std::span<PointState> states, std::span<const PassSums> sums,
+               std::span<const OwnerValues> owner, const EstimatorParams& params, uint64_t pass,
+               std::span<float> radii, PointState* copy);
 
-// Stages 3-5 over all points, block by block in parallel, as Renderer::step runs them: for each
-// block of sums.size() points, gather and next-event samples into `sums`, then fold. `copy`
-// (sized to the points) receives the new states.
+// What every stage of a pass reads: the world, the pass's photons and grid, the estimator's
+// parameters and the random stream's key.
 struct PassInputs {
   const World& world;
   const HashGrid& grid;
@@ -90,24 +96,24 @@ struct PassInputs {
   const BoundaryIndex* boundary = nullptr;
   uint64_t seed = 0, pass = 0;
   bool next_event = true;
-  std::span<const GlossyPoint> glossy{};  // PPM: EyePassResult::glossy (indices into the points)
-  std::span<const float> clearance{};     // PPM: per point, BoundaryIndex::clearance
 };
-void gather_and_fold(const PassInputs& in, std::span<const MeasurementPoint> points,
-                     std::span<PointState> states, std::span<float> radii,
-                     std::span<PassGather> sums, PointState* copy);
 
-// SPPM (ESTIMATOR.md section 10): the same with the camera stage first, per block of pixels:
-// trace_visible_points into `points` and `glossy` (block-sized scratch) and the sums' emission,
-// gather, next-event samples, count each pixel's passes with a visible point in `visible`, keep
-// the smallest kernel mass of its visible points in `min_mass` and the largest f a glossy visible
-// point of it may have (throughput x Bsdf::max_f) in `glossy_f` (section 12), then fold.
-struct CameraPathInputs;
-void sppm_gather_and_fold(const PassInputs& in, const CameraPathInputs& camera,
-                          std::span<PointState> states, std::span<float> radii,
-                          std::span<uint32_t> visible, std::span<float> min_mass,
-                          std::span<float> glossy_f, std::span<MeasurementPoint> points,
-                          std::span<GlossyPoint> glossy, std::span<PassGather> sums,
-                          PointState* copy);
+// Points per parallel task inside a fold block. The methods cut a block into chunks of this
+// many points, the same every pass: a chunk's glossy entries sit at the front of its share of
+// the scratch, so every stage of a chunk must see the same chunk.
+inline constexpr size_t kStageChunk = 256;
+
+// Runs body(first, count) for the chunks [first, first + count) of [0, n) of kStageChunk
+// points, in parallel.
+template <class Body>
+void for_each_chunk(size_t n, Body&& body) {
+  const size_t chunks = (n + kStageChunk - 1) / kStageChunk;
+  parallel_for(chunks, 1, [&](size_t b, size_t e) {
+    for (size_t c = b; c < e; ++c) {
+      const size_t first = c * kStageChunk;
+      body(first, std::min(kStageChunk, n - first));
+    }
+  });
+}
 
 }  // namespace pb

@@ -83,8 +83,9 @@ void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, std::vect
   }
 }
 
-PhotonPassStats PhotonTracer::run(uint64_t seed, uint64_t pass, uint64_t count,
+PhotonPassStats PhotonTracer::run(uint64_t seed, uint64_t pass, uint64_t first, uint64_t last,
                                   std::vector<PhotonHit>& hits) {
+  const uint64_t count = last > first ? last - first : 0;
   const size_t chunks = size_t((count + kChunk - 1) / kChunk);
   if (chunk_hits_.size() < chunks) chunk_hits_.resize(chunks);
   chunk_bounds_.resize(chunks);
@@ -94,7 +95,7 @@ PhotonPassStats PhotonTracer::run(uint64_t seed, uint64_t pass, uint64_t count,
     std::vector<PhotonHit>& out = chunk_hits_[k];
     out.clear();
     uint64_t local_rays = 0;
-    for (size_t i = begin; i < end; ++i) trace(seed, pass, i, out, local_rays);
+    for (size_t i = begin; i < end; ++i) trace(seed, pass, first + i, out, local_rays);
     Bounds b;
     float max_flux = 0.0f;
     for (const PhotonHit& h : out) {

@@ -30,14 +30,17 @@ class PhotonTracer {
   // deposit_first_hit: record photons at their first surface (all light from photons).
   PhotonTracer(const World& world, bool deposit_first_hit);
 
-  // Traces photons [0, count) of `pass`; photon k draws from Rng(seed, pass, k). The hits are
+  // Traces photons [first, last) of `pass`; photon k draws from Rng(seed, pass, k) whatever the
+  // range, so the photons of a pass split into ranges (across machines) are the photons of the
+  // whole pass, and the ranges' gathered sums add up to the whole pass's. The hits are
   // written into `hits` (reused across passes) in spatial order: sorted by the Morton code of
   // their position on a 1024^3 lattice over the hits' bounds, ties in photon order. The order
   // depends only on the hits, not on the threads. Why: a gather reads hits[k] for every photon
   // near its point; in photon order each is a cache miss, in Morton order a point's photons are
   // a few contiguous runs that the neighbouring points read again (bench/README.md: a 2.1-2.4x
   // faster gather at 1 M photons per pass, and a faster grid build).
-  PhotonPassStats run(uint64_t seed, uint64_t pass, uint64_t count, std::vector<PhotonHit>& hits);
+  PhotonPassStats run(uint64_t seed, uint64_t pass, uint64_t first, uint64_t last,
+                      std::vector<PhotonHit>& hits);
 
   // A photon path never takes more bounces than this; Russian roulette ends almost all first.
   static constexpr int kMaxBounces = 256;

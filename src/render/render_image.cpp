@@ -24,29 +24,34 @@ ExrImage pack_channels(const FilmImage& film) {
   return out;
 }
 
-ExrImage Renderer::image(const RunInfo& run) const { return image(run, view()); }
-
-ExrImage Renderer::image(const RunInfo& run, const RenderState& state) const {
-  return image(run, view(state));
+ExrImage Renderer::image(const RunInfo& run) const {
+  FilmImage film;
+  const FilmSummary summary = develop(&film);
+  return image(run, film, summary, work_, initial_radius_, states_.size());
 }
 
-ExrImage Renderer::image(const RunInfo& run, const View& v) const {
+ExrImage Renderer::image(const RunInfo& run, const RenderState& state) const {
   FilmImage film;
-  const FilmSummary summary = develop(v, &film);
+  const FilmSummary summary = develop(state, &film);
+  return image(run, film, summary, state.work, state.initial_radius, state.states.size());
+}
+
+ExrImage Renderer::image(const RunInfo& run, const FilmImage& film, const FilmSummary& summary,
+                         const WorkCounters& work, double initial_radius, size_t states) const {
   ExrImage out = pack_channels(film);
   out.metadata = describe(options_);
   out.metadata.insert(out.metadata.end(),
                       {
                           {"version", PHOTONBOUND_VERSION},
                           {"command_line", options_.command_line},
-                          {"passes_done", std::to_string(v.work.passes)},
-                          {"photons_emitted", std::to_string(v.work.photons)},
+                          {"passes_done", std::to_string(work.passes)},
+                          {"photons_emitted", std::to_string(work.photons)},
                           {"seconds", number_text(run.seconds)},
                           {"stop_reason", run.stop_reason},
-                          {"initial_radius", number_text(v.initial_radius)},
+                          {"initial_radius", number_text(initial_radius)},
                           {"mean_error_bound", number_text(summary.mean_bound)},
                           {"unknown_pixels", std::to_string(summary.unknown_pixels)},
-                          {"estimator_states", std::to_string(v.states.size())},
+                          {"estimator_states", std::to_string(states)},
                       });
   // The view rendered, in the file's coordinates: the values of --look-from, --look-at, --up
   // and --fov that reproduce it here or frame it in another renderer (the entries above say

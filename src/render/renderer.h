@@ -1,8 +1,8 @@
-// The render itself: state, step() and snapshot/restore, nothing else. PPM runs the eye pass
-// once and keeps its measurement points; SPPM traces fresh camera paths every pass and keeps one
-// state per pixel. Every pass runs the stages of pass_stages.h in turn (trace photons, build the
-// grid, [SPPM: camera paths,] gather into pass sums, fold the sums into the estimator). When to
-// stop, what to print and when to checkpoint belong to the driver (driver.h).
+// The render itself: state, step() and snapshot/restore, nothing else. The method (method.h:
+// PPM keeps the measurement points of one eye pass, SPPM traces fresh camera paths every pass
+// and keeps one state per pixel) runs the camera's side of a pass; the renderer owns what both
+// share: the states and radii, the photons (a photon index range per pass) and their grid.
+// When to stop, what to print and when to checkpoint belong to the driver (app/driver.h).
 #pragma once
 
 #include "world/boundary.h"
@@ -10,6 +10,7 @@
 #include "render/eye_pass.h"
 #include "estimator/film.h"
 #include "render/hash_grid.h"
+#include "render/method.h"
 #include "io/image_io.h"
 #include "options/options.h"
 #include "render/photon_pass.h"
@@ -17,36 +18,11 @@
 #include "world/world.h"
 
 #include <cstdint>
-#include <stdexcept>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace pb {
-
-// A saved render that does not fit this one (restore()); the state file's format is
-// app/checkpoint.h's.
-class StateError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-// The work done so far, part of every state.
-struct WorkCounters {
-  uint64_t passes = 0;
-  uint64_t photons = 0;  // emitted, all passes
-  uint64_t rays = 0;     // photon-pass rays, all passes
-};
-
-// Everything a state file holds of the render itself.
-struct RenderState {
-  WorkCounters work;
-  double initial_radius = 0.0;
-  std::vector<PointState> states;  // PPM: one per measurement point; SPPM: one per pixel
-  std::vector<uint32_t> visible;   // SPPM: passes with a visible point, per pixel
-  std::vector<float> min_mass;     // SPPM: smallest kernel mass of a visible point, per pixel
-  double max_photon_power = 0.0;   // largest channel of a photon's power seen (section 12)
-  std::vector<float> glossy_f;     // SPPM: largest f a glossy visible point had, per pixel
-};
 
 // Wall-clock seconds spent in each phase, accumulated over all passes (for the benchmark).
 struct PhaseTimings {
@@ -75,6 +51,7 @@ double min_radius(const World& world);
 class Renderer {
  public:
   Renderer(Scene scene, const RenderOptions& options);
+  ~Renderer();
 
   // Runs one more pass (pass number passes() + 1). With `copy`, also copies every point's
   // state into it as the pass leaves it (resized to the point count first).
@@ -103,7 +80,7 @@ class Renderer {
 
   const RenderOptions& options() const { return options_; }
   // PPM: the measurement points. SPPM: the image size and the median footprint only.
-  const EyePassResult& eye() const { return eye_; }
+  const EyePassResult& eye() const { return method_->eye(); }
   const std::vector<PointState>& states() const { return states_; }
   FilmSettings film_settings() const;
   const PhaseTimings& timings() const { return timings_; }
@@ -116,51 +93,28 @@ class Renderer {
   void use_boundary_moments(bool on) { boundary_on_ = on; }
 
  private:
-  // The current state or a snapshot's, without copying either.
-  struct View {
-    const WorkCounters& work;
-    double initial_radius;
-    const std::vector<PointState>& states;
-    const std::vector<uint32_t>& visible;
-    const std::vector<float>& min_mass;
-    double max_photon_power;
-    const std::vector<float>& glossy_f;
-  };
-  View view() const {
-    return {work_, initial_radius_, states_, visible_, min_mass_, max_photon_power_, glossy_f_};
-  }
-  static View view(const RenderState& s) {
-    return {s.work,     s.initial_radius,   s.states,  s.visible,
-            s.min_mass, s.max_photon_power, s.glossy_f};
-  }
-  PixelLayout layout(const View& v) const;
-  FilmSummary develop(const View& v, FilmImage* image) const;
-  ExrImage image(const RunInfo& run, const View& v) const;
+  // Which of `states` make up each pixel, with a snapshot's side state or the current one.
+  PixelLayout layout(const std::vector<PointState>& states, const RenderState* saved,
+                     double max_photon_power) const;
+  FilmSummary develop(const std::vector<PointState>& states, const RenderState* saved,
+                      uint64_t passes, double max_photon_power, FilmImage* image) const;
+  ExrImage image(const RunInfo& run, const FilmImage& film, const FilmSummary& summary,
+                 const WorkCounters& work, double initial_radius, size_t states) const;
 
   const RenderOptions options_;
   World world_;
   PinholeCamera camera_;
-  EyePassResult eye_;
+  std::unique_ptr<PhotonMethod> method_;
   std::vector<PointState> states_;
   EstimatorParams params_;
   PhotonTracer tracer_;
   HashGrid grid_;
   BoundaryIndex boundary_;  // where surfaces end, for discs up to the initial radius
   bool boundary_on_ = true;
-  std::vector<float> clearance_;  // PPM: per point, BoundaryIndex::clearance at the initial radius
   std::vector<PhotonHit> hits_;
   std::vector<vec3> hit_positions_;
   std::vector<float> radii_;       // search_radius(r2) per point, for the grid build
-  std::vector<PassGather> sums_;   // one fold block's pass sums (pass_stages.h)
-  std::vector<uint32_t> visible_;  // SPPM: passes with a visible point, per pixel
-  std::vector<float> min_mass_;    // SPPM: smallest kernel mass seen, per pixel
   double max_photon_power_ = 0.0;  // emitted or stored, the largest channel
-  vec3 max_f_{0.0f};               // largest BRDF a Lambertian point can have
-  std::vector<float> glossy_f_;    // SPPM: largest glossy f seen, per pixel
-  // PPM with glossy points: the points with f times Bsdf::max_f for the sparse-photon bound.
-  std::vector<MeasurementPoint> capped_points_;
-  std::vector<MeasurementPoint> visible_points_;  // SPPM: one fold block's, reused
-  std::vector<GlossyPoint> visible_glossy_;       // SPPM: their Bsdfs where not Lambertian
   WorkCounters work_;
   double initial_radius_ = 0.0;
   PhaseTimings timings_;

@@ -2,6 +2,7 @@
 // the bias and Laplacian estimates on a quadratic field, and the per-point progressive state
 // (PPM update, streaming moments, retroactive bias correction, Student-t quantiles) against
 // direct recomputation from the recorded per-pass samples.
+#include "pass_sample.h"
 #include "estimator/estimator.h"
 #include "estimator/kernel.h"
 #include "util/rng.h"
@@ -269,15 +270,15 @@ TEST(KernelEstimate, QuadraticFieldBiasAndLaplacianPhotonGrid) {
 struct Recorded {
   double r2;        // R_j^2 (state.r2 before the pass)
   double n_before;  // state.n before the pass
-  PassGather g;
+  PassSample g;
   dvec3 x;  // X_j = D_j + phi_j / (pi R_j^2 M_e)
 };
 
 // Synthetic gathers whose per-pass estimates look like a real point's: X_j ~ L + b R_j^2 + noise,
 // Laplacian samples ~ lap0 + noise, about 20% of passes without photons (phi = 0, count = 0).
-PassGather synthetic_gather(uint64_t seed, uint64_t pass, double r2, double me) {
+PassSample synthetic_gather(uint64_t seed, uint64_t pass, double r2, double me) {
   Rng rng(seed, 0, pass, Stream::Test);
-  PassGather g;
+  PassSample g;
   const bool empty = rng.next_double() < 0.2;
   g.count = empty ? 0 : 1 + (rng.next_u32() % 60);
   const dvec3 L(0.8, 1.5, 0.3), b(0.6, -0.4, 1.0), lap0(2.0, -1.0, 5.0);
@@ -332,7 +333,7 @@ TEST(Estimator, UpdateIdentityPhotonRadianceIsMeanOfPassEstimates) {
   dvec3 sum(0.0);
   for (int j = 1; j <= kPasses; ++j) {
     const double r2 = s.r2;
-    const PassGather g = synthetic_gather(11, uint64_t(j), r2, kMe);
+    const PassSample g = synthetic_gather(11, uint64_t(j), r2, kMe);
     sum += g.phi / (kPi_ * r2 * kMe);
     accumulate_pass(s, g, p, uint64_t(j));
     const dvec3 lp = photon_radiance(s, uint64_t(j), kMe);
@@ -380,7 +381,7 @@ TEST(Estimator, EmptyFirstPassesKeepRadius) {
   p.alpha = kAlpha;
   p.photons_per_pass = kMe;
   s.r2 = 0.04;
-  PassGather g;
+  PassSample g;
   g.direct = dvec3(0.2);
   for (uint64_t j = 1; j <= 5; ++j) {
     accumulate_pass(s, g, p, j);
@@ -488,7 +489,7 @@ PointState exact_drift(uint64_t passes, AfterPass after_pass) {
   s.r2 = 0.5;
   for (uint64_t j = 1; j <= passes; ++j) {
     const double r2 = s.r2;
-    PassGather g;
+    PassSample g;
     g.count = 25;
     g.phi = dvec3(kPi_ * r2 * kDriftPhotons * (kDriftL + kDriftB * r2));
     g.phi_lap_r2 = dvec3(kPi_ * r2 * r2 * kDriftPhotons * lap_true);
@@ -546,7 +547,7 @@ TEST(Estimator, NoiseReplicaHasTheVarianceAndCovarianceOfTheNoise) {
     a.r2 = b.r2 = 1.0;
     for (uint64_t j = 1; j <= kPasses; ++j) {
       const double c = z(rng);
-      PassGather ga, gb;
+      PassSample ga, gb;
       ga.direct = dvec3(5.0 + c + z(rng));
       gb.direct = dvec3(5.0 + c + z(rng));
       accumulate_pass(a, ga, params, j);
@@ -600,7 +601,7 @@ TEST(Estimator, KnownOnlyWithEnoughPhotonsAndTwoPasses) {
   {
     PointState s;
     s.r2 = 0.01;
-    PassGather g;
+    PassSample g;
     g.direct = dvec3(0.3);
     for (uint64_t j = 1; j <= 5; ++j) {
       accumulate_pass(s, g, p, j);
@@ -614,7 +615,7 @@ TEST(Estimator, KnownOnlyWithEnoughPhotonsAndTwoPasses) {
     PointState s;
     s.r2 = 0.01;
     EXPECT_FALSE(estimate(s, 0, kMe).known);
-    PassGather g;
+    PassSample g;
     g.count = 3;
     g.phi = dvec3(0.1);
     accumulate_pass(s, g, p, 1);
@@ -626,11 +627,11 @@ TEST(Estimator, KnownOnlyWithEnoughPhotonsAndTwoPasses) {
   {
     PointState s;
     s.r2 = 0.01;
-    PassGather none;
+    PassSample none;
     accumulate_pass(s, none, p, 1);
     accumulate_pass(s, none, p, 2);
     EXPECT_FALSE(estimate(s, 2, kMe).known);
-    PassGather g;
+    PassSample g;
     g.count = 1;
     g.phi = dvec3(0.1);
     for (uint64_t j = 3; j <= 8; ++j) {
@@ -766,7 +767,7 @@ ModelCheckRun model_check_run(double r0) {
       // Poisson process of intensity me over the square around the point, thinned by the
       // density: arrival times of a unit-rate process up to the square's expected count.
       const double lambda = me * 4.0 * r * r;
-      PassGather g;
+      PassSample g;
       for (double t = -std::log(1.0 - rng.next_double()); t < lambda;
            t += -std::log(1.0 - rng.next_double())) {
         const double dx = (2.0 * rng.next_double() - 1.0) * r,

@@ -1,6 +1,7 @@
 // The image's mean-error prediction (ESTIMATOR.md section 7) on synthetic fields of known
 // correlation: states fed pass samples directly, developed as SPPM pixels, against the spread
 // of the actual mean |error| over many independent trials.
+#include "pass_sample.h"
 #include "estimator/film.h"
 
 #include <gtest/gtest.h>
@@ -37,7 +38,7 @@ Trial trial(uint64_t seed, int block, double shared) {
     for (double& c : common) c = std::sqrt(shared) * z(rng);
     for (int y = 0; y < kSide; ++y)
       for (int x = 0; x < kSide; ++x) {
-        PassGather g;
+        PassSample g;
         const double own = std::sqrt(1.0 - shared) * z(rng);
         g.direct = dvec3(1.0 + common[size_t(y / block) * blocks + size_t(x / block)] + own);
         accumulate_pass(states[size_t(y) * kSide + size_t(x)], g, params, j);

@@ -3,6 +3,7 @@
 // points over independent trials, and the fraction of (point, trial) whose actual error lies
 // within the reported bound compared with the nominal confidence. Then the same in a render
 // whose visible points are glossy (glTF's BRDF evaluated per photon) against its exact answer.
+#include "pass_sample.h"
 #include "analytic.h"
 #include "render_fixture.h"
 
@@ -115,7 +116,7 @@ TEST(SlowCoverage, SyntheticDensityBoundsCoverNominalConfidence) {
         PointState& s = states[q];
         const double px = points[q][0], py = points[q][1];
         const double r2 = s.r2;
-        PassGather g;
+        PassSample g;
         const int cx = int(px * PassPhotons::kCells), cy = int(py * PassPhotons::kCells);
         for (int yy = cy - 1; yy <= cy + 1; ++yy) {
           for (int xx = cx - 1; xx <= cx + 1; ++xx) {

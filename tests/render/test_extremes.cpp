@@ -5,6 +5,7 @@
 // (finite channels or +inf exactly where unknown, bounds that shrink or grow as the method says,
 // coverage, positive radii), not only the absence of a crash. ctest -R Extremes selects the suite;
 // test_slow_extremes.cpp holds the long forms.
+#include "pass_sample.h"
 #include "extremes.h"
 
 #include <gtest/gtest.h>
@@ -862,7 +863,7 @@ TEST(Extremes, NoRadiusFreezeInDouble) {
     params.min_r2 = 0.0;
     PointState s;
     s.r2 = 1.0;
-    PassGather g;
+    PassSample g;
     g.count = uint64_t(m);
     g.phi = dvec3(m);  // X_j = 1 / (pi R_j^2): any positive value
     long double n_ref = 0.0L, r2_ref = 1.0L;

@@ -1,0 +1,106 @@
+#include "render/ppm.h"
+
+#include "util/parallel.h"
+
+#include <algorithm>
+#include <string>
+
+namespace pb {
+
+namespace {
+
+// Points per fold block: the pass sums of a block are gathered (stages 3-4) into one array,
+// then folded (stage 5). 16384 points keep the block's sums and owner values (2.4 MB) and
+// states (3.4 MB) in the last-level cache between the two, and the block's PassSums exist
+// whole for a distributed reduction.
+constexpr size_t kFoldBlock = 16384;
+
+}  // namespace
+
+PpmMethod::PpmMethod(const World& world, const PinholeCamera& camera, int max_depth)
+    : eye_(run_eye_pass(world, camera, max_depth)) {
+  state_count_ = eye_.points.size();
+  if (!eye_.glossy.empty()) {
+    capped_points_ = eye_.points;
+    for (const GlossyPoint& g : eye_.glossy) capped_points_[g.point].f *= g.bsdf.max_f(g.wo);
+  }
+  sums_.resize(std::min(kFoldBlock, state_count_));
+  owner_.resize(sums_.size());
+}
+
+void PpmMethod::prepare(const BoundaryIndex& boundary, double initial_radius) {
+  boundary_ = &boundary;
+  clearance_.resize(eye_.points.size());
+  const float r0 = search_radius(initial_radius * initial_radius);
+  parallel_for(eye_.points.size(), 4096, [&](size_t b, size_t e) {
+    for (size_t k = b; k < e; ++k) {
+      const MeasurementPoint& p = eye_.points[k];
+      clearance_[k] = boundary.clearance(p.triangle, p.position, r0);
+    }
+  });
+}
+
+void ppm_pass(const PassInputs& in, std::span<const MeasurementPoint> points,
+              std::span<const GlossyPoint> glossy, std::span<const float> clearance,
+              std::span<PointState> states, std::span<float> radii, std::span<PassSums> sums,
+              std::span<OwnerValues> owner, PointState* copy) {
+  const size_t n = states.size(), block = sums.size();
+  for (size_t first = 0; first < n; first += block) {
+    const size_t count = std::min(block, n - first);
+    for_each_chunk(count, [&](size_t b, size_t m) {
+      const size_t at = first + b;
+      const std::span<const MeasurementPoint> pts = points.subspan(at, m);
+      const std::span<const PointState> st = std::span<const PointState>(states).subspan(at, m);
+      const GlossyTable table{glossy, at};
+      gather_pass(pts, st, in.grid, in.hits, table, sums.subspan(b, m));
+      const std::span<OwnerValues> own = owner.subspan(b, m);
+      std::fill(own.begin(), own.end(), OwnerValues{});
+      disc_pass(pts, st, in.boundary, clearance.empty() ? clearance : clearance.subspan(at, m),
+                own);
+      if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, at, own);
+    });
+    // A distributed render reduces sums[0, count) across machines here.
+    for_each_chunk(count, [&](size_t b, size_t m) {
+      fold_pass(states.subspan(first + b, m), std::span<const PassSums>(sums).subspan(b, m),
+                std::span<const OwnerValues>(owner).subspan(b, m), in.params, in.pass,
+                radii.subspan(first + b, m), copy ? copy + first + b : nullptr);
+    });
+  }
+}
+
+void PpmMethod::step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
+                     PointState* copy) {
+  ppm_pass(in, eye_.points, eye_.glossy, clearance_, states, radii, sums_, owner_, copy);
+}
+
+void PpmMethod::restore(const RenderState& s) {
+  // PPM keeps no per-pixel side state: a state with one is SPPM's.
+  if (!s.visible.empty())
+    throw StateError("the state holds " + std::to_string(s.visible.size()) +
+                     " SPPM pixel counters but this render has 0");
+  if (!s.min_mass.empty())
+    throw StateError("the state holds " + std::to_string(s.min_mass.size()) +
+                     " SPPM kernel masses but this render has 0");
+  if (!s.glossy_f.empty())
+    throw StateError("the state holds " + std::to_string(s.glossy_f.size()) +
+                     " SPPM glossy caps but this render has 0");
+}
+
+PixelLayout PpmMethod::layout(const std::vector<PointState>& states, const RenderState*) const {
+  PixelLayout l = layout_of(eye_);
+  if (!capped_points_.empty()) l.point_f = colours_of(capped_points_);
+  // Each point's disc's kernel mass at the current radius (the sparse-photon bound and the
+  // validity of the bias model need it; points within their clearance are whole).
+  l.mass.assign(states.size(), 1.0f);
+  parallel_for(states.size(), 1024, [&](size_t b, size_t e) {
+    for (size_t k = b; k < e; ++k) {
+      const MeasurementPoint& p = eye_.points[k];
+      const float r = search_radius(states[k].r2);
+      if (!clearance_.empty() && r <= clearance_[k]) continue;  // the whole disc: mass 1
+      l.mass[k] = float(boundary_->moments(p.triangle, p.position, p.normal, r).mass);
+    }
+  });
+  return l;
+}
+
+}  // namespace pb

@@ -1,0 +1,121 @@
+#include "render/sppm.h"
+
+#include <algorithm>
+#include <string>
+
+namespace pb {
+
+namespace {
+
+// Pixels per fold block, as PPM's points (ppm.cpp): the block's sums, owner values and states
+// stay in the last-level cache between gather and fold.
+constexpr size_t kFoldBlock = 16384;
+
+}  // namespace
+
+SppmMethod::SppmMethod(const World& world, const PinholeCamera& camera,
+                       CameraPathSettings settings)
+    : camera_(camera), settings_(settings) {
+  // SPPM keeps no points: the default radius comes from the footprints of a sample of
+  // pixel-centre paths (every 4th pixel each way).
+  eye_.width = camera.width();
+  eye_.height = camera.height();
+  eye_.median_footprint = median_footprint(world, camera, settings.max_depth, 4);
+  state_count_ = size_t(eye_.width) * size_t(eye_.height);
+  visible_.assign(state_count_, 0);
+  min_mass_.assign(state_count_, 1.0f);
+  glossy_f_.assign(state_count_, 0.0f);
+  // The largest BRDF of any Lambertian surface a visible point can lie on (the sparse-photon
+  // bound); glossy points bound theirs with Bsdf::max_f (glossy_f_).
+  const vec3 up(0.0f, 0.0f, 1.0f);
+  for (const Material& m : world.scene().materials)
+    if (Bsdf(m, up, up, world.mirror_roughness()).is_lambertian())
+      max_f_ = glm::max(max_f_, lambertian(m.base_color));
+  const size_t block = std::min(kFoldBlock, state_count_);
+  points_.resize(block);
+  glossy_.resize(block);
+  sums_.resize(block);
+  owner_.resize(block);
+}
+
+void SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
+                      PointState* copy) {
+  const CameraPathInputs camera{in.world, camera_,  settings_.max_depth, settings_.follow_roughness,
+                                in.seed,  in.pass,  in.next_event,       in.boundary};
+  const size_t n = states.size(), block = sums_.size();
+  for (size_t first = 0; first < n; first += block) {
+    const size_t count = std::min(block, n - first);
+    // Stages 0, 3 and 4 chunk by chunk, so that a chunk's visible points are still in cache.
+    for_each_chunk(count, [&](size_t b, size_t m) {
+      const size_t at = first + b;
+      const std::span<MeasurementPoint> pts = std::span(points_).subspan(b, m);
+      const std::span<OwnerValues> own = std::span(owner_).subspan(b, m);
+      const std::span<GlossyPoint> scratch = std::span(glossy_).subspan(b, m);
+      const std::span<const PointState> st = std::span<const PointState>(states).subspan(at, m);
+      const size_t n_glossy = trace_visible_points(
+          camera, at, std::span<const float>(radii).subspan(at, m), pts, scratch, own);
+      const GlossyTable table{scratch.first(n_glossy), 0};  // indices into pts
+      gather_pass(pts, st, in.grid, in.hits, table, std::span(sums_).subspan(b, m));
+      if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, at, own);
+      record_visible(at, pts, own, table.entries, st);
+    });
+    // A distributed render reduces sums_[0, count) across machines here.
+    for_each_chunk(count, [&](size_t b, size_t m) {
+      fold_pass(states.subspan(first + b, m), std::span<const PassSums>(sums_).subspan(b, m),
+                std::span<const OwnerValues>(owner_).subspan(b, m), in.params, in.pass,
+                radii.subspan(first + b, m), copy ? copy + first + b : nullptr);
+    });
+  }
+}
+
+void SppmMethod::record_visible(size_t first, std::span<const MeasurementPoint> points,
+                                std::span<const OwnerValues> owner,
+                                std::span<const GlossyPoint> glossy,
+                                std::span<const PointState> states) {
+  for (size_t k = 0; k < points.size(); ++k) {
+    if (!(max_component(points[k].f) > 0.0f)) continue;
+    const size_t pixel = first + k;
+    if (visible_[pixel] != UINT32_MAX) ++visible_[pixel];  // saturating: far beyond use
+    min_mass_[pixel] = std::min(min_mass_[pixel], float(owner[k].disc.mass));
+  }
+  for (const GlossyPoint& g : glossy) {  // only while the cap can still matter
+    if (states[g.point].photons >= kMinPhotonsForBound) continue;
+    const float f = max_component(points[g.point].f * g.bsdf.max_f(g.wo));
+    float& cap = glossy_f_[first + g.point];
+    cap = std::max(cap, f);
+  }
+}
+
+void SppmMethod::save(RenderState& s) const {
+  s.visible = visible_;
+  s.min_mass = min_mass_;
+  s.glossy_f = glossy_f_;
+}
+
+void SppmMethod::restore(const RenderState& saved) {
+  if (saved.visible.size() != visible_.size())
+    throw StateError("the state holds " + std::to_string(saved.visible.size()) +
+                     " SPPM pixel counters but this render has " + std::to_string(visible_.size()));
+  if (saved.min_mass.size() != min_mass_.size())
+    throw StateError("the state holds " + std::to_string(saved.min_mass.size()) +
+                     " SPPM kernel masses but this render has " + std::to_string(min_mass_.size()));
+  if (saved.glossy_f.size() != glossy_f_.size())
+    throw StateError("the state holds " + std::to_string(saved.glossy_f.size()) +
+                     " SPPM glossy caps but this render has " + std::to_string(glossy_f_.size()));
+  visible_ = saved.visible;
+  min_mass_ = saved.min_mass;
+  glossy_f_ = saved.glossy_f;
+}
+
+PixelLayout SppmMethod::layout(const std::vector<PointState>&, const RenderState* saved) const {
+  PixelLayout l;
+  l.width = eye_.width;
+  l.height = eye_.height;
+  l.visible_passes = saved ? saved->visible : visible_;
+  l.max_f = max_f_;
+  l.glossy_f = saved ? saved->glossy_f : glossy_f_;
+  l.mass = saved ? saved->min_mass : min_mass_;
+  return l;
+}
+
+}  // namespace pb
