@@ -24,8 +24,8 @@ namespace pb {
 inline constexpr float kMinGgxAlpha = 1e-4f;
 
 // The renderer's threshold (--mirror-roughness): GGX lobes whose roughness is below it are
-// rendered as perfect mirrors. It may not go below kMinMirrorRoughness (above); README
-// "Materials" says why the default is what it is.
+// rendered as perfect mirrors. It may not go below kMinMirrorRoughness (above); docs/materials.md
+// ("Mirror threshold") says why the default is what it is.
 inline constexpr double kMinMirrorRoughness = 0.032;
 inline constexpr double kDefaultMirrorRoughness = kMinMirrorRoughness;
 
