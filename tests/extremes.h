@@ -197,7 +197,7 @@ struct FilmCounts {
   size_t pixels = 0, with_points = 0, unknown = 0, variance_overflow = 0;
 };
 
-// Develops the render and asserts the channel contract of README "Output": radiance, bias,
+// Develops the render and asserts the channel contract of docs/usage.md "Output": radiance, bias,
 // photons and radius finite; bound and noise finite and >= 0 where known, +inf on all three
 // channels exactly before the second pass (from then on a point with few or no photons has the
 // sparse-photon bound of ESTIMATOR.md section 12) and where the bias model is refuted; radius > 0

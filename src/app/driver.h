@@ -70,8 +70,8 @@ struct RenderReport {
   RunInfo run() const { return {seconds, stop_text(stop)}; }
 };
 
-// What the stop rule of `options` compares with --target-error (README "Stopping"): the upper
-// confidence limit of the image's mean error (mean-error), the mean of the pixels' bounds
+// What the stop rule of `options` compares with --target-error (docs/error-bounds.md "Stopping"):
+// the upper confidence limit of the image's mean error (mean-error), the mean of the pixels' bounds
 // (mean-bound), or the bound that the share Q of the pixels is within (pixels:Q).
 double tested_quantity(const RenderOptions& options, const FilmSummary& summary);
 // A short name of it for the progress line ("mean error", "mean bound", "90% of pixels").

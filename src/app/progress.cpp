@@ -50,7 +50,7 @@ std::string ProgressPrinter::line(const PassInfo& info) {
   const double tested = tested_quantity(o, s);
   if (pass >= 2) {
     if (o.target_error) {
-      // The quantity the stop rule tests, next to the target (README "Stopping").
+      // The quantity the stop rule tests, next to the target (docs/error-bounds.md "Stopping").
       line << " | " << tested_name(o) << " " << (o.stop_rule == StopRule::MeanError ? "<= " : "")
            << tested << " (target " << *o.target_error << ")";
     } else {
@@ -96,7 +96,7 @@ void PassLogger::after_pass(const PassInfo& info) {
   const auto t0 = Clock::now();
   const FilmSummary& s = info.summary;
   JsonObject line;
-  // JSON has no infinity: an unknown mean bound is written as -1 (README).
+  // JSON has no infinity: an unknown mean bound is written as -1 (docs/usage.md "Logging").
   line.add("pass", info.pass)
       .add("seconds", info.schedule.seconds)
       .add("photons", info.renderer.work().photons)

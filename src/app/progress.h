@@ -22,7 +22,7 @@ class ProgressPrinter : public PassObserver {
   double last_print_ = -1.0;
 };
 
-// --log: one JSON object per logged pass (README "Measuring the trade"). Passes are logged while
+// --log: one JSON object per logged pass (docs/usage.md "Logging"). Passes are logged while
 // the time spent logging stays within `max_overhead` of the run's time, so the log never slows
 // the pass loop by more than that; the last pass is always logged. With a reference image each
 // line also carries the actual error and coverage.

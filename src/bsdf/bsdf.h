@@ -1,4 +1,4 @@
-// glTF's material at a surface point (README "Materials"): the Bsdf every stage asks, and the
+// glTF's material at a surface point (docs/materials.md): the Bsdf every stage asks, and the
 // pure functions it is made of, of directions in world space. Directions point away from the
 // surface; n is the side the incoming direction is on.
 #pragma once

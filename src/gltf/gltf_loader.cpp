@@ -10,7 +10,7 @@
 // it is read; Draco and meshoptimizer data are decoded on first use (gltf_decode.h). Errors throw
 // SceneError("<file>: <one line>"); a Scene is only returned whole.
 //
-// Material rules (README "Materials" repeats them): glTF 2.0's metallic-roughness material with
+// Material rules (docs/materials.md repeats them): glTF 2.0's metallic-roughness material with
 // glTF's defaults (metallicFactor and roughnessFactor 1: a material without
 // pbrMetallicRoughness is a rough metal), KHR_materials_ior, _specular, _transmission,
 // _volume, _clearcoat, _sheen and _emissive_strength, textures (base colour,
@@ -175,10 +175,11 @@ void Loader::check_extensions() {
   // finest level of detail).
   static const std::set<std::string> exact_without = {"KHR_xmp", "KHR_xmp_json_ld",
                                                       "KHR_materials_variants", "MSFT_lod"};
-  // Unknown extensions, even required ones, are rendered without (README "Scenes"): a material
-  // extension then falls back to the core factors; data an unknown extension holds is missing,
-  // and the accessors that lack it are refused with their own message. What rendering without
-  // it means, where that is not only a material falling back to its core factors:
+  // Unknown extensions, even required ones, are rendered without (docs/gltf.md "Compression,
+  // instancing, deformation and extensions"): a material extension then falls back to the core
+  // factors; data an unknown extension holds is missing, and the accessors that lack it are refused
+  // with their own message. What rendering without it means, where that is not only a material
+  // falling back to its core factors:
   auto without = [](const std::string& e) -> std::string {
     if (e == "KHR_materials_unlit")
       return ": its materials are lit (light is simulated, not painted on), by their "

@@ -1,4 +1,4 @@
-// Loads the glTF 2.0 subset photonbound renders (README "Scenes") into plain Scene data.
+// Loads the glTF 2.0 subset photonbound renders (docs/gltf.md) into plain Scene data.
 // Only the loader's own files (src/gltf_*.cpp) see tinygltf types.
 #pragma once
 

@@ -1,5 +1,5 @@
 // The builders the option table (option_table.cpp) makes its rows with: ranges with the text
-// README and --help show, and one builder per kind of member (real, integer, choice, text,
+// docs/usage.md and --help show, and one builder per kind of member (real, integer, choice, text,
 // three numbers). Internal to option_table.cpp.
 #pragma once
 
@@ -20,7 +20,7 @@ namespace pb::option_builders {
   throw UsageError(std::string(flag) + ": " + what);
 }
 
-// A closed or open interval of doubles, with the text README and --help show.
+// A closed or open interval of doubles, with the text docs/usage.md and --help show.
 struct RealRange {
   double lo, hi;
   bool lo_open, hi_open;

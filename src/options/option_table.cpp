@@ -214,7 +214,7 @@ std::vector<OptionSpec> make_table() {
                         "continue the render saved in STATE (scene and image options must match)"),
                    &RenderOptions::resume_from, "none"));
   t.push_back(text(base("--log", "log", "FILE.jsonl", measure, K::Run,
-                        "per-pass JSON log (\"Measuring the trade\")"),
+                        "per-pass JSON log (docs/usage.md \"Logging\")"),
                    &RenderOptions::log_path, "none"));
   t.push_back(text(base("--reference", "reference", "REF.exr", measure, K::Run,
                         "with --log: add the actual error and coverage against this image"),

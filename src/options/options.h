@@ -28,13 +28,14 @@ class UsageError : public std::runtime_error {
 enum class Method { SPPM, PPM };
 enum class DirectMode { NextEvent, Photons };
 enum class ProgressMode { Auto, Always, Never };
-// What --target-error tests (README "Stopping", ESTIMATOR.md section 7).
+// What --target-error tests (docs/usage.md "Stop rules", ESTIMATOR.md section 7).
 enum class StopRule { MeanError, MeanBound, Pixels };
 
 // Members only: ranges, defaults and help live in the option table.
 // Below this roughness a gathered GGX lobe's sparse-photon bound falls slowly where photons
 // are few (10^4-fold on Blender's 01_principled_material at 32 passes), while following a lobe
-// at or above it costs at most about 3x where they are plentiful (README "Sharp lobes").
+// at or above it costs at most about 3x where they are plentiful (docs/materials.md, "Sharp
+// lobes are followed in SPPM").
 inline constexpr double kDefaultFollowRoughness = 0.7;
 
 struct RenderOptions {
@@ -80,7 +81,7 @@ struct RenderOptions {
   std::string command_line;  // as typed, for the metadata (not an option)
 };
 
-// What `resume` may do with an option (README "Checkpoints").
+// What `resume` may do with an option (docs/usage.md "Checkpoints and interruption").
 enum class OptionKind {
   Image,   // shapes the render state: a continued render must have the saved value
   Stop,    // a stop condition: given on resume, the three replace the saved ones together
@@ -95,7 +96,7 @@ struct OptionSpec {
   std::string_view help;     // one line
   std::string_view group;    // --help section
   OptionKind kind = OptionKind::Image;
-  std::string range;  // "(0, 1]" as README and --help print it; empty when not numeric
+  std::string range;  // "(0, 1]" as docs/usage.md and --help print it; empty when not numeric
   std::string unset;  // how an unset optional reads: "none", "auto", "first"
   // Value-less flags and the value each stands for (--progress = always, --quiet = never).
   std::vector<std::pair<std::string_view, std::string_view>> switches;
@@ -168,8 +169,9 @@ void validate(const RenderOptions& options);
 
 // The --help text, made from the table.
 std::string usage_text();
-// README's option table, made from the table (`photonbound --help-table`; a test checks that
-// README holds exactly this).
+// The option table of docs/usage.md "Command line", made from the table (`photonbound
+// --help-table`; Options.UsageOptionTableIsTheGeneratedOne checks that docs/usage.md holds
+// exactly this).
 std::string markdown_option_table();
 
 // Shortest text that reads back as the same double (metadata, messages).

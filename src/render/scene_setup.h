@@ -1,6 +1,6 @@
-// What a render adds to a loaded scene before it is prepared (README "Cameras and the default
-// view", "Environment light"): the environment light of --environment, or the default sky when
-// the file has no light at all; and the lines that tell the user what was assumed.
+// What a render adds to a loaded scene before it is prepared (docs/gltf.md "Cameras and the default
+// view", "Environment light and the default sky"): the environment light of --environment, or the
+// default sky when the file has no light at all; and the lines that tell the user what was assumed.
 #pragma once
 
 #include "io/image_io.h"

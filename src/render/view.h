@@ -1,6 +1,6 @@
 // The camera a render looks through: the file's perspective camera (the first, or --camera
 // NAME), or the default view of a file without one, with --look-from, --look-at, --up and --fov
-// applied on top (README "Cameras and the default view").
+// applied on top (docs/gltf.md "Cameras and the default view").
 #pragma once
 
 #include "scene/camera.h"

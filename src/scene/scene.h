@@ -46,7 +46,7 @@ enum class AlphaMode : uint8_t { Opaque, Mask, Blend };
 
 // glTF 2.0's metallic-roughness material with the extensions photonbound reads, as the file
 // gives it (factors with glTF's defaults; each texture multiplies its factor). World::surface()
-// evaluates the textures at a hit and makes the Bsdf from the result (README "Materials").
+// evaluates the textures at a hit and makes the Bsdf from the result (docs/materials.md).
 struct Material {
   std::string name;
   vec3 base_color{1.0f};  // baseColorFactor.rgb, linear

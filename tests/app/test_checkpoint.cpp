@@ -1,4 +1,4 @@
-// Checkpoints, resume and interruption (README "Checkpoints").
+// Checkpoints, resume and interruption (docs/usage.md "Checkpoints and interruption").
 #include "process_fixture.h"
 #include "render_fixture.h"
 

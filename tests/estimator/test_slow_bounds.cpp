@@ -1,6 +1,7 @@
 // The error bounds against exact answers in rendered scenes (issue "Error bounds", ESTIMATOR.md
 // section 9): coverage at 50% and 90% confidence, and renders to halving target errors.
-// Labelled slow. build/tools/bounds_study prints the same figures as tables for the README.
+// Labelled slow. build/tools/bounds_study prints the same figures as tables for
+// docs/error-bounds.md.
 #include "analytic.h"
 #include "reference_truth.h"
 #include "render_fixture.h"
@@ -93,7 +94,8 @@ TEST(SlowBounds, EdgeBandOfTheBoxWithABlock) {
 }
 
 // Issue "Bounds along geometric edges" on the Cornell box, against its reference (a long SPPM
-// render, tools/study/cornell_64x64_sppm_reference.exr; README "Coverage" says how it was made).
+// render, tools/study/cornell_64x64_sppm_reference.exr; docs/error-bounds.md "The Cornell box
+// against its reference" says how it was made).
 // SPPM at 10k photons per pass, 4 seeds pooled, every pixel counted, the reference's own noise
 // counted (reference::Accuracy): coverage within 2 points of nominal at 16, 64 and 256 passes
 // (16,000+ correlated pixel-channels per check: a binomial standard error of 0.004 at 50% for
@@ -215,7 +217,8 @@ TEST(SlowBounds, PixelsRuleAtNinetyPercentKeepsNinetyPercentOfPixelsWithinTheTar
 }
 
 // HJJ10's rule (mean-bound): the mean of the per-pixel 90% bounds at the target. It is
-// conservative at 90% (README: 2.45-2.85x below the target), so every run ends below it.
+// conservative at 90% (2.45-2.85x below the target when this test was written; docs/error-bounds.md
+// "The stop rules side by side" has the 20-seed figures), so every run ends below it.
 TEST(SlowBounds, MeanBoundRuleAtNinetyPercentEndsBelowTheTarget) {
   for (double target : {0.02, 0.01}) {
     RenderOptions o = test::quick_options("plane_point.gltf", 32, 1);

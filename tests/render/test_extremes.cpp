@@ -86,8 +86,8 @@ TEST(Extremes, ValidateRadiusRange) {
   }
 }
 
-// Every other numeric range of README "Command line", in process: the ends accepted, one step
-// beyond rejected with the option's name.
+// Every other numeric range of docs/usage.md "Command line", in process: the ends accepted, one
+// step beyond rejected with the option's name.
 TEST(Extremes, ValidateEveryDocumentedRange) {
   struct Case {
     std::function<void(RenderOptions&)> set;
@@ -343,7 +343,7 @@ double plane_scene_size() {
   return double(scene.bounds.diagonal());
 }
 
-// 1e-9 x the scene size is below the floor (1e-6 x the scene size, README "Default radius"):
+// 1e-9 x the scene size is below the floor (1e-6 x the scene size, docs/usage.md "Default radius"):
 // the render starts at the floor and stays there; points almost never see a photon, so their
 // bound is the sparse-photon bound of ESTIMATOR.md section 12 for a disc of that radius: finite
 // but far above any radiance in the scene (it shrinks only as 1/passes).
@@ -405,9 +405,9 @@ TEST(Extremes, HugeInitialRadius) {
 }
 
 // A quarter of and the whole scene size (7 and 28 on a plane lit from a height of 1): the disc
-// holds most of the light's footprint, c stays near 1/2 or above, and the estimate is a blur of
-// the footprint whose bias the Laplacian at that radius cannot extrapolate (the error is 0.5
-// against a bound of 0.2 after 64 passes, README "Error bounds"). The model checks (ESTIMATOR.md
+// holds most of the light's footprint, c stays near 1/2 or above, and the estimate is a blur of the
+// footprint whose bias the Laplacian at that radius cannot extrapolate (the error is 0.5 against a
+// bound of 0.2 after 64 passes, docs/error-bounds.md "Stopping"). The model checks (ESTIMATOR.md
 // sections 11b and 11c: at the whole size the slope, at a quarter the two scales, since few discs
 // lie whole on the plane there) must refute the model for the image, so every bound is unknown and
 // a target render stops "unreachable" in a bounded number of passes instead of reporting a small
@@ -597,10 +597,10 @@ TEST(Extremes, ScaledClosedBox) {
 // ---------------------------------------------------------------------------------------------
 // Emitter radiance 1e-30 and 1e30.
 
-// The plane's point light scaled by k: the photon paths do not depend on the power, so the image
-// is the unscaled one times k, bounds included, with every channel finite. The Variance channel
-// is float32: ~L^2 / i overflows to +inf at k = 1e30 (README "Output": the variance of the mean)
-// and underflows at k = 1e-30; the bound and noise channels, computed in double, stay right.
+// The plane's point light scaled by k: the photon paths do not depend on the power, so the image is
+// the unscaled one times k, bounds included, with every channel finite. The Variance channel is
+// float32: ~L^2 / i overflows to +inf at k = 1e30 (docs/usage.md "Output": the variance of the
+// mean) and underflows at k = 1e-30; the bound and noise channels, computed in double, stay right.
 TEST(Extremes, EmitterIntensityScaled) {
   TempDir dir;
   RenderOptions o = extremes::options(test::scene_path("plane_point.gltf"), 16, 10000);

@@ -119,7 +119,7 @@ TEST(Render, SceneVariantsGiveTheSameImage) {
   }
 }
 
-// The EXR layout of README "Output".
+// The EXR layout of docs/usage.md "Output".
 TEST(Render, ImageHasEveryChannelAndMetadata) {
   const ExrImage img = render_image(test::quick_options("cornell.gltf", 16, 3), 2);
   for (const char* c : {"R", "G", "B", "ErrorBound.R", "ErrorBound.G", "ErrorBound.B", "Bias.R",

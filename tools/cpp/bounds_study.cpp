@@ -1,5 +1,5 @@
-// Prints the README's evidence for the error bounds: coverage against the exact answers of the
-// analytic scenes, and renders to halving target errors (specified vs actual error).
+// Prints docs/error-bounds.md's evidence for the error bounds: coverage against the exact answers
+// of the analytic scenes, and renders to halving target errors (specified vs actual error).
 // Run: build/tools/bounds_study [all|coverage|termination|stopping|edges|cornell|rules|
 // calibration|correlation|slope|modelcheck|modelnull] [ppm|sppm] [seeds]
 // (a few minutes on 2 cores)
@@ -199,7 +199,8 @@ void edges_table() {
 // The Cornell box against its rendered reference (SPPM only: the reference is a long SPPM render,
 // a pixel-area average), every pixel counted, and the pixels within two radii of an edge of the
 // gather's surfaces (reference::edge_band) as their own rows. 10k photons per pass, so that the
-// runs' errors stay well above the reference's own (README "Coverage").
+// runs' errors stay well above the reference's own (docs/error-bounds.md "The Cornell box against
+// its reference").
 void cornell_table(int seeds) {
   if (g_method != Method::SPPM) {
     std::printf("(the Cornell reference is an SPPM render: run `bounds_study cornell sppm`)\n");
