@@ -1,6 +1,6 @@
 """The one EXR reader and writer of the tools, and photonbound's channel layout.
 
-EXR channel names come from include/photonbound/channels.def, the table the C++ writer reads
+EXR channel names come from src/estimator/channels.def, the table the C++ writer reads
 too (channel(), rgb_prefix(), channel_names()), so a channel renamed there is renamed here.
 Images are read as named float32 planes (Exr) through OpenImageIO's Python module (the Debian
 package python3-openimageio; tools/install-deps.sh installs it).
@@ -20,7 +20,7 @@ except ImportError:  # the tools are meant for /usr/bin/python3 with the Debian 
     oiio = None
 
 RGB = ("R", "G", "B")  # the components of an RGB channel group (channels.def)
-CHANNELS_DEF = os.path.join(REPO, "include", "photonbound", "channels.def")
+CHANNELS_DEF = os.path.join(REPO, "src", "estimator", "channels.def")
 
 
 def need_oiio():
@@ -32,7 +32,7 @@ def need_oiio():
 
 
 # ---------------------------------------------------------------------------------------------
-# The EXR channel layout: include/photonbound/channels.def
+# The EXR channel layout: src/estimator/channels.def
 
 _CHANNEL_LINE = re.compile(r'PB_CHANNEL\(\s*(\w+)\s*,\s*"([^"]*)"\s*,\s*(RGB|SCALAR)\s*,\s*'
                            r'"((?:[^"\\]|\\.)*)"\s*\)\s*$')

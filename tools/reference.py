@@ -12,7 +12,7 @@ glTF file (.gltf or .glb, through tools/gltf_scene.py): with `--pixel area` (the
 pixel's average over its area, from N x N stratified sub-pixel rays (`--sub`, default 16), what
 `--method sppm` estimates; with `--pixel centre` the value at the pixel-centre measurement point
 `--method ppm` uses (src/camera.cpp). It has every channel of photonbound's layout
-(include/photonbound/channels.def); all but the radiance are 0.
+(src/estimator/channels.def); all but the radiance are 0.
 
 `render` runs a long photonbound render (its own error bound channels included) and prints
 its mean bound, so you can check that it is at least 10x below the errors you study. It uses
