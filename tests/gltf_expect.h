@@ -126,9 +126,7 @@ inline void expect_grid(const Mesh& m, const Grid& g, const Tolerance& tol, bool
 
 // ---- The loader tests ----
 
-inline json light_ext(int light) {
-  return json{{"KHR_lights_punctual", json{{"light", light}}}};
-}
+inline json light_ext(int light) { return json{{"KHR_lights_punctual", json{{"light", light}}}}; }
 
 // One triangle (0,0,0) (1,0,0) (0,1,0) facing +z with material 0 'grey' (base colour
 // (0.5, 0.6, 0.7), metallic 0) under root node 0 'geometry'; perspective camera 0 (yfov 0.7,
@@ -143,17 +141,15 @@ inline Doc triangle_doc() {
   const int ind = d.indices({0, 1, 2});
   const json pbr = json{{"baseColorFactor", {0.5, 0.6, 0.7, 1}}, {"metallicFactor", 0}};
   d.j["materials"] = json::array({json{{"name", "grey"}, {"pbrMetallicRoughness", pbr}}});
-  const json prim = json{{"attributes", json{{"POSITION", pos}, {"NORMAL", nor}}},
-                         {"indices", ind},
-                         {"material", 0}};
+  const json prim = json{
+      {"attributes", json{{"POSITION", pos}, {"NORMAL", nor}}}, {"indices", ind}, {"material", 0}};
   d.j["meshes"] = json::array({json{{"name", "tri"}, {"primitives", json::array({prim})}}});
   const json persp = json{{"yfov", 0.7}, {"znear", 0.01}, {"aspectRatio", 1.5}};
   d.j["cameras"] = json::array({json{{"type", "perspective"}, {"perspective", persp}}});
-  d.j["nodes"] = json::array({json{{"name", "geometry"}, {"mesh", 0}},
-                              json{{"name", "eye"}, {"camera", 0}, {"translation", {0, 0, 5}}},
-                              json{{"name", "lamp"},
-                                   {"translation", {0, 2, 0}},
-                                   {"extensions", light_ext(0)}}});
+  d.j["nodes"] = json::array(
+      {json{{"name", "geometry"}, {"mesh", 0}},
+       json{{"name", "eye"}, {"camera", 0}, {"translation", {0, 0, 5}}},
+       json{{"name", "lamp"}, {"translation", {0, 2, 0}}, {"extensions", light_ext(0)}}});
   const json bulb =
       json{{"name", "bulb"}, {"type", "point"}, {"color", {1, 0.5, 0.25}}, {"intensity", 8}};
   d.j["extensions"]["KHR_lights_punctual"]["lights"] = json::array({bulb});
@@ -163,9 +159,7 @@ inline Doc triangle_doc() {
 
 inline json& material0(Doc& d) { return d.j["materials"][0]; }
 inline json& light0(Doc& d) { return d.j["extensions"]["KHR_lights_punctual"]["lights"][0]; }
-inline void set_roots(Doc& d, const std::vector<int>& roots) {
-  d.j["scenes"][0]["nodes"] = roots;
-}
+inline void set_roots(Doc& d, const std::vector<int>& roots) { d.j["scenes"][0]["nodes"] = roots; }
 // Adds `node` as a new root node; returns its index.
 inline int add_root(Doc& d, json node) {
   const int n = d.add("nodes", std::move(node));

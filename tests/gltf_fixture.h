@@ -227,7 +227,9 @@ struct Doc {
   int vec3s(const std::vector<float>& xyz) {
     return accessor(view(xyz), 5126, xyz.size() / 3, "VEC3");
   }
-  int indices(const std::vector<uint16_t>& i) { return accessor(view(i), 5123, i.size(), "SCALAR"); }
+  int indices(const std::vector<uint16_t>& i) {
+    return accessor(view(i), 5123, i.size(), "SCALAR");
+  }
   void require(const std::vector<std::string>& extensions) {
     for (const std::string& e : extensions) {
       j["extensionsUsed"].push_back(e);
@@ -237,8 +239,8 @@ struct Doc {
   json buffers(bool glb) const {
     json b0 = json{{"byteLength", bin.size()}};
     if (!glb)
-      b0["uri"] = buffer_uri.empty() ? "data:application/octet-stream;base64," + base64(bin)
-                                     : buffer_uri;
+      b0["uri"] =
+          buffer_uri.empty() ? "data:application/octet-stream;base64," + base64(bin) : buffer_uri;
     json all = json::array({b0});
     for (const json& b : more_buffers) all.push_back(b);
     return all;

@@ -47,7 +47,10 @@ LoaderCase unrolled(const std::string& name, int mode, const std::vector<float>&
 
 const std::vector<LoaderCase> kRows = {
     {.name = "LoadsMinimalScene",
-     .edit = [](Doc& d) { d.j["nodes"][0] = json{{"mesh", 0}, {"translation", {1, 2, 3}}}; },
+     .edit =
+         [](Doc& d) {
+           d.j["nodes"][0] = json{{"mesh", 0}, {"translation", {1, 2, 3}}};
+         },
      .check =
          [](const Scene& s) {
            ASSERT_EQ(s.meshes.size(), 1u);
@@ -108,11 +111,17 @@ const std::vector<LoaderCase> kRows = {
          },
      .error = {"extends past the end of buffer 0"}},
     {.name = "IndexValueOutOfRange",
-     .edit = [](Doc& d) { add_mesh_root(d, "bad", 0, d.indices({0, 1, 7}), 0); },
+     .edit =
+         [](Doc& d) {
+           add_mesh_root(d, "bad", 0, d.indices({0, 1, 7}), 0);
+         },
      .error = {"mesh 'bad' primitive 0 indices accessor 3: index 2 has value 7, out of range for "
                "3 vertices"}},
     {.name = "IndexCountNotMultipleOfThree",
-     .edit = [](Doc& d) { add_mesh_root(d, "bad", 0, d.indices({0, 1, 2, 0}), 0); },
+     .edit =
+         [](Doc& d) {
+           add_mesh_root(d, "bad", 0, d.indices({0, 1, 2, 0}), 0);
+         },
      .error = {"has 4 indices, not a multiple of 3"}},
     {.name = "WrongComponentTypeForPosition",
      .edit =
@@ -141,11 +150,17 @@ const std::vector<LoaderCase> kRows = {
          }},
     // Lines alone leave the file nothing to draw; a mode glTF does not define is refused.
     {.name = "LinesAloneLeaveNoTriangles",
-     .edit = [](Doc& d) { set_mesh0(d, "tri", primitive(0, {{"mode", 1}})); },
+     .edit =
+         [](Doc& d) {
+           set_mesh0(d, "tri", primitive(0, {{"mode", 1}}));
+         },
      .error = {"no triangles to render: the scene's nodes reference no mesh with a "
                "non-degenerate triangle (1 primitive is points or lines, which have no area)"}},
     {.name = "UndefinedModesAreRefused",
-     .edit = [](Doc& d) { set_mesh0(d, "tri", primitive(0, {{"mode", 9}})); },
+     .edit =
+         [](Doc& d) {
+           set_mesh0(d, "tri", primitive(0, {{"mode", 9}}));
+         },
      .error = {"mesh 'tri' primitive 0 uses mode 9, which glTF 2.0 does not define"}},
     // Strip 0 1 2 3 4 over a zigzag: (0 1 2) (1 3 2) (2 3 4). Fan 0 1 3 2 4 around vertex 0:
     // (1 3 0) (3 2 0) (2 4 0).
@@ -168,10 +183,16 @@ const std::vector<LoaderCase> kRows = {
      .error = {"POSITION accessor 0 sparse indices are not strictly increasing (index 1 is 0 "
                "after 1)"}},
     {.name = "NanCoordinate",
-     .edit = [](Doc& d) { add_mesh_root(d, "nan", d.vec3s({0, 0, 0, kNan, 0, 0, 0, 1, 0})); },
+     .edit =
+         [](Doc& d) {
+           add_mesh_root(d, "nan", d.vec3s({0, 0, 0, kNan, 0, 0, 0, 1, 0}));
+         },
      .error = {"mesh 'nan' has a non-finite vertex coordinate"}},
     {.name = "InfCoordinate",
-     .edit = [](Doc& d) { add_mesh_root(d, "inf", d.vec3s({0, 0, 0, 1, 0, 0, 0, kInf, 0})); },
+     .edit =
+         [](Doc& d) {
+           add_mesh_root(d, "inf", d.vec3s({0, 0, 0, 1, 0, 0, 0, kInf, 0}));
+         },
      .error = {"mesh 'inf' has a non-finite vertex coordinate"}},
     {.name = "NanNormal",
      .edit =
@@ -194,7 +215,10 @@ const std::vector<LoaderCase> kRows = {
            EXPECT_TRUE(has_warning(s, "mesh 'zn': zero or non-finite normals"));
          }},
     {.name = "AbsurdCoordinate",
-     .edit = [](Doc& d) { add_mesh_root(d, "huge", d.vec3s({0, 0, 0, 1e12f, 0, 0, 0, 1, 0})); },
+     .edit =
+         [](Doc& d) {
+           add_mesh_root(d, "huge", d.vec3s({0, 0, 0, 1e12f, 0, 0, 0, 1, 0}));
+         },
      .error = {"mesh 'huge' has a vertex coordinate beyond the limit of 1e10"}},
     {.name = "DegenerateTrianglesAreSkippedAndCounted",
      .edit =
@@ -212,7 +236,9 @@ const std::vector<LoaderCase> kRows = {
          }},
     {.name = "OnlyDegenerateTrianglesMeansNoTriangles",
      .edit =
-         [](Doc& d) { set_mesh0(d, "tri", primitive(0, {{"indices", d.indices({0, 0, 1, 2, 2, 2})}})); },
+         [](Doc& d) {
+           set_mesh0(d, "tri", primitive(0, {{"indices", d.indices({0, 0, 1, 2, 2, 2})}}));
+         },
      .error = {": no triangles"}},
     // Interleaved POSITION + NORMAL (byteStride 24, two triangles, non-indexed); UNSIGNED_BYTE
     // and UNSIGNED_INT indices.

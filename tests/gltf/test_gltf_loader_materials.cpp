@@ -19,9 +19,12 @@ LoaderCase material(const std::string& name, const json& body,
 LoaderCase refused(const std::string& name, const json& body, const std::string& phrase) {
   json m = json{{"name", "bad"}};
   m.update(body);
-  return {.name = name, .edit = [=](Doc& d) { material0(d) = m; }, .error = {"material 'bad'", phrase}};
+  return {
+      .name = name, .edit = [=](Doc& d) { material0(d) = m; }, .error = {"material 'bad'", phrase}};
 }
-json ext(const char* extension, const json& members) { return {{"extensions", {{extension, members}}}}; }
+json ext(const char* extension, const json& members) {
+  return {{"extensions", {{extension, members}}}};
+}
 json pbr(const json& members) { return {{"pbrMetallicRoughness", members}}; }
 // textured() with one 2 x 2 image as texture 0, `extension` used, and `material`.
 LoaderCase textured_material(const std::string& name, const char* extension, const json& material,
@@ -175,7 +178,10 @@ const std::vector<LoaderCase> kRows = {
     refused("BaseColorTextureThatDoesNotExist", pbr({{"baseColorTexture", {{"index", 3}}}}),
             "texture 3, which does not"),
     {.name = "WrongLengthBaseColorIsMalformed",
-     .edit = [](Doc& d) { material0(d) = pbr({{"baseColorFactor", {0.5, 0.5}}}); },
+     .edit =
+         [](Doc& d) {
+           material0(d) = pbr({{"baseColorFactor", {0.5, 0.5}}});
+         },
      .error = {"malformed glTF: Array length of `baseColorFactor`"}},
     {.name = "MaterialIndexOutOfRange",
      .edit = [](Doc& d) { add_mesh_root(d, "odd", 0, 2, 5); },
@@ -227,8 +233,7 @@ const std::vector<LoaderCase> kRows = {
      .check =
          [](const Scene& s) {
            EXPECT_TRUE(s.materials[s.meshes[0].material].thin);
-           EXPECT_TRUE(
-               has_warning(s, "material 'prism': dispersion without KHR_materials_volume"));
+           EXPECT_TRUE(has_warning(s, "material 'prism': dispersion without KHR_materials_volume"));
          }},
     // KHR_materials_clearcoat: the factors, clearcoatTexture (R), clearcoatRoughnessTexture (G)
     // and clearcoatNormalTexture with its scale; tangents for the coat's normal texture alone;

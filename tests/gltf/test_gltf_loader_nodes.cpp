@@ -74,7 +74,10 @@ const std::vector<LoaderCase> kRows = {
            expect_vec(s.meshes[0].normals[2], glm::normalize(vec3(1, 0.5f, 0)));
          }},
     {.name = "NegativeDeterminantFlipsWinding",
-     .edit = [](Doc& d) { d.j["nodes"][0] = json{{"mesh", 0}, {"scale", {-1, 1, 1}}}; },
+     .edit =
+         [](Doc& d) {
+           d.j["nodes"][0] = json{{"mesh", 0}, {"scale", {-1, 1, 1}}};
+         },
      .check =
          [](const Scene& s) {
            const Mesh& m = s.meshes[0];
@@ -84,15 +87,22 @@ const std::vector<LoaderCase> kRows = {
            expect_vec(m.normals[0], vec3(0, 0, 1));
          }},
     {.name = "AbsurdCoordinateAfterTransform",
-     .edit = [](Doc& d) { d.j["nodes"][0] = json{{"mesh", 0}, {"scale", {1e11, 1e11, 1e11}}}; },
+     .edit =
+         [](Doc& d) {
+           d.j["nodes"][0] = json{{"mesh", 0}, {"scale", {1e11, 1e11, 1e11}}};
+         },
      .error = {"mesh 'tri' has a vertex coordinate beyond the limit of 1e10"}},
     {.name = "SingularTransform",
      .edit =
-         [](Doc& d) { d.j["nodes"][0] = json{{"name", "flat"}, {"mesh", 0}, {"scale", {1, 1, 0}}}; },
+         [](Doc& d) {
+           d.j["nodes"][0] = json{{"name", "flat"}, {"mesh", 0}, {"scale", {1, 1, 0}}};
+         },
      .error = {"node 'flat' has a singular transform"}},
     {.name = "NodeCycle",
      .edit =
-         [](Doc& d) { d.j["nodes"][0] = json{{"name", "loop"}, {"mesh", 0}, {"children", {0}}}; },
+         [](Doc& d) {
+           d.j["nodes"][0] = json{{"name", "loop"}, {"mesh", 0}, {"children", {0}}};
+         },
      .error = {"node 'loop' is reached twice"}},
     {.name = "NoScenesUsesEveryRootNode",
      .edit =
@@ -117,7 +127,10 @@ const std::vector<LoaderCase> kRows = {
          },
      .error = {"the node hierarchy is deeper than 1000 levels"}},
     {.name = "MeshIndexOutOfRange",
-     .edit = [](Doc& d) { d.j["nodes"][0] = json{{"name", "geometry"}, {"mesh", 4}}; },
+     .edit =
+         [](Doc& d) {
+           d.j["nodes"][0] = json{{"name", "geometry"}, {"mesh", 4}};
+         },
      .error = {"node 'geometry' refers to mesh 4, which does not exist (the file has 1 mesh)"}},
     {.name = "MeshIndexOutOfRangeCountsTheMeshes",
      .edit =
@@ -128,17 +141,17 @@ const std::vector<LoaderCase> kRows = {
      .error = {"(the file has 2 meshes)"}},
     // No camera is not an error: the render frames the bounds (view.h).
     {.name = "NoCamera",
-     .edit = [](Doc& d) { set_roots(d, {0, 2}); },
+     .edit =
+         [](Doc& d) {
+           set_roots(d, {0, 2});
+         },
      .check =
          [](const Scene& s) {
            EXPECT_TRUE(s.cameras.empty());
            EXPECT_EQ(s.lights.size(), 1u);
          }},
     {.name = "OrthographicCameraIsSkipped",
-     .edit =
-         [](Doc& d) {
-           add_ortho_camera(d);
-         },
+     .edit = [](Doc& d) { add_ortho_camera(d); },
      .check =
          [](const Scene& s) {
            EXPECT_EQ(s.cameras.size(), 1u);
@@ -154,8 +167,8 @@ const std::vector<LoaderCase> kRows = {
     {.name = "InvalidYfov",
      .edit =
          [](Doc& d) {
-           d.j["cameras"][0] = json{{"type", "perspective"},
-                                    {"perspective", json{{"yfov", 3.5}, {"znear", 0.1}}}};
+           d.j["cameras"][0] =
+               json{{"type", "perspective"}, {"perspective", json{{"yfov", 3.5}, {"znear", 0.1}}}};
          },
      .error = {"camera 0: yfov 3.5 must be in (0, pi)"}},
     {.name = "SpotLightDirectionAndCones",
@@ -191,14 +204,20 @@ const std::vector<LoaderCase> kRows = {
          }},
     // No light is not an error either: the render adds the default sky (scene_setup.h).
     {.name = "NoLight",
-     .edit = [](Doc& d) { set_roots(d, {0, 1}); },
+     .edit =
+         [](Doc& d) {
+           set_roots(d, {0, 1});
+         },
      .check =
          [](const Scene& s) {
            EXPECT_TRUE(s.lights.empty());
            EXPECT_FALSE(has_light(s));
          }},
     {.name = "ZeroIntensityLightIsNoLight",
-     .edit = [](Doc& d) { light0(d) = json{{"type", "point"}, {"intensity", 0}}; },
+     .edit =
+         [](Doc& d) {
+           light0(d) = json{{"type", "point"}, {"intensity", 0}};
+         },
      .check =
          [](const Scene& s) {
            EXPECT_EQ(s.lights.size(), 1u);
@@ -210,8 +229,10 @@ const std::vector<LoaderCase> kRows = {
     {.name = "DirectionalLight",
      .edit =
          [](Doc& d) {
-           light0(d) = json{
-               {"name", "sun"}, {"type", "directional"}, {"color", {1, 0.5, 0.25}}, {"intensity", 4}};
+           light0(d) = json{{"name", "sun"},
+                            {"type", "directional"},
+                            {"color", {1, 0.5, 0.25}},
+                            {"intensity", 4}};
            d.j["nodes"][2] = json{{"name", "lamp"},
                                   {"translation", {5, 6, 7}},
                                   {"rotation", {-0.7071067811865476, 0, 0, 0.7071067811865476}},
@@ -226,20 +247,30 @@ const std::vector<LoaderCase> kRows = {
            EXPECT_TRUE(s.warnings.empty());
          }},
     {.name = "NegativeIntensity",
-     .edit = [](Doc& d) { light0(d) = json{{"name", "dark"}, {"type", "point"}, {"intensity", -1}}; },
+     .edit =
+         [](Doc& d) {
+           light0(d) = json{{"name", "dark"}, {"type", "point"}, {"intensity", -1}};
+         },
      .error = {"light 'dark': intensity and color must be finite and >= 0"}},
     // Each intensity fits in a float; their total power (4 pi I per light) does not.
     {.name = "PowerBeyondFloatRange",
      .edit =
-         [](Doc& d) { light0(d) = json{{"name", "flood"}, {"type", "point"}, {"intensity", 3e38}}; },
+         [](Doc& d) {
+           light0(d) = json{{"name", "flood"}, {"type", "point"}, {"intensity", 3e38}};
+         },
      .error = {"the lights emit", "beyond the float range"}},
     // 1e30, the extremes suite's brightest emitter, still loads.
     {.name = "PowerOfTheBrightestExtremeLoads",
      .edit =
-         [](Doc& d) { light0(d) = json{{"name", "bright"}, {"type", "point"}, {"intensity", 1e30}}; },
+         [](Doc& d) {
+           light0(d) = json{{"name", "bright"}, {"type", "point"}, {"intensity", 1e30}};
+         },
      .check = [](const Scene& s) { EXPECT_EQ(s.lights.size(), 1u); }},
     {.name = "LightIndexOutOfRange",
-     .edit = [](Doc& d) { d.j["nodes"][2] = json{{"name", "lamp"}, {"extensions", light_ext(3)}}; },
+     .edit =
+         [](Doc& d) {
+           d.j["nodes"][2] = json{{"name", "lamp"}, {"extensions", light_ext(3)}};
+         },
      .error = {"node 'lamp' refers to light 3, which does not exist"}},
     {.name = "SpotInnerConeBeyondOuterIsRefused",
      .edit = [](Doc& d) { light0(d) = spot(0.6, 0.5); },
@@ -264,12 +295,13 @@ TEST_F(LoaderTest, AModelFarFromTheOriginIsCentredBeforeItIsRoundedToFloat) {
   // parent node translated by t.
   auto placed = [](const glm::dvec3& t) {
     Doc d = triangle_doc();
-    d.j["accessors"][0] = json{{"bufferView", d.view(std::vector<float>{0, 0, 0, 0.1f, 0, 0, 0, 0.1f, 0})},
-                               {"componentType", kFloat},
-                               {"count", 3},
-                               {"type", "VEC3"},
-                               {"min", {0, 0, 0}},
-                               {"max", {0.1, 0.1, 0}}};
+    d.j["accessors"][0] =
+        json{{"bufferView", d.view(std::vector<float>{0, 0, 0, 0.1f, 0, 0, 0, 0.1f, 0})},
+             {"componentType", kFloat},
+             {"count", 3},
+             {"type", "VEC3"},
+             {"min", {0, 0, 0}},
+             {"max", {0.1, 0.1, 0}}};
     d.add("nodes", json{{"translation", {t.x, t.y, t.z}}, {"children", {0, 1, 2}}});
     set_roots(d, {3});
     return d;

@@ -37,7 +37,8 @@ const std::vector<LoaderCase> kRows = {
            json top = images(json::array({png_image(png_bytes(3, 2))}));
            top["samplers"] =
                json::array({json{{"magFilter", 9728}, {"wrapS", 33071}, {"wrapT", 33648}}});
-           top["textures"] = json::array({json{{"source", 0}, {"sampler", 0}}, json{{"source", 0}}});
+           top["textures"] =
+               json::array({json{{"source", 0}, {"sampler", 0}}, json{{"source", 0}}});
            const json xf = json::parse(R"({"KHR_texture_transform": {"offset": [0.5, 0.25],
              "rotation": 0.3, "scale": [2, 4], "texCoord": 1}})");
            d = textured(top, json::parse(R"({
@@ -127,7 +128,9 @@ const std::vector<LoaderCase> kRows = {
     // Unused images are never decoded: junk nobody uses loads.
     {.name = "UnusedImagesAreNeverDecoded",
      .edit =
-         [](Doc& d) { d = textured(images(json::array({kJunkImage})), {{"doubleSided", false}}); },
+         [](Doc& d) {
+           d = textured(images(json::array({kJunkImage})), {{"doubleSided", false}});
+         },
      .check = [](const Scene& s) { EXPECT_TRUE(s.images.empty()); }},
     // TANGENT through a mirroring node transform: xyz by the linear part, w flipped. Texture 1
     // has only a KHR_texture_basisu source.
@@ -181,10 +184,10 @@ TEST_F(LoaderTest, KtxTwoImagesAsPlainSourcesFallBackToTheirFactorsWithOneWarnin
                                      '0',  0xbb, '\r', '\n', 0x1a, '\n'};
   ktx2.resize(64, 0);
   write("lamp.ktx2", ktx2);
-  const Doc d = textured(
-      json{{"images", json::array({json{{"uri", "lamp.ktx2"}}})},
-           {"textures", json::array({json{{"source", 0}}, json{{"source", 0}}})}},
-      json::parse(R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1, 1],
+  const Doc d =
+      textured(json{{"images", json::array({json{{"uri", "lamp.ktx2"}}})},
+                    {"textures", json::array({json{{"source", 0}}, json{{"source", 0}}})}},
+               json::parse(R"({"pbrMetallicRoughness": {"baseColorFactor": [0.5, 0.25, 1, 1],
                                                "baseColorTexture": {"index": 0}},
                       "emissiveFactor": [1, 1, 1], "emissiveTexture": {"index": 1}})"));
   const Scene s = load(d);
