@@ -1,5 +1,5 @@
-// Small glTF files for the decode tests (test_gltf_decode.cpp, test_gltf_accessors.cpp) and the
-// corpus generator (make_gltf_corpus.cpp): a wavy grid with normals and two texture coordinate
+// Small glTF files for the decode and loader tests (test_gltf_*.cpp) and the corpus generator
+// (make_gltf_corpus.cpp): a wavy grid with normals and two texture coordinate
 // sets, its Draco and meshoptimizer encodings, and a document writer (.gltf with an embedded
 // buffer, or .glb). Documents are built with nlohmann::json.
 #pragma once
@@ -141,6 +141,7 @@ struct Doc {
   json j;
   std::vector<unsigned char> bin;
   json more_buffers = json::array();  // buffers 1, 2, ...
+  std::string buffer_uri;             // buffer 0's uri in a .gltf (default: a data URI)
 
   Doc() {
     j["asset"] = json{{"version", "2.0"}};
@@ -222,6 +223,13 @@ struct Doc {
     v["extensions"] = json{{"EXT_meshopt_compression", ext}};
     return add("bufferViews", v);
   }
+  // A float VEC3 accessor and an UNSIGNED_SHORT index accessor over new bufferViews.
+  int vec3s(const std::vector<float>& xyz) {
+    return accessor(view(xyz), 5126, xyz.size() / 3, "VEC3");
+  }
+  int indices(const std::vector<uint16_t>& i) {
+    return accessor(view(i), 5123, i.size(), "SCALAR");
+  }
   void require(const std::vector<std::string>& extensions) {
     for (const std::string& e : extensions) {
       j["extensionsUsed"].push_back(e);
@@ -230,7 +238,9 @@ struct Doc {
   }
   json buffers(bool glb) const {
     json b0 = json{{"byteLength", bin.size()}};
-    if (!glb) b0["uri"] = "data:application/octet-stream;base64," + base64(bin);
+    if (!glb)
+      b0["uri"] =
+          buffer_uri.empty() ? "data:application/octet-stream;base64," + base64(bin) : buffer_uri;
     json all = json::array({b0});
     for (const json& b : more_buffers) all.push_back(b);
     return all;
