@@ -5,6 +5,7 @@
 #include "util/rng.h"
 
 #include <algorithm>
+#include <optional>
 
 namespace pb {
 
@@ -24,168 +25,225 @@ bool survives(vec3& weight, Rng& rng) {
   return true;
 }
 
+// One camera path's state between its vertices (ESTIMATOR.md section 10).
+struct CameraPath {
+  Rng rng;
+  vec3 origin{0.0f}, origin_normal{0.0f};  // the vertex the ray leaves (the camera at first)
+  float origin_error = 0.0f;
+  vec3 dir{0.0f};
+  vec3 weight{1.0f};
+  dvec3 emission{0.0};     // light the path saw (and its vertices' next-event samples)
+  MeasurementPoint point;  // the visible point; f = 0: none
+  DiscMoments disc;
+  // The ray leaves a followed GGX lobe: the light it finds directly (an emitter, the
+  // environment) is that vertex's direct light, which its next-event sample has counted.
+  bool after_lobe = false;
+  // The path went past --max-depth by roulette (a pass-over or a followed lobe): it goes on by
+  // roulette through delta branches too, up to kPassOverDepth beyond, instead of being cut
+  // where the limit would cut a path that reached it.
+  bool past_limit = false;
+  int depth = 0;
+
+  CameraPath(const CameraPathInputs& in, size_t pixel)
+      : rng(in.seed, in.pass, pixel, Stream::Camera) {
+    const int width = in.camera.width();
+    const float jx = rng.next_float(), jy = rng.next_float();
+    const int x = int(pixel % size_t(width)), y = int(pixel / size_t(width));
+    origin = in.camera.origin();
+    dir = in.camera.direction(float(x) + jx, float(y) + jy);
+  }
+
+  // The next ray leaves surface s in direction wi.
+  void leave(const Surface& s, const vec3& wi) {
+    origin = s.position;
+    origin_normal = s.ng;
+    origin_error = s.error;
+    dir = wi;
+  }
+};
+
+// What a vertex tells the path: go on from it, or the path is over (with or without a point).
+enum class Step { Continue, End };
+
+// At or beyond --max-depth a path goes on only by Russian roulette, and kPassOverDepth vertices
+// beyond it at most (a pass-over or a followed lobe; ESTIMATOR.md section 10).
+bool beyond_limit_survives(CameraPath& path, const CameraPathInputs& in, vec3& weight) {
+  if (path.depth < in.max_depth) return true;
+  if (path.depth >= in.max_depth + kPassOverDepth || !survives(weight, path.rng)) return false;
+  path.past_limit = true;
+  return true;
+}
+
+// A followed GGX lobe below --follow-roughness (section 10): this vertex's direct light with
+// its whole Bsdf (so the choice adds no noise to it), then follow the lobe with p_lobe or gather
+// photons at the diffuse base with 1 - p_lobe, each divided by its probability. Rough glass is
+// followed with all light from photons too (its photons are never gathered); its direct light
+// from the other side is one more sample, through the surface. Sharp rough glass is left out:
+// its light comes from what its paths hit. With the base chosen, w and bsdf become the diffuse
+// base's, whose direct light is counted.
+enum class LobeChoice { Followed, PathEnded, Base };
+LobeChoice follow_lobe(CameraPath& path, const CameraPathInputs& in, const Surface& s, const vec3& wo,
+                 vec3& w, Bsdf& bsdf) {
+  const bool glass_direct = s.bsdf.glass_lit_directly();
+  const bool sharp_glass = s.bsdf.has_rough_glass() && !glass_direct;
+  const GlossyPoint whole{0, wo, sharp_glass ? s.bsdf.without_glass() : s.bsdf};
+  path.point.f = w;
+  if (in.next_event) {
+    path.emission += direct_light(in.world, path.point, &whole, path.rng);
+    // Through the surface: diffuse transmission, and rough glass when broad.
+    if (glass_direct || s.bsdf.transmits_diffusely())
+      path.emission += direct_light_through(in.world, s, wo, w, glass_direct, path.rng);
+  }
+  const float p_lobe = s.bsdf.lobe_probability(wo, in.follow_roughness);
+  if (p_lobe >= 1.0f || (p_lobe > 0.0f && path.rng.next_float() < p_lobe)) {
+    const GlossyPoint lobe{0, wo, s.bsdf.lobe_part(in.follow_roughness)};
+    path.weight = w / p_lobe;
+    path.point = MeasurementPoint{};  // no visible point here
+    // At or beyond --max-depth the followed path goes on by Russian roulette, as a pass-over
+    // does: the lobe's indirect light keeps its mean.
+    if (!beyond_limit_survives(path, in, path.weight)) return LobeChoice::PathEnded;
+    BsdfSample b;
+    if (!lobe.bsdf.sample(wo, path.rng, Transport::Radiance, b)) return LobeChoice::PathEnded;
+    path.weight *= b.weight;
+    if (!(max_component(path.weight) > 0.0f)) return LobeChoice::PathEnded;
+    path.leave(s, b.wi);
+    // The light this path finds directly was counted by the next-event sample, unless it left
+    // through sharp rough glass, which that sample left out.
+    path.after_lobe = in.next_event && !(sharp_glass && b.glass);
+    return LobeChoice::Followed;
+  }
+  w /= 1.0f - p_lobe;
+  bsdf = s.bsdf.base_part(in.follow_roughness);  // its direct light: next_event_pass skips it
+  return LobeChoice::Base;
+}
+
+// Passing over (section 10, "Passing over"): almost all of the disc is off reachable surface,
+// so photons cannot estimate the radiance here, but a path can: L = L_direct + integral of
+// f L cos over the non-delta part, by one next-event sample and one direction from that part,
+// and the photons gathered where it lands. At --max-depth the path does not keep the point (its
+// pixel would be unknown for good: validity is the least mass over the passes, and over
+// thousands of passes a rare deep path comes): it goes on by Russian roulette, so the indirect
+// part keeps its mean; kPassOverDepth more vertices cut it (no point, the truncation every depth
+// limit makes).
+Step pass_over(CameraPath& path, const CameraPathInputs& in, const Surface& s, const vec3& wo,
+               vec3 w, const Bsdf& bsdf, bool direct_counted) {
+  if (in.next_event && !direct_counted) {
+    const GlossyPoint here{0, wo, bsdf};
+    path.point.f = w;
+    path.emission += direct_light(in.world, path.point, &here, path.rng);
+  }
+  path.point = MeasurementPoint{};
+  path.disc = DiscMoments{};
+  if (!beyond_limit_survives(path, in, w)) return Step::End;
+  BsdfSample b;
+  if (!bsdf.sample_non_delta_part(wo, path.rng, b)) return Step::End;
+  path.weight = w * b.weight;
+  if (!(max_component(path.weight) > 0.0f)) return Step::End;
+  path.leave(s, b.wi);
+  path.after_lobe = in.next_event;  // the next-event sample counted what it finds directly
+  return Step::Continue;
+}
+
+// The path stops at the non-delta part of surface s (chosen with 1 - p_delta): a followed lobe,
+// a pass-over, or the visible point, whose Bsdf goes to `glossy` when it is not Lambertian.
+Step stop_at(CameraPath& path, const CameraPathInputs& in, const Hit& hit, const Surface& s,
+             const vec3& wo, float p_delta, float radius, std::optional<GlossyPoint>& glossy) {
+  const bool front = glm::dot(wo, s.ng) > 0.0f;
+  vec3 w = p_delta > 0.0f ? path.weight / (1.0f - p_delta) : path.weight;
+  MeasurementPoint& point = path.point;
+  point.position = in.world.spawn(s, wo);  // lifted off the surface: shadow rays start here
+  point.normal = front ? s.ng : -s.ng;
+  point.shading = front ? s.ns : -s.ns;
+  Bsdf bsdf = s.bsdf;
+  bool direct_counted = false;  // this vertex's next-event sample is taken
+  // A sharp lobe is followed at --max-depth too (by roulette beyond it): gathered with it, a
+  // rare deep path would give its pixel the lobe's peak f in the sparse-photon bound
+  // (ESTIMATOR.md section 12) for good.
+  if (path.depth < in.max_depth + kPassOverDepth && s.bsdf.has_lobe_below(in.follow_roughness)) {
+    switch (follow_lobe(path, in, s, wo, w, bsdf)) {
+      case LobeChoice::Followed:
+        return Step::Continue;
+      case LobeChoice::PathEnded:
+        return Step::End;
+      case LobeChoice::Base:
+        direct_counted = true;
+    }
+  }
+  const bool lambertian = bsdf.is_lambertian();
+  point.f = lambertian ? w * bsdf.diffuse_f() : w;
+  point.triangle = in.world.triangle_index(hit);
+  if (!(max_component(point.f) > 0.0f)) {
+    point.f = vec3(0.0f);  // a black surface (or a path weight of 0): no visible point
+    return Step::End;
+  }
+  if (in.boundary) {
+    path.disc = in.boundary->moments(point.triangle, point.position, point.normal, radius);
+    if (path.disc.mass < kValidKernelMass)
+      return pass_over(path, in, s, wo, w, bsdf, direct_counted);
+  }
+  if (!lambertian) glossy = GlossyPoint{0, wo, bsdf};
+  return Step::End;
+}
+
+// A vertex on surface `hit`: its emission, then stop there (the non-delta part) or follow a
+// delta branch, with 1 - p_delta and p_delta.
+Step at_vertex(CameraPath& path, const CameraPathInputs& in, const Hit& hit, float radius,
+               std::optional<GlossyPoint>& glossy) {
+  const Surface s = in.world.surface(hit);
+  const vec3 wo = -path.dir;
+  path.weight *= in.world.transmittance(s, wo, path.origin);  // inside an absorbing volume
+  if (s.material->emits() && !path.after_lobe)
+    path.emission += dvec3(path.weight * in.world.emitted(s, wo));
+  path.after_lobe = false;
+  const float p_delta = s.bsdf.delta_probability(wo);
+  bool stop = p_delta < 1.0f;
+  if (stop && p_delta > 0.0f) {
+    const float u = path.rng.next_float();
+    stop = u >= p_delta;
+  }
+  if (stop) return stop_at(path, in, hit, s, wo, p_delta, radius, glossy);
+  // A delta branch: the chain is cut at --max-depth, unless it is past the limit already.
+  if (path.depth >= in.max_depth) {
+    if (!path.past_limit || path.depth >= in.max_depth + kPassOverDepth ||
+        !survives(path.weight, path.rng))
+      return Step::End;
+  }
+  BsdfSample b;
+  if (!s.bsdf.sample_delta(wo, path.rng, Transport::Radiance, b, path.weight)) return Step::End;
+  path.weight *= p_delta < 1.0f ? b.weight / p_delta : b.weight;
+  if (!(max_component(path.weight) > 0.0f)) return Step::End;
+  path.leave(s, b.wi);
+  return Step::Continue;
+}
+
 }  // namespace
 
 size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
                             std::span<MeasurementPoint> points, std::span<GlossyPoint> glossy,
                             std::span<OwnerValues> out) {
-  const int width = in.camera.width();
   size_t glossy_count = 0;
   for (size_t k = 0; k < points.size(); ++k) {
-    const size_t pixel = first + k;
-    Rng rng(in.seed, in.pass, pixel, Stream::Camera);
-    const float jx = rng.next_float(), jy = rng.next_float();
-    const int x = int(pixel % size_t(width)), y = int(pixel / size_t(width));
-    vec3 origin = in.camera.origin(), origin_normal(0.0f);
-    float origin_error = 0.0f;
-    vec3 dir = in.camera.direction(float(x) + jx, float(y) + jy);
-    vec3 weight(1.0f);
-    dvec3 emission(0.0);
-    MeasurementPoint point;  // f = 0: none
-    DiscMoments disc;
-    // The ray leaves a followed GGX lobe: the light it finds directly (an emitter, the
-    // environment) is that vertex's direct light, which its next-event sample has counted.
-    bool after_lobe = false;
-    // The path went past --max-depth by roulette (a pass-over or a followed lobe): it goes on by
-    // roulette through delta branches too, up to kPassOverDepth beyond, instead of being cut
-    // where the limit would cut a path that reached it.
-    bool past_limit = false;
-    for (int depth = 0;; ++depth) {
+    CameraPath path(in, first + k);
+    std::optional<GlossyPoint> g;
+    for (;; ++path.depth) {
       Hit hit;
-      const bool found = depth == 0 ? in.world.camera_hit(origin, dir, hit)
-                                    : in.world.trace(origin, origin_normal, origin_error, dir, hit);
+      const bool found =
+          path.depth == 0
+              ? in.world.camera_hit(path.origin, path.dir, hit)
+              : in.world.trace(path.origin, path.origin_normal, path.origin_error, path.dir, hit);
       if (!found) {  // the environment (black without one), seen along the path
-        if (!after_lobe) emission += dvec3(weight * in.world.lights().environment_radiance(dir));
+        if (!path.after_lobe)
+          path.emission += dvec3(path.weight * in.world.lights().environment_radiance(path.dir));
         break;
       }
-      const Surface s = in.world.surface(hit);
-      const vec3 wo = -dir;
-      const bool front = glm::dot(wo, s.ng) > 0.0f;
-      weight *= in.world.transmittance(s, wo, origin);  // inside an absorbing volume
-      if (s.material->emits() && !after_lobe) emission += dvec3(weight * in.world.emitted(s, wo));
-      after_lobe = false;
-      // Stop here (the non-delta part) or follow a delta branch: 1 - p_delta and p_delta.
-      const float p_delta = s.bsdf.delta_probability(wo);
-      bool stop = p_delta < 1.0f;
-      if (stop && p_delta > 0.0f) {
-        const float u = rng.next_float();
-        stop = u >= p_delta;
-      }
-      if (stop) {
-        vec3 w = p_delta > 0.0f ? weight / (1.0f - p_delta) : weight;
-        point.position = in.world.spawn(s, wo);  // lifted off the surface: shadow rays start here
-        point.normal = front ? s.ng : -s.ng;
-        point.shading = front ? s.ns : -s.ns;
-        Bsdf bsdf = s.bsdf;
-        bool direct_counted = false;  // this vertex's next-event sample is taken
-        // A sharp lobe is followed at --max-depth too (by roulette beyond it, below): gathered
-        // with it, a rare deep path would give its pixel the lobe's peak f in the sparse-photon
-        // bound (ESTIMATOR.md section 12) for good.
-        if (depth < in.max_depth + kPassOverDepth && s.bsdf.has_lobe_below(in.follow_roughness)) {
-          // This vertex's direct light with its whole Bsdf (so the choice below adds no noise
-          // to it), then follow the GGX lobe with p_lobe or gather photons at the diffuse base
-          // with 1 - p_lobe, each divided by its probability (ESTIMATOR.md section 10). Rough
-          // glass is followed with all light from photons too (its photons are never gathered);
-          // its direct light from the other side is one more sample, through the surface.
-          // Sharp rough glass is left out: its light comes from what its paths hit.
-          const bool glass_direct = s.bsdf.glass_lit_directly();
-          const bool sharp_glass = s.bsdf.has_rough_glass() && !glass_direct;
-          const GlossyPoint whole{0, wo, sharp_glass ? s.bsdf.without_glass() : s.bsdf};
-          point.f = w;
-          if (in.next_event) {
-            emission += direct_light(in.world, point, &whole, rng);
-            // Through the surface: diffuse transmission, and rough glass when broad.
-            if (glass_direct || s.bsdf.transmits_diffusely())
-              emission += direct_light_through(in.world, s, wo, w, glass_direct, rng);
-          }
-          const float p_lobe = s.bsdf.lobe_probability(wo, in.follow_roughness);
-          if (p_lobe >= 1.0f || (p_lobe > 0.0f && rng.next_float() < p_lobe)) {
-            const GlossyPoint lobe{0, wo, s.bsdf.lobe_part(in.follow_roughness)};
-            weight = w / p_lobe;
-            point = MeasurementPoint{};  // no visible point here
-            // At or beyond --max-depth the followed path goes on by Russian roulette, as a
-            // pass-over does: the lobe's indirect light keeps its mean.
-            if (depth >= in.max_depth) {
-              if (!survives(weight, rng)) break;
-              past_limit = true;
-            }
-            BsdfSample b;
-            if (!lobe.bsdf.sample(wo, rng, Transport::Radiance, b)) break;
-            weight *= b.weight;
-            if (!(max_component(weight) > 0.0f)) break;
-            origin = s.position;
-            origin_normal = s.ng;
-            origin_error = s.error;
-            dir = b.wi;
-            // The light this path finds directly was counted by the next-event sample, unless
-            // it left through sharp rough glass, which that sample left out.
-            after_lobe = in.next_event && !(sharp_glass && b.glass);
-            continue;
-          }
-          w /= 1.0f - p_lobe;
-          bsdf = s.bsdf.base_part(
-              in.follow_roughness);  // its direct light is counted: next_event_pass skips it
-          direct_counted = true;
-        }
-        const bool lambertian = bsdf.is_lambertian();
-        point.f = lambertian ? w * bsdf.diffuse_f() : w;
-        point.triangle = in.world.triangle_index(hit);
-        if (!(max_component(point.f) > 0.0f)) {
-          point.f = vec3(0.0f);  // a black surface (or a path weight of 0): no visible point
-          break;
-        }
-        if (in.boundary) {
-          disc = in.boundary->moments(point.triangle, point.position, point.normal, radii[k]);
-          if (disc.mass < kValidKernelMass) {
-            // Almost all of the disc is off reachable surface: photons cannot estimate the
-            // radiance here (ESTIMATOR.md section 10, "Passing over"), but a path can:
-            // L = L_direct + integral of f L cos over the non-delta part, by one next-event
-            // sample and one direction from that part, and the photons gathered where it lands.
-            if (in.next_event && !direct_counted) {
-              const GlossyPoint here{0, wo, bsdf};
-              point.f = w;
-              emission += direct_light(in.world, point, &here, rng);
-            }
-            point = MeasurementPoint{};
-            disc = DiscMoments{};
-            // At --max-depth the path does not keep the point (its pixel would be unknown for
-            // good: validity is the least mass over the passes, and over thousands of passes a
-            // rare deep path comes): it goes on by Russian roulette (survives), so the indirect
-            // part keeps its mean; kPassOverDepth more vertices cut it (no point, the truncation
-            // every depth limit makes).
-            if (depth >= in.max_depth) {
-              if (depth >= in.max_depth + kPassOverDepth || !survives(w, rng)) break;
-              past_limit = true;
-            }
-            BsdfSample b;
-            if (!bsdf.sample_non_delta_part(wo, rng, b)) break;
-            weight = w * b.weight;
-            if (!(max_component(weight) > 0.0f)) break;
-            origin = s.position;
-            origin_normal = s.ng;
-            origin_error = s.error;
-            dir = b.wi;
-            after_lobe = in.next_event;  // the next-event sample counted what it finds directly
-            continue;
-          }
-        }
-        if (!lambertian) glossy[glossy_count++] = {uint32_t(k), wo, bsdf};
-        break;
-      }
-      if (depth >= in.max_depth) {  // the chain is cut, unless it is past the limit already
-        if (!past_limit || depth >= in.max_depth + kPassOverDepth || !survives(weight, rng)) break;
-      }
-      BsdfSample b;
-      if (!s.bsdf.sample_delta(wo, rng, Transport::Radiance, b, weight)) break;
-      weight *= p_delta < 1.0f ? b.weight / p_delta : b.weight;
-      if (!(max_component(weight) > 0.0f)) break;
-      origin = s.position;
-      origin_normal = s.ng;
-      origin_error = s.error;
-      dir = b.wi;
+      if (at_vertex(path, in, hit, radii[k], g) == Step::End) break;
     }
-    points[k] = point;
-    out[k] = OwnerValues{emission, disc};
+    if (g) {
+      g->point = uint32_t(k);
+      glossy[glossy_count++] = *g;
+    }
+    points[k] = path.point;
+    out[k] = OwnerValues{path.emission, path.disc};
   }
   return glossy_count;
 }
