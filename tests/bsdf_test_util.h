@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <initializer_list>
 #include <string>
 #include <vector>
 
@@ -153,18 +152,34 @@ inline bool leaves_along_a_branch(const Bsdf& bsdf, const vec3& wo, Transport mo
   return found;
 }
 
-// chi_square at views theta (radians, azimuth 0.7 about ns), 2e5 draws each, seeded by `seed`
-// and theta: each p-value above 1e-4 (the callers' comments give the family-wise rates).
+// chi_square at views theta (radians, azimuth 0.7 about ns), `draws` draws each (2e5 unless
+// told), seeded by `seed` and theta: each p-value above `min_p` (1e-4 unless told; the callers'
+// comments give the family-wise rates).
 inline void expect_draws_follow_the_pdf(const Bsdf& bsdf, const vec3& ns,
-                                        std::initializer_list<double> thetas, uint64_t seed,
-                                        const char* name) {
+                                        const std::vector<double>& thetas, uint64_t seed,
+                                        const char* name, int draws = 200000, double min_p = 1e-4) {
   const Basis f(ns);
   for (double theta : thetas) {
     Rng rng(seed, uint64_t(theta * 10), 0, Stream::Test);
-    const double pv = chi_square(bsdf, f.world(theta, 0.7), ns, 200000, rng).p_value;
-    std::printf("%-36s theta %.1f: p = %.3g\n", name, theta, pv);
-    EXPECT_GT(pv, 1e-4) << name << " theta " << theta;
+    const double pv = chi_square(bsdf, f.world(theta, 0.7), ns, draws, rng).p_value;
+    std::printf("%-36s theta %.2f: p = %.3g\n", name, theta, pv);
+    EXPECT_GT(pv, min_p) << name << " theta " << theta;
   }
+}
+
+// ng and a shading normal tilted from it by up to ~0.3 rad (the three numbers of two
+// random_unit draws, in order).
+inline void random_normals(Rng& rng, vec3& ng, vec3& ns) {
+  ng = random_unit(rng);
+  ns = glm::normalize(ng + 0.3f * random_unit(rng));
+  if (glm::dot(ns, ng) < 0.2f) ns = ng;
+}
+
+// The same with a coat normal, tilted from ng by up to ~0.3 rad as well (drawn after ns).
+inline void random_normals(Rng& rng, vec3& ng, vec3& ns, vec3& nc) {
+  random_normals(rng, ng, ns);
+  nc = glm::normalize(ng + 0.3f * random_unit(rng));
+  if (glm::dot(nc, ng) < 0.2f) nc = ng;
 }
 
 // The draws of sample() for a Bsdf with normal +z, seen from wo, binned over the whole sphere

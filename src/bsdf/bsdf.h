@@ -1,44 +1,19 @@
-// glTF's material at a surface point (docs/materials.md): the Bsdf every stage asks, and the
-// pure functions it is made of, of directions in world space. Directions point away from the
-// surface; n is the side the incoming direction is on.
+// glTF's material at a surface point (docs/materials.md): the Bsdf every stage asks, of
+// directions in world space (the pure functions it is made of are in bsdf/scattering.h).
+// Directions point away from the surface; n is the side the incoming direction is on. Its
+// definitions, by operation: bsdf.cpp (construction), bsdf_eval.cpp (eval, pdf and the
+// layering), bsdf_bounds.cpp (max_f), bsdf_sample.cpp (sampling), bsdf_delta.cpp (delta branches
+// and dispersion), bsdf_glass.cpp (rough glass, diffuse transmission) and bsdf_lobe_split.cpp
+// (SPPM's lobe split).
 #pragma once
 
-#include "util/math.h"
 #include "bsdf/microfacet.h"
-#include "util/rng.h"
+#include "bsdf/scattering.h"
 #include "scene/scene.h"
+#include "util/math.h"
+#include "util/rng.h"
 
 namespace pb {
-
-// Fresnel reflectance of a smooth dielectric for unpolarised light (Born & Wolf; pbrt-v4
-// FrDielectric). cos_i: cosine on the incident side (> 0); eta: eta_transmitted / eta_incident.
-// Returns 1 under total internal reflection.
-float fresnel_dielectric(float cos_i, float eta);
-
-// Mirror direction of w about n.
-inline vec3 reflect(const vec3& w, const vec3& n) { return 2.0f * glm::dot(w, n) * n - w; }
-
-// Refracts w (pointing away from the surface, on n's side) into the other side.
-// eta = eta_transmitted / eta_incident. Returns false under total internal reflection.
-bool refract(const vec3& w, const vec3& n, float eta, vec3& wt);
-
-// Lambertian BRDF value rho / pi (symmetric in its directions).
-inline vec3 lambertian(const vec3& rho) { return rho / kPi; }
-
-// Cosine-weighted direction about n from two uniform numbers; pdf = cos / pi.
-vec3 sample_cosine_hemisphere(const vec3& n, float u1, float u2);
-
-// Uniform direction on the unit sphere; pdf = 1 / (4 pi).
-vec3 sample_uniform_sphere(float u1, float u2);
-
-// Uniform direction in the cone of directions within acos(cos_max) of axis; pdf = 1/(2 pi
-// (1-cos_max)).
-vec3 sample_uniform_cone(const vec3& axis, float cos_max, float u1, float u2);
-
-// Veach's correction for shading normals in adjoint (photon) transport, thesis eq. 5.19:
-// |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|), wo toward where the photon came from, wi the new direction.
-// Without it, interpolated normals create or destroy energy in photon paths.
-float adjoint_shading_factor(const vec3& wo, const vec3& wi, const vec3& ng, const vec3& ns);
 
 // KHR_materials_dispersion's index of refraction for RGB channel 0, 1 or 2 (dispersion = 20 /
 // Abbe number; ior is n_d, the index at 587.6 nm). The channels stand for the three lines that

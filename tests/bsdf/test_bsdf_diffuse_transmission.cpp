@@ -7,6 +7,7 @@
 #include "bsdf/bsdf.h"
 #include "util/rng.h"
 
+#include "bsdf_properties.h"
 #include "bsdf_test_util.h"
 
 #include <gtest/gtest.h>
@@ -17,6 +18,9 @@ namespace pb {
 namespace {
 
 using glm::dvec3;
+using test::BsdfCase;
+using test::BsdfProperties;
+using test::cases_of;
 using test::random_unit;
 
 BsdfParams translucent(float dt, float roughness, float specular = 1.0f) {
@@ -111,6 +115,19 @@ TEST(DiffuseTransmission, WithoutALayerAWhiteSheetPassesAllItDoesNotReflect) {
   ppm.follows_transmission = false;
   EXPECT_TRUE(Bsdf(ppm, n, n).is_lambertian());
 }
+
+// The suite's cases (bsdf_properties.h): half transmitted under a glossy layer, and all of it
+// without a layer. Their draws through the surface are not eval()'s or pdf()'s
+// (DrawsIntegrateToTheDefinitionOverEveryBin checks them), so the suite checks weights,
+// reciprocity of the reflection and the albedo.
+std::vector<BsdfCase> diffuse_transmission_cases() {
+  std::vector<BsdfCase> c = cases_of({{"half under a layer r0.5", translucent(0.5f, 0.5f)},
+                                      {"all without a layer", translucent(1.0f, 1.0f, 0.0f)}},
+                                     802, 0, {});
+  for (BsdfCase& x : c) x.contract = false;
+  return c;
+}
+PB_BSDF_PROPERTY_CASES(DiffuseTransmission, diffuse_transmission_cases());
 
 }  // namespace
 }  // namespace pb

@@ -5,6 +5,7 @@
 #include "bsdf/bsdf.h"
 #include "util/rng.h"
 
+#include "bsdf_properties.h"
 #include "bsdf_test_util.h"
 
 #include <gtest/gtest.h>
@@ -15,6 +16,9 @@
 namespace pb {
 namespace {
 
+using test::BsdfCase;
+using test::BsdfProperties;
+using test::cases_of;
 using test::random_unit;
 
 BsdfParams glass(float ior, float dispersion, bool thin = false) {
@@ -200,6 +204,20 @@ TEST(Dispersion, ATintedPathDrawsOnlyTheBranchesItCarries) {
   BsdfSample s;
   EXPECT_FALSE(b.sample(wo, rng, Transport::Importance, s, vec3(0.0f)));
 }
+
+// The suite's cases (bsdf_properties.h): smooth dispersive volumes, delta branches alone (no
+// continuous draws, nothing for the chi-square test).
+std::vector<BsdfCase> dispersion_cases() {
+  std::vector<BsdfCase> c = cases_of({{"volume ior 1.5 dispersion 0.5", glass(1.5f, 0.5f)},
+                                      {"volume ior 1.8 dispersion 2", glass(1.8f, 2.0f)}},
+                                     803, 0, {});
+  for (BsdfCase& x : c) {
+    x.min_continuous = 0;
+    x.min_delta = 500;
+  }
+  return c;
+}
+PB_BSDF_PROPERTY_CASES(Dispersion, dispersion_cases());
 
 }  // namespace
 }  // namespace pb

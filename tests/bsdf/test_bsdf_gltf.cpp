@@ -1,17 +1,16 @@
 // glTF's material through the Bsdf interface, in world space with tilted shading normals: the
-// Lambertian fast path, eval against MetalRoughBrdf in the shading frame, reciprocity, sample()
-// against eval() and pdf() (per sample, and by a chi-square test of the sampled directions,
-// delta draws included), white furnaces per roughness against the deterministic quadrature of
-// microfacet_quadrature.h, the adjoint (photon) use, and thin against volumetric glass.
+// Lambertian fast path, eval against MetalRoughBrdf in the shading frame, reciprocity, white
+// furnaces per roughness against the deterministic quadrature of microfacet_quadrature.h, the
+// adjoint (photon) use, and thin against volumetric glass. Per draw (delta draws included) and by
+// chi-square, reciprocity and albedo: bsdf_properties.h, over the cases below.
 #include "bsdf/bsdf.h"
 #include "util/rng.h"
 
+#include "bsdf_properties.h"
 #include "bsdf_test_util.h"
 #include "microfacet_quadrature.h"
 
 #include <gtest/gtest.h>
-
-#include <boost/math/distributions/chi_squared.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -23,10 +22,11 @@ namespace {
 
 using test::Basis;
 using test::brdf_of;
-using test::chi_square;
-using test::ChiSquare;
+using test::BsdfCase;
+using test::BsdfProperties;
+using test::cases_of;
 using test::expect_sample_matches_eval;
-using test::leaves_along_a_branch;
+using test::random_normals;
 using test::random_unit;
 
 BsdfParams params(vec3 base, float metallic, float roughness, float transmission = 0.0f,
@@ -42,13 +42,6 @@ BsdfParams params(vec3 base, float metallic, float roughness, float transmission
   // has its own tests, test_bsdf_rough_glass.cpp).
   p.follows_transmission = false;
   return p;
-}
-
-// ng and a shading normal tilted from it by up to ~0.3 rad.
-void random_normals(Rng& rng, vec3& ng, vec3& ns) {
-  ng = random_unit(rng);
-  ns = glm::normalize(ng + 0.3f * random_unit(rng));
-  if (glm::dot(ns, ng) < 0.2f) ns = ng;
 }
 
 TEST(GltfBsdf, LambertianFastPathNeedsSpecularZero) {
@@ -179,53 +172,40 @@ TEST(GltfBsdf, ReciprocalInWorldSpace) {
   EXPECT_GT(tested, 4000);
 }
 
-// Materials that exercise every part: glossy dielectric and metal, a mixture, a smooth coat
-// (delta reflection over a diffuse base), glossy reflection beside smooth transmission (thin and
-// volumetric), and a Lambertian.
-struct Case {
-  const char* name;
-  BsdfParams p;
-};
-std::vector<Case> cases() {
-  return {{"dielectric r0.5", params(vec3(0.7f, 0.4f, 0.2f), 0.0f, 0.5f)},
-          {"metal r0.3", params(vec3(0.95f, 0.64f, 0.54f), 1.0f, 0.3f)},
-          {"mixture r0.7", params(vec3(0.5f), 0.5f, 0.7f)},
-          {"smooth coat r0.02", params(vec3(0.6f, 0.3f, 0.3f), 0.0f, 0.02f)},
-          {"glossy + thin glass", params(vec3(0.8f), 0.2f, 0.4f, 0.5f, true)},
-          {"glossy + volume glass", params(vec3(0.9f), 0.0f, 0.6f, 0.6f, false)},
-          {"lambertian", params(vec3(0.5f), 0.0f, 1.0f, 0.0f, true, 0.0f)}};
-}
-
-TEST(GltfBsdf, SampleWeightIsEvalCosOverPdfAndDeltaDrawsAreBranches) {
-  // Continuous draws: weight = eval |wi.ns| / pdf and pdf = pdf(wo, wi) (relative 2e-3: the
-  // sampled direction is rounded through the shading frame); delta draws leave along a branch.
-  Rng rng(303, 0, 0, Stream::Test);
-  for (const Case& c : cases()) {
-    int continuous = 0, delta = 0;
-    for (int k = 0; k < 20000; ++k) {
-      vec3 ng, ns;
-      random_normals(rng, ng, ns);
-      const Bsdf bsdf(c.p, ng, ns);
-      const vec3 wo = random_unit(rng);
-      const vec3 n = glm::dot(wo, ng) > 0.0f ? ns : -ns;
-      if (glm::dot(wo, n) < 0.02f) continue;
-      const Transport mode = k % 2 ? Transport::Radiance : Transport::Importance;
-      BsdfSample s;
-      if (!bsdf.sample(wo, rng, mode, s)) continue;
-      ASSERT_TRUE(is_finite(s.weight)) << c.name;
-      if (s.delta) {
-        EXPECT_TRUE(leaves_along_a_branch(bsdf, wo, mode, s)) << c.name;
-        ++delta;
-        continue;
-      }
-      expect_sample_matches_eval(bsdf, wo, s, ns, c.name);
-      ++continuous;
-    }
-    EXPECT_GT(continuous, 1000) << c.name;
-    if (c.p.transmission > 0.0f || c.p.roughness < kDefaultMirrorRoughness)
-      EXPECT_GT(delta, 500) << c.name;
+// The suite's cases (bsdf_properties.h): materials that exercise every part: glossy dielectric
+// and metal, a mixture, a smooth coat (delta reflection over a diffuse base), glossy reflection
+// beside smooth transmission (thin and volumetric), and a Lambertian. Delta draws are expected
+// beside glass and below the mirror roughness. Chi-square: 4e5 draws per case from a fixed seed;
+// the 7 cases x 2 geometries each must keep p > 1e-3 (all together a false alarm below 1.4%).
+// Geometry: ng tilted, ns 0.25 rad from ng, wo at 30 and 70 degrees from ns.
+std::vector<BsdfCase> gltf_cases() {
+  std::vector<BsdfCase> cases =
+      cases_of({{"dielectric r0.5", params(vec3(0.7f, 0.4f, 0.2f), 0.0f, 0.5f)},
+                {"metal r0.3", params(vec3(0.95f, 0.64f, 0.54f), 1.0f, 0.3f)},
+                {"mixture r0.7", params(vec3(0.5f), 0.5f, 0.7f)},
+                {"smooth coat r0.02", params(vec3(0.6f, 0.3f, 0.3f), 0.0f, 0.02f)},
+                {"glossy + thin glass", params(vec3(0.8f), 0.2f, 0.4f, 0.5f, true)},
+                {"glossy + volume glass", params(vec3(0.9f), 0.0f, 0.6f, 0.6f, false)},
+                {"lambertian", params(vec3(0.5f), 0.0f, 1.0f, 0.0f, true, 0.0f)}},
+               303, 304, {0.52, 1.22});
+  const vec3 ng = glm::normalize(vec3(0.2f, -0.3f, 1.0f));
+  for (BsdfCase& c : cases) {
+    if (c.params.transmission > 0.0f || c.params.roughness < kDefaultMirrorRoughness)
+      c.min_delta = 500;
+    c.chi_draws = 400000;
+    c.chi_min_p = 1e-3;
+    c.chi_ng = ng;
+    c.chi_ns = glm::normalize(ng + 0.25f * Basis(ng).t);
   }
+  // Below the mirror roughness appendix B's dielectric is a mirror of weight F(wo.n) beside a
+  // diffuse base weighted 1 - max F(v.h) at each pair's half vector (diffuse_term): at grazing
+  // views v.h exceeds wo.n for most wi, so the sum exceeds 1, at most F(wo.n) + max(base) (1.07
+  // at cosine 0.15 for this base 0.6: F = 0.466). The specification's model, not the sampling
+  // (measured 1.032 there); the bound keeps that excess from growing.
+  cases[3].albedo_max = 1.07;
+  return cases;
 }
+PB_BSDF_PROPERTY_CASES(GltfBsdf, gltf_cases());
 
 // The mean red weight of n draws of sample() (absorbed draws 0) and its standard error.
 struct SampledAlbedo {
@@ -250,20 +230,20 @@ TEST(GltfBsdf, BaseAndLobeSumToTheWholeAndEachSamplesItself) {
   // never a delta branch; relative 2e-3 as above). Which cases have a lobe is fixed.
   Rng rng(311, 0, 0, Stream::Test);
   int with_lobe = 0;
-  for (const Case& c : cases()) {
-    const Bsdf probe(c.p, vec3(0, 0, 1), vec3(0, 0, 1));
+  for (const BsdfCase& c : gltf_cases()) {
+    const Bsdf probe(c.params, vec3(0, 0, 1), vec3(0, 0, 1));
     const bool lobe = probe.has_lobe_below(1.0f);
-    EXPECT_EQ(lobe, c.p.roughness >= kDefaultMirrorRoughness &&
-                        !(c.p.metallic == 0.0f && c.p.specular == 0.0f))
+    EXPECT_EQ(lobe, c.params.roughness >= kDefaultMirrorRoughness &&
+                        !(c.params.metallic == 0.0f && c.params.specular == 0.0f))
         << c.name;
-    EXPECT_FALSE(probe.has_lobe_below(c.p.roughness)) << c.name;  // strictly below
+    EXPECT_FALSE(probe.has_lobe_below(c.params.roughness)) << c.name;  // strictly below
     if (!lobe) continue;
     ++with_lobe;
     int drawn[2] = {0, 0};
     for (int k = 0; k < 4000; ++k) {
       vec3 ng, ns;
       random_normals(rng, ng, ns);
-      const Bsdf bsdf(c.p, ng, ns);
+      const Bsdf bsdf(c.params, ng, ns);
       const Bsdf parts[2] = {bsdf.base_part(1.0f), bsdf.lobe_part(1.0f)};
       const vec3 wo = random_unit(rng), wi = random_unit(rng);
       const vec3 n = glm::dot(wo, ng) > 0.0f ? ns : -ns;
@@ -272,7 +252,7 @@ TEST(GltfBsdf, BaseAndLobeSumToTheWholeAndEachSamplesItself) {
       for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(sum[ch], whole[ch], 1e-5f * whole[ch]) << c.name;
       const float p_lobe = bsdf.lobe_probability(wo, 1.0f);
       EXPECT_TRUE(p_lobe > 0.0f && p_lobe <= 1.0f) << c.name;
-      if (c.p.metallic == 1.0f) EXPECT_EQ(p_lobe, 1.0f) << c.name;  // no base to gather at
+      if (c.params.metallic == 1.0f) EXPECT_EQ(p_lobe, 1.0f) << c.name;  // no base to gather at
       for (int part = 0; part < 2; ++part) {
         const Bsdf& b = parts[part];
         const vec3 bound = b.max_f(wo), value = b.eval(wo, wi);
@@ -280,11 +260,11 @@ TEST(GltfBsdf, BaseAndLobeSumToTheWholeAndEachSamplesItself) {
         BsdfSample s;
         if (!b.sample(wo, rng, Transport::Radiance, s)) continue;
         ASSERT_FALSE(s.delta) << c.name;
-        expect_sample_matches_eval(b, wo, s, ns, c.name);
+        expect_sample_matches_eval(b, wo, s, ns, c.name.c_str());
         ++drawn[part];
       }
     }
-    if (c.p.metallic < 1.0f) EXPECT_GT(drawn[0], 1000) << c.name;
+    if (c.params.metallic < 1.0f) EXPECT_GT(drawn[0], 1000) << c.name;
     EXPECT_GT(drawn[1], 1000) << c.name;
   }
   EXPECT_EQ(with_lobe, 5);
@@ -312,27 +292,6 @@ TEST(GltfBsdf, LobeAlbedoByItsSamplerEqualsItsQuadrature) {
       const auto [mean, se] = sampled_albedo(lobe, wo, rng);
       EXPECT_NEAR(mean, quad, 4.0 * se + 2e-4) << "roughness " << p.roughness << " mu " << mu;
       EXPECT_GT(quad, 0.01);
-    }
-  }
-}
-
-TEST(GltfBsdf, ChiSquareSampledDirectionsFollowThePdf) {
-  // 4e5 draws per case from a fixed seed; the 7 cases x 2 geometries each must keep p > 1e-3
-  // (all together a false alarm below 1.4%). Geometry: ng tilted, ns 0.25 rad from ng, wo at 30
-  // and 70 degrees from ns.
-  Rng rng(304, 0, 0, Stream::Test);
-  const vec3 ng = glm::normalize(vec3(0.2f, -0.3f, 1.0f));
-  const Basis g(ng);
-  const vec3 ns = glm::normalize(ng + 0.25f * g.t);
-  const Basis fs(ns);
-  for (const Case& c : cases()) {
-    for (double theta : {0.52, 1.22}) {
-      const vec3 wo = fs.world(theta, 0.7);
-      const Bsdf bsdf(c.p, ng, ns);
-      const ChiSquare r = chi_square(bsdf, wo, ns, 400000, rng);
-      std::printf("%-22s theta %.2f: chi2 %.1f, dof %d, p %.3g\n", c.name, theta, r.statistic,
-                  r.dof, r.p_value);
-      EXPECT_GT(r.p_value, 1e-3) << c.name << " theta " << theta;
     }
   }
 }

@@ -5,9 +5,10 @@
 // against eval() and pdf(), the mirror and thin-glass branches.
 #include "bsdf/bsdf.h"
 #include "bsdf/microfacet.h"
-#include "util/rng.h"
 #include "bsdf/thin_film.h"
+#include "util/rng.h"
 
+#include "bsdf_properties.h"
 #include "bsdf_test_util.h"
 
 #include <gtest/gtest.h>
@@ -19,9 +20,10 @@
 namespace pb {
 namespace {
 
-using test::expect_draws_follow_the_pdf;
+using test::BsdfCase;
+using test::BsdfProperties;
+using test::cases_of;
 using test::expect_sample_matches_eval;
-using test::leaves_along_a_branch;
 using test::random_unit;
 
 // The extension's "Iridescence Fresnel" GLSL, line by line in double (its evalSensitivity with
@@ -184,8 +186,8 @@ TEST(Iridescence, NoFilmIsTheMaterialBitForBit) {
 
 TEST(Iridescence, ReciprocalBoundedByMaxFAndSampledByItsPdf) {
   // f(wo, wi) = f(wi, wo) (v.h is the same both ways); max_f bounds eval for random, drawn and
-  // grazing wi; draws agree with eval and pdf (relative 2e-3), and by chi-square at two views
-  // for two films (4 tests at p > 1e-4).
+  // grazing wi; draws agree with eval and pdf (relative 2e-3); the suite's cases below test the
+  // draws of two films by chi-square.
   Rng rng(704, 0, 0, Stream::Test);
   for (int k = 0; k < 3000; ++k) {
     const vec3 ng = random_unit(rng);
@@ -215,13 +217,19 @@ TEST(Iridescence, ReciprocalBoundedByMaxFAndSampledByItsPdf) {
       }
     }
   }
-  const vec3 ng = glm::normalize(vec3(0.1f, -0.2f, 1.0f));
-  const vec3 ns = glm::normalize(vec3(0.25f, -0.1f, 1.0f));
-  expect_draws_follow_the_pdf(Bsdf(film(vec3(0.3f), 0.0f, 0.3f, 1.0f, 350.0f), ng, ns), ns,
-                              {0.4, 1.3}, 705, "film over a dielectric");
-  expect_draws_follow_the_pdf(Bsdf(film(vec3(0.9f), 1.0f, 0.5f, 0.7f, 250.0f), ng, ns), ns,
-                              {0.4, 1.3}, 706, "film over a metal");
 }
+
+// The suite's cases (bsdf_properties.h): two films, each tested by chi-square at two views with
+// a seed of its own (4 tests at p > 1e-4).
+std::vector<BsdfCase> iridescence_cases() {
+  std::vector<BsdfCase> c =
+      cases_of({{"film over a dielectric", film(vec3(0.3f), 0.0f, 0.3f, 1.0f, 350.0f)},
+                {"film over a metal", film(vec3(0.9f), 1.0f, 0.5f, 0.7f, 250.0f)}},
+               707, 705);
+  c[1].chi_seed = 706;
+  return c;
+}
+PB_BSDF_PROPERTY_CASES(Iridescence, iridescence_cases());
 
 TEST(Iridescence, MirrorsAndThinGlassReflectTheFilm) {
   // Below the mirror roughness the metal's branch is the film's Fresnel at the view's cosine,
