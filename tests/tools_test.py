@@ -9,9 +9,9 @@ imported.
                                              confidences): the table and plots are written and
                                              the table agrees with `photonbound compare --json`,
                                              and references and renders have the channels of
-                                             channels.def; then the Cornell sweep, whose
-                                             shipped reference must be 10x below its smallest
-                                             actual error; then the glTF reader
+                                             src/estimator/channels.def; then the Cornell
+                                             sweep, whose shipped reference must be 10x below
+                                             its smallest actual error; then the glTF reader
                                              (tools.gltf_scene) on .gltf, .glb, external
                                              buffers, a node hierarchy and interleaved data
   tools_test.py bad-input --photonbound EXE  missing files, wrong channels, bad options and

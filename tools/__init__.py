@@ -14,7 +14,8 @@ way:
   common       ToolError (a one-line, user-facing failure), run_main, atomic file writes
   gltf_scene   the glTF reader (standard library only)
   gltf_writer  the glTF writer: one binary buffer, .gltf (embedded or external) and .glb
-  exr          photonbound's EXR channel layout (channels.def), reading and writing EXRs
+  exr          photonbound's EXR channel layout (src/estimator/channels.def), reading and
+               writing EXRs
   cli          how the tools run build/photonbound and read its logs
   analytic     the closed-form answers of the analytic scenes
 

@@ -8,7 +8,7 @@
   expected_abs_noise  E|X| = sqrt(2/pi) sd of normal noise of standard deviation sd
 
 The camera, lights, reflectance and emission are read from the scene's glTF file (Gltf, the
-reader tools/gltf_scene.py in numpy arrays), and camera rays are made as src/camera.cpp makes
+reader tools/gltf_scene.py in numpy arrays), and camera rays are made as src/scene/camera.cpp makes
 them. The C++ tests have their own copies of these formulas (tests/analytic.h,
 tests/reference_truth.h): a change to one side needs the same change to the other.
 """
@@ -62,7 +62,7 @@ class Gltf:
 
 
 def camera_rays(camera, width, height):
-    """Unit directions through the pixel centres, (height, width, 3), as src/camera.cpp makes
+    """Unit directions through the pixel centres, (height, width, 3), as src/scene/camera.cpp makes
     them: pixel (0, 0) is the top-left corner and pixels are square."""
     tan_half = math.tan(0.5 * camera["yfov"])
     aspect = width / height

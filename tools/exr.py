@@ -19,7 +19,7 @@ try:
 except ImportError:  # the tools are meant for /usr/bin/python3 with the Debian package
     oiio = None
 
-RGB = ("R", "G", "B")  # the components of an RGB channel group (channels.def)
+RGB = ("R", "G", "B")  # the components of an RGB channel group (src/estimator/channels.def)
 CHANNELS_DEF = os.path.join(REPO, "src", "estimator", "channels.def")
 
 
@@ -77,9 +77,9 @@ def rgb_prefix(group_id):
 
 
 def channel(group_id, component=None):
-    """The EXR channel name of a group, as src/channels.cpp makes it: channel("ErrorBound", "R")
-    or channel("ErrorBound", 0) is "ErrorBound.R", channel("Radiance", "G") is "G"; a SCALAR
-    group takes no component: channel("Photons") is "Photons"."""
+    """The EXR channel name of a group, as src/estimator/channels.cpp makes it:
+    channel("ErrorBound", "R") or channel("ErrorBound", 0) is "ErrorBound.R", channel("Radiance",
+    "G") is "G"; a SCALAR group takes no component: channel("Photons") is "Photons"."""
     _, name, kind, _ = _group(group_id)
     if kind == "SCALAR":
         if component is not None:
@@ -118,7 +118,7 @@ class Exr:
         return self.planes[name]
 
     def rgb(self, group="Radiance"):
-        """(height, width, 3) array of an RGB channel group of channels.def, by its id."""
+        """(height, width, 3) array of an RGB channel group of src/estimator/channels.def, by id."""
         return np.stack([self.channel(channel(group, c)) for c in RGB], axis=-1)
 
     def meta(self, key, default=None):
@@ -172,8 +172,9 @@ def write_exr(path, planes, metadata):
 
 
 def write_reference(path, radiance, metadata):
-    """An EXR with the full channel layout of channels.def: the radiance ((h, w, 3)), and 0 in
-    every other channel (bound, bias, noise, variance, photons, radius): an exact reference."""
+    """An EXR with the full channel layout of src/estimator/channels.def: the radiance ((h, w, 3)),
+    and 0 in every other channel (bound, bias, noise, variance, photons, radius): an exact
+    reference."""
     zero = np.zeros(radiance.shape[:2], np.float32)
     planes = {name: zero for name in channel_names()}
     for k, c in enumerate(RGB):

@@ -3,7 +3,7 @@
 #   tools/fuzz.sh [SECONDS] [WORKERS]     default: 900 s on 2 workers = 30 CPU-minutes
 # Builds fuzz/ in build-fuzz/, seeds the corpus with every shipped scene, and runs in fork mode
 # so that one finding does not end the run. Findings (crash-*, leak-*, timeout-*, oom-*) land in
-# build-fuzz/findings/; each one fixed is kept in tests/data/fuzz/ where test_loader replays it.
+# build-fuzz/findings/; each one fixed is kept in tests/data/fuzz/ where test_gltf_loader_files replays it.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds="${1:-900}"

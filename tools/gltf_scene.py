@@ -15,12 +15,13 @@ tools/gltf_writer.py is its counterpart that writes.
   scene.nodes       [Node]          the nodes reached from the scene, parents first, with their
                                     world matrices (scene.world[node index])
 
-It follows the renderer's reading (src/gltf_loader.cpp, README "Scenes"): the default scene
-(or scene 0, or every node that is nobody's child), depth first; a node's "matrix" or T * R * S
-(the quaternion normalised); matrices are column-major lists of 16 numbers as in glTF; normals
-by the inverse transpose; a mirroring transform keeps the counter-clockwise front, so world
-triangles are wound front-side counter-clockwise. It does not judge materials or geometry (a
-reflectance above 1, a degenerate triangle): tools that care check those themselves.
+It follows the renderer's reading (src/gltf/gltf_loader.cpp; docs/gltf.md "Files, meshes and
+primitives"): the default scene (or scene 0, or every node that is nobody's child), depth first;
+a node's "matrix" or T * R * S (the quaternion normalised); matrices are column-major lists of
+16 numbers as in glTF; normals by the inverse transpose; a mirroring transform keeps the
+counter-clockwise front, so world triangles are wound front-side counter-clockwise. It does not
+judge materials or geometry (a reflectance above 1, a degenerate triangle): tools that care check
+those themselves.
 
 Whatever it cannot read (a missing buffer, a sparse or out-of-range accessor, a node reached
 twice, a primitive that is not TRIANGLES) raises GltfError, a ToolError whose message is one
@@ -336,9 +337,10 @@ class Material:
     KHR_materials_emissive_strength (default 1), transmission (KHR_materials_transmission,
     default 0), ior (KHR_materials_ior, default 1.5), specular (KHR_materials_specular
     specularFactor, default 1) and thin (no KHR_materials_volume with a thicknessFactor above 0).
-    .model is the renderer's reading of it (README "Materials"): "lambertian" (metallic 0, no
-    transmission, specular 0), "dielectric" (transmission bounding a volume), "thin"
-    (transmission without a volume) or "glossy" (glTF's metallic-roughness BRDF)."""
+    .model is the renderer's reading of it (docs/materials.md "Materials: glTF 2.0's
+    metallic-roughness model"): "lambertian" (metallic 0, no transmission, specular 0),
+    "dielectric" (transmission bounding a volume), "thin" (transmission without a volume) or
+    "glossy" (glTF's metallic-roughness BRDF)."""
 
     def __init__(self, index, json_):
         self.index, self.json = index, json_

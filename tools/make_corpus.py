@@ -1,5 +1,6 @@
 """Writes a corpus of glTF files laid out the way Blender's glTF exporter writes them, one per
-material feature of README "Materials": python3 -m tools.make_corpus OUTDIR.
+material feature of docs/materials.md "Materials: glTF 2.0's metallic-roughness model":
+python3 -m tools.make_corpus OUTDIR.
 
 Needs numpy and OpenImageIO (tools/install-deps.sh), which write the textures (PNG and JPEG);
 the files are written by tools/gltf_writer.py, the tools' one glTF writer. Deterministic. Like

@@ -56,7 +56,8 @@ Scenes (analytic answers are radiances in the renderer's units):
   unlit.gltf         A model as exporters write one with neither camera nor light: a 4 x 4
                      grey ground (rho 0.8), a red box, a blue sphere and a mirror sphere.
                      Rendered as shipped it gets the default view (framing the bounds) and the
-                     default sky (uniform radiance 1): the README's example.
+                     default sky (uniform radiance 1): docs/gltf.md "A scene
+                     with no camera and no light".
   furnace.gltf       Flat-shaded unit sphere (a convex polyhedron, rho 0.5), camera at
                      (0, 0, 4), no light: under the default sky (Le = 1) exactly L = rho Le =
                      0.5 wherever the sphere is seen, 1 elsewhere.
@@ -64,8 +65,8 @@ Scenes (analytic answers are radiances in the renderer's units):
                      travelling 30 degrees from straight down, camera 3 above looking down:
                      exactly L = (0.5/pi) * 2 * cos(30 deg) = 0.275664.
 
---corpus DIR writes files the way exporters do (tests/test_corpus.cpp renders them, with
-tests/make_gltf_corpus's Draco, meshopt, quantised and sparse files):
+--corpus DIR writes files the way exporters do (tests/gltf/test_corpus.cpp renders them, with
+build/tools/make_gltf_corpus's Draco, meshopt, quantised and sparse files):
 
   exported.glb       no camera, no light; an animation, a morph target and an extension
                      photonbound does not implement (KHR_materials_specular).
@@ -547,7 +548,7 @@ def build_glass_slab():
 
 
 def unlit_parts(b):
-    """The unlit model: ground, box, sphere, mirror sphere (the README's example)."""
+    """The unlit model: ground, box, sphere, mirror sphere (docs/gltf.md's example)."""
     ground = b.lambertian("ground", (0.8, 0.8, 0.8))
     red = b.lambertian("red", (0.75, 0.2, 0.12))
     blue = b.lambertian("blue", (0.15, 0.3, 0.7))
@@ -881,7 +882,7 @@ def main():
     where = ap.add_mutually_exclusive_group()
     where.add_argument("--heavy", metavar="DIR", help="write only cornell_heavy.glb, into DIR")
     where.add_argument("--corpus", metavar="DIR", help="write only the exporter-style files of "
-                       "tests/test_corpus.cpp, into DIR")
+                       "tests/gltf/test_corpus.cpp, into DIR")
     args = ap.parse_args()
     if args.heavy or args.corpus:
         write_into(Path(args.heavy or args.corpus), [HEAVY] if args.heavy else CORPUS)

@@ -1,5 +1,5 @@
-"""Writes a small equirectangular sky map (EXR) for README pictures and tests by hand:
-a blue gradient above the horizon, a dim ground below and a small sun of radiance 60.
+"""Writes a small equirectangular sky map (EXR) for docs/materials.md's pictures and tests by
+hand: a blue gradient above the horizon, a dim ground below and a small sun of radiance 60.
 
   python3 -m tools.make_sky OUT.exr [--width 256]
 """

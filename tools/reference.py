@@ -11,7 +11,7 @@ scenes/closed_box.gltf ("box"), with the camera, light, reflectance and emission
 glTF file (.gltf or .glb, through tools/gltf_scene.py): with `--pixel area` (the default) each
 pixel's average over its area, from N x N stratified sub-pixel rays (`--sub`, default 16), what
 `--method sppm` estimates; with `--pixel centre` the value at the pixel-centre measurement point
-`--method ppm` uses (src/camera.cpp). It has every channel of photonbound's layout
+`--method ppm` uses (src/scene/camera.cpp). It has every channel of photonbound's layout
 (src/estimator/channels.def); all but the radiance are 0.
 
 `render` runs a long photonbound render (its own error bound channels included) and prints
@@ -21,7 +21,7 @@ renders it judges (the study uses seed 1). Options after `--` go to `photonbound
 (e.g. --radius, --photons-per-pass, --alpha, --checkpoint-every).
 
 For a long reference, start from a radius of a fraction of a pixel and keep alpha near 1
-(README "Pictures, plots and references"): the render is then noise-dominated and its bound
+(docs/study.md "Making a reference converge"): the render is then noise-dominated and its bound
 falls like passes^-0.5, where the default radius and alpha give about passes^-0.25 in the
 Cornell box, because the bias at edges shrinks only as fast as the radius.
 """

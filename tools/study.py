@@ -45,7 +45,8 @@ from .common import REPO, ToolError, parse_resolution, run_main, use_agg, write_
 
 SEED = 1
 CORNELL_REFERENCE = os.path.join(REPO, "tools", "study", "cornell_64x64_reference.exr")
-# The same scene's long SPPM render (README "Coverage": how it was made), for --method sppm.
+# The same scene's long SPPM render, for --method sppm (how it was made: docs/error-bounds.md
+# "The Cornell box against its reference (SPPM, 64x64, 10k photons per pass, 4 seeds pooled)").
 CORNELL_SPPM_REFERENCE = os.path.join(REPO, "tools", "study", "cornell_64x64_sppm_reference.exr")
 
 # Targets halve in turn. They are chosen so that the tightest run at 90% takes one to three
@@ -53,9 +54,9 @@ CORNELL_SPPM_REFERENCE = os.path.join(REPO, "tools", "study", "cornell_64x64_spp
 # issue asks for that reference's bound to be 10x below the errors studied. With the default
 # 100k photons per pass its 64x64 image already has a mean error of 0.005 after the first 16
 # passes, so a sweep of distinct runs would need a reference hours longer than the 105-minute
-# one shipped (the bound of a long PPM render falls like passes^-0.25 to -0.5; README "The
-# study"). With 250 photons per pass the
-# same sweep starts from a 5x rougher image, noise-dominated like a short render of a big scene.
+# one shipped (the bound of a long PPM render falls like passes^-0.25 to -0.5; docs/study.md
+# "The study"). With 250 photons per pass the same sweep starts from a 5x rougher image,
+# noise-dominated like a short render of a big scene.
 SCENES = {
     "plane": {"file": "plane_point.gltf", "resolution": "64x64", "direct": "photons",
               "photons": 100000, "reference": "exact", "targets": [0.08, 0.04, 0.02, 0.01]},
@@ -101,7 +102,7 @@ def make_reference(name, cfg, resolution, folder, method="ppm"):
     h, w = ref.shape
     if f"{w}x{h}" != resolution:
         raise ToolError(f"{name}: the reference {path} is {w}x{h}, not {resolution}: render one "
-                        "with python3 -m tools.reference render (see README)")
+                        "with python3 -m tools.reference render (see docs/study.md)")
     return path
 
 

@@ -33,7 +33,7 @@ from .common import ToolError, run_main, save_figure, save_png, use_agg
 
 EXACT_COLOUR = (0.62, 0.62, 0.62, 1.0)
 UNKNOWN_COLOUR = (0.0, 0.0, 0.0, 1.0)
-RELATIVE_FLOOR = 0.01  # src/film.cpp kRelativeFloor
+RELATIVE_FLOOR = 0.01  # src/estimator/film.h kRelativeFloor
 
 
 def srgb(linear):
