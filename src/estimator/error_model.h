@@ -6,7 +6,7 @@
 
 namespace pb {
 
-// What --target-error measures (README "Stopping"): the absolute error, or the error relative
+// What --target-error measures (docs/usage.md "Stop rules"): the absolute error, or the error relative
 // to max(L, kRelativeFloor x the image's mean radiance) (film.h).
 enum class ErrorMetric { Absolute, Relative };
 
