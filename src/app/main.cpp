@@ -1,19 +1,20 @@
 // photonbound command-line entry point. The only catch-all: maps failures to exit codes
 // (0 done, 1 runtime failure or bad input file, 2 bad usage).
-#include "render/camera_paths.h"
-#include "estimator/channels.h"
 #include "app/checkpoint.h"
 #include "app/checkpoint_writer.h"
 #include "app/compare.h"
+#include "app/diagnostics.h"
 #include "app/driver.h"
-#include "util/file_io.h"
+#include "app/progress.h"
+#include "estimator/channels.h"
 #include "gltf/gltf_loader.h"
 #include "io/image_io.h"
 #include "options/options.h"
-#include "util/parallel.h"
-#include "app/progress.h"
+#include "render/camera_paths.h"
 #include "render/renderer.h"
 #include "render/scene_setup.h"
+#include "util/file_io.h"
+#include "util/parallel.h"
 
 #include <unistd.h>
 #include <algorithm>
@@ -30,17 +31,11 @@ namespace {
 
 std::atomic<bool> g_stop{false};
 
-// --radius above this fraction of the scene size draws a warning (render()).
-constexpr double kRadiusWarnFraction = 0.05;
-// The share of the view that back-face culling leaves out above which the render notes it.
-constexpr double kCulledNoteShare = 0.01;
-
 // First Ctrl-C (or SIGTERM): finish the pass and write the image. Second: leave at once.
 extern "C" void on_signal(int sig) {
   if (g_stop.exchange(true)) _exit(128 + sig);
 }
 
-// Renders `options`; with `saved`, continues that render (already checked to match).
 // What the stop line reports: the quantity the stop rule tests, then the mean bound.
 std::string stop_figures(const pb::RenderOptions& o, const pb::FilmSummary& s) {
   std::ostringstream out;
@@ -55,6 +50,103 @@ std::string stop_figures(const pb::RenderOptions& o, const pb::FilmSummary& s) {
   return out.str();
 }
 
+void print_lines(const std::vector<std::string>& lines) {
+  for (const std::string& line : lines) std::cerr << line << "\n";
+}
+
+// The scene, completed for rendering (its warnings and notes printed); with `saved`, checked to
+// be the scene and options that render was made with.
+pb::Scene load_scene(const pb::RenderOptions& options, const pb::SavedRender* saved) {
+  pb::Scene scene = pb::load_gltf(options.scene);
+  for (const std::string& w : scene.warnings)
+    std::cerr << "photonbound: warning: " << options.scene << ": " << w << "\n";
+  for (const std::string& n : pb::complete_scene(scene, options))
+    std::cerr << "photonbound: note: " << n << "\n";
+  if (saved) {
+    const std::vector<std::string> diff = pb::differences(*saved, options, scene.content_hash);
+    if (!diff.empty()) {
+      std::string msg = options.resume_from + ": cannot continue this render: ";
+      for (size_t k = 0; k < diff.size(); ++k) msg += (k ? "; " : "") + diff[k];
+      throw pb::StateError(msg);
+    }
+  }
+  return scene;
+}
+
+std::ofstream open_log(const std::string& path) {
+  std::ofstream log_file;
+  if (!path.empty()) {
+    log_file.open(path, std::ios::trunc);
+    if (!log_file) throw std::runtime_error(path + ": cannot write the log");
+  }
+  return log_file;
+}
+
+void check_reference_size(const pb::RenderOptions& options, const pb::ExrImage& reference,
+                          const pb::Renderer& renderer) {
+  if (!options.reference_path.empty() &&
+      (reference.width != renderer.eye().width || reference.height != renderer.eye().height))
+    throw pb::ImageError(options.reference_path + " is " + std::to_string(reference.width) + "x" +
+                         std::to_string(reference.height) + " but the render is " +
+                         std::to_string(renderer.eye().width) + "x" +
+                         std::to_string(renderer.eye().height));
+}
+
+// The pass observers: the progress line, the log, and the checkpoints. A checkpoint is the image
+// and the state, each written atomically; the state goes last, so a state file never refers to
+// passes the image does not show.
+struct Observers {
+  pb::ProgressPrinter progress{std::cerr};
+  pb::PassLogger logger;
+  pb::CheckpointWriter checkpoints;
+  std::vector<pb::PassObserver*> list;
+  Observers(const pb::RenderOptions& options, bool show, std::ofstream& log_file,
+            const pb::ExrImage& reference, uint64_t scene_hash, const pb::Renderer& renderer,
+            const std::string& state_path)
+      : logger(log_file, options.reference_path.empty() ? nullptr : &reference),
+        checkpoints(options.checkpoint_every.value_or(0.0), options, scene_hash,
+                    [&options, &renderer, &state_path](const pb::SavedRender& s) {
+                      // On the background thread, from the snapshot (CheckpointWriter).
+                      pb::write_exr(options.output,
+                                    renderer.image({s.schedule.seconds, ""}, s.render),
+                                    pb::ExrCompression::None);
+                      pb::save_state(state_path, s);
+                    }) {
+    if (show) list.push_back(&progress);
+    if (log_file.is_open()) list.push_back(&logger);
+    if (options.checkpoint_every) list.push_back(&checkpoints);
+  }
+};
+
+std::string start_line(const pb::RenderOptions& options, const pb::Renderer& renderer, int threads,
+                       bool resumed) {
+  std::ostringstream line;
+  line << "photonbound: "
+       << (options.method == pb::Method::PPM
+               ? std::to_string(renderer.eye().points.size()) + " measurement points"
+               : std::to_string(renderer.states().size()) + " pixels (SPPM)")
+       << ", " << threads << (threads == 1 ? " thread" : " threads")
+       << (resumed ? ", resumed" : "");
+  return line.str();
+}
+
+// ESTIMATOR.md section 7: the image, the warnings it draws, the state, and the stop line.
+void finish_render(const pb::RenderOptions& options, const pb::Renderer& renderer,
+                   const pb::RenderReport& report, const pb::DriverState& schedule,
+                   uint64_t scene_hash, bool keep_state, const std::string& state_path) {
+  // Ctrl-C keeps the work: the state is written then too.
+  const pb::ExrImage image = renderer.image(report.run());
+  pb::write_exr(options.output, image);
+  print_lines(pb::result_diagnostics(options, image, renderer.world().scene(), report.summary));
+  if (keep_state || report.stop == pb::StopReason::Interrupted)
+    pb::save_state(state_path, {options, scene_hash, renderer.snapshot(), schedule});
+  if (options.progress != pb::ProgressMode::Never)
+    std::cerr << "photonbound: stopped (" << pb::stop_text(report.stop) << ") after "
+              << report.work.passes << " passes, " << report.seconds << " s; "
+              << stop_figures(options, report.summary) << "; wrote " << options.output << "\n";
+}
+
+// Renders `options`; with `saved`, continues that render (already checked to match).
 int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   // Installed first: a Ctrl-C while the scene loads still ends with an image and a state.
   std::signal(SIGINT, on_signal);
@@ -62,151 +154,25 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   pb::check_writable(options.output);  // fail before hours of rendering, not after
   const bool keep_state = options.checkpoint_every || !options.state_path.empty();
   const std::string state_path = pb::state_path_for(options);
-  pb::Scene scene = pb::load_gltf(options.scene);
-  for (const std::string& w : scene.warnings)
-    std::cerr << "photonbound: warning: " << options.scene << ": " << w << "\n";
-  for (const std::string& n : pb::complete_scene(scene, options))
-    std::cerr << "photonbound: note: " << n << "\n";
+  pb::Scene scene = load_scene(options, saved);
   const uint64_t scene_hash = scene.content_hash;
-  if (saved) {
-    const std::vector<std::string> diff = pb::differences(*saved, options, scene_hash);
-    if (!diff.empty()) {
-      std::string msg = options.resume_from + ": cannot continue this render: ";
-      for (size_t k = 0; k < diff.size(); ++k) msg += (k ? "; " : "") + diff[k];
-      throw pb::StateError(msg);
-    }
-  }
-
   pb::ExrImage reference;
   if (!options.reference_path.empty()) reference = pb::read_exr(options.reference_path);
-  std::ofstream log_file;
-  if (!options.log_path.empty()) {
-    log_file.open(options.log_path, std::ios::trunc);
-    if (!log_file) throw std::runtime_error(options.log_path + ": cannot write the log");
-  }
-
-  // ESTIMATOR.md section 8: with error estimation the accumulated Laplacian converges only for
-  // alpha > 2/3, so the bias part of the bound is unreliable below it.
-  if (options.alpha <= 2.0 / 3.0)
-    std::cerr << "photonbound: warning: --alpha " << options.alpha
-              << " is at or below 2/3: the Laplacian (bias) estimate does not converge and the "
-                 "error bounds are unreliable\n";
-  // The default is silent where following does not apply; a chosen value is not.
-  if (options.follow_roughness > 0.0 && options.follow_roughness != pb::kDefaultFollowRoughness &&
-      (options.method == pb::Method::PPM || options.direct != pb::DirectMode::NextEvent))
-    std::cerr << "photonbound: warning: --follow-roughness does nothing here: it needs "
-                 "--method sppm with next-event direct light\n";
+  std::ofstream log_file = open_log(options.log_path);
+  print_lines(pb::option_diagnostics(options));
   pb::ThreadLimit threads(options.threads);
   pb::Renderer renderer(std::move(scene), options);
   if (saved) renderer.restore(saved->render);
-  // PPM's points are fixed, so it cannot follow rough glass or diffuse transmission through a
-  // surface (bsdf.h BsdfParams::follows_transmission).
-  if (const std::string glass = renderer.world().followed_transmission_names();
-      !glass.empty() && options.method == pb::Method::PPM)
-    std::cerr << "photonbound: warning: " << options.scene << ": " << glass
-              << ": rough and diffuse transmission are rendered by --method ppm as smooth glass "
-                 "and as diffuse reflection (its fixed points cannot follow a path through a "
-                 "surface); --method sppm renders them\n";
-  // Which materials the mirror threshold turns into perfect mirrors (a choice, not a flaw).
-  if (const std::string note = renderer.world().mirror_note();
-      !note.empty() && options.progress != pb::ProgressMode::Never)
-    std::cerr << "photonbound: note: " << options.scene << ": " << note << "\n";
-  // glTF's back-face culling (World::camera_hit) can leave out much of a view: say so, since a
-  // renderer that draws every face (a path tracer ignoring doubleSided) shows another picture.
-  if (const double culled = pb::culled_view_share(renderer.world(), renderer.camera());
-      culled >= kCulledNoteShare && options.progress != pb::ProgressMode::Never)
-    std::cerr << "photonbound: note: " << options.scene << ": " << std::setprecision(3)
-              << 100.0 * culled << std::setprecision(6)
-              << "% of the view looks through the back of single-sided faces (doubleSided "
-                 "false), which glTF culls as its viewers do; a face meant to be seen from "
-                 "behind needs doubleSided true\n";
-  // An environment outside a closed shell around the camera lights nothing it sees: a sky box
-  // or dome drawn for glTF viewers (which light it by the environment, without shadows) is
-  // opaque here. Said before the render, which would come out black.
-  if (const pb::Scene& sc = renderer.world().scene(); sc.environment)
-    if (const auto shell = renderer.world().camera_enclosure(renderer.camera().origin())) {
-      std::string outer;
-      for (const auto& [mesh, share] : shell->outermost) {
-        std::ostringstream item;
-        item << "'" << mesh << "' in " << std::setprecision(3) << 100.0 * share << "%";
-        outer += (outer.empty() ? " (outermost: mesh " : ", ") + item.str();
-      }
-      if (!outer.empty()) outer += " of the directions)";
-      std::cerr << "photonbound: warning: " << options.scene
-                << ": every ray from the camera meets a surface before the environment" << outer
-                << ", so " << sc.environment->source
-                << " cannot light what the camera sees; a sky box or dome made for viewers is "
-                   "opaque to light here: remove it from the file, or light the scene inside it\n";
-    }
-  // The bias term models the radiance as smooth (second order) within the radius. A radius of
-  // the scene's size breaks that (the extremes suite measured a bound of 0.128 against an error
-  // of ~1 at R = scene size), so say so rather than report a bound that cannot be trusted.
-  if (renderer.boundary().truncated())
-    std::cerr << "photonbound: warning: " << options.scene
-              << ": too many boundary segments within the radius for the boundary correction "
-                 "(ESTIMATOR.md section 11); every disc counts as whole, so bounds along edges "
-                 "may be too small (a higher --resolution or a smaller --radius avoids this)\n";
-  if (options.radius && *options.radius > kRadiusWarnFraction * renderer.world().scene_size())
-    std::cerr << "photonbound: warning: --radius " << *options.radius << " is "
-              << std::setprecision(3) << 100.0 * *options.radius / renderer.world().scene_size()
-              << std::setprecision(6)
-              << "% of the scene size: the bias estimate assumes the radiance is smooth within "
-                 "the radius, so the error bounds may be far too small until the radii shrink\n";
-  if (!options.reference_path.empty() &&
-      (reference.width != renderer.eye().width || reference.height != renderer.eye().height))
-    throw pb::ImageError(options.reference_path + " is " + std::to_string(reference.width) + "x" +
-                         std::to_string(reference.height) + " but the render is " +
-                         std::to_string(renderer.eye().width) + "x" +
-                         std::to_string(renderer.eye().height));
+  print_lines(pb::preflight_diagnostics(options, renderer));
+  check_reference_size(options, reference, renderer);
 
-  // A checkpoint is the image and the state, each written atomically; the state goes last, so
-  // a state file never refers to passes the image does not show.
   const bool show = options.progress == pb::ProgressMode::Always ||
                     (options.progress == pb::ProgressMode::Auto && isatty(STDERR_FILENO));
-  std::vector<pb::PassObserver*> observers;
-  pb::ProgressPrinter progress(std::cerr);
-  if (show) observers.push_back(&progress);
-  pb::PassLogger logger(log_file, options.reference_path.empty() ? nullptr : &reference);
-  if (log_file.is_open()) observers.push_back(&logger);
-  pb::CheckpointWriter checkpoints(
-      options.checkpoint_every.value_or(0.0), options, scene_hash, [&](const pb::SavedRender& s) {
-        // On the background thread, from the snapshot (CheckpointWriter).
-        pb::write_exr(options.output, renderer.image({s.schedule.seconds, ""}, s.render),
-                      pb::ExrCompression::None);
-        pb::save_state(state_path, s);
-      });
-  if (options.checkpoint_every) observers.push_back(&checkpoints);
-
-  if (show)
-    std::cerr << "photonbound: "
-              << (options.method == pb::Method::PPM
-                      ? std::to_string(renderer.eye().points.size()) + " measurement points"
-                      : std::to_string(renderer.states().size()) + " pixels (SPPM)")
-              << ", " << threads.threads() << (threads.threads() == 1 ? " thread" : " threads")
-              << (saved ? ", resumed" : "") << "\n";
+  Observers observers(options, show, log_file, reference, scene_hash, renderer, state_path);
+  if (show) std::cerr << start_line(options, renderer, threads.threads(), saved) << "\n";
   pb::Driver driver(renderer, saved ? saved->schedule : pb::DriverState{});
-  const pb::RenderReport report = driver.run(&g_stop, observers);
-  // Ctrl-C keeps the work: the state is written then too.
-  const pb::ExrImage image = renderer.image(report.run());
-  pb::write_exr(options.output, image);
-  if (const auto dark = pb::dark_image_warning(image, renderer.world().scene()))
-    std::cerr << "photonbound: warning: " << options.scene << ": " << *dark << "\n";
-  if (report.summary.model_refuted)
-    std::cerr << "photonbound: warning: " << options.scene
-              << ": every error bound with a photon part is unknown: the bias model fails at this "
-                 "radius (in "
-              << std::setprecision(3) << 100.0 * report.summary.slope_disagreement
-              << "% of the points' channels the samples' drift with the radius disagrees with the "
-                 "Laplacian, in "
-              << 100.0 * report.summary.scale_disagreement << std::setprecision(6)
-              << "% of the points the kernel at half the radius does); start with a smaller "
-                 "--radius\n";
-  if (keep_state || report.stop == pb::StopReason::Interrupted)
-    pb::save_state(state_path, {options, scene_hash, renderer.snapshot(), driver.state()});
-  if (options.progress != pb::ProgressMode::Never)
-    std::cerr << "photonbound: stopped (" << pb::stop_text(report.stop) << ") after "
-              << report.work.passes << " passes, " << report.seconds << " s; "
-              << stop_figures(options, report.summary) << "; wrote " << options.output << "\n";
+  const pb::RenderReport report = driver.run(&g_stop, observers.list);
+  finish_render(options, renderer, report, driver.state(), scene_hash, keep_state, state_path);
   return 0;
 }
 

@@ -4,6 +4,10 @@
 // absolute value, for a normal error: the folded normal distribution's moments.
 #pragma once
 
+#include "util/math.h"
+
+#include <vector>
+
 namespace pb {
 
 // What --target-error measures (docs/usage.md "Stop rules"): the absolute error, or the error relative
@@ -20,11 +24,59 @@ double abs_error_variance(double mu, double sigma);
 // radius R and pixels of footprint f: (integral kappa)^2 / integral kappa^2 (R / f)^2 =
 // 1.4449 (R / f)^2 (the quintic kernel; at least 1). The photon-sharing model the mean-error
 // rule measures against (`bounds_study correlation`); the rule itself measures K from the
-// noise replicas (film.cpp, ESTIMATOR.md section 7), since next-event and jitter noise are
-// each pixel's own.
+// noise replicas (predict_mean_error, ESTIMATOR.md section 7), since next-event and jitter noise
+// are each pixel's own.
 double correlated_pixels(double radius, double footprint);
 
 // The one-sided normal quantile z_p (p in (0, 1)).
 double normal_quantile(double p);
+
+// One pixel's bias estimate B and its variance, as the prior sees it (ESTIMATOR.md section 6b);
+// `use` is false for pixels without one (unknown or exact).
+struct BiasEstimate {
+  dvec3 bias{0.0}, variance{0.0};
+  bool use = false;
+};
+// The empirical-Bayes prior of the bias (section 6b): per pixel and channel, the variance tau^2
+// of the true bias around 0, estimated over the (2 kPriorWindow + 1)^2 window of the pixels in
+// use as mean(B^2) - mean(Var B) (the estimates' own noise taken out), never below 0.
+inline constexpr int kPriorWindow = 4;
+std::vector<dvec3> bias_prior(const std::vector<BiasEstimate>& pixels, int width, int height);
+// The shrinkage w = tau^2 / (tau^2 + Var B) of a bias estimate B under the prior tau^2 (section
+// 6b): the error's bias part is w B, and the posterior's variance w Var B; 1 when B is exact.
+double bias_shrinkage(double prior, double bias_variance);
+
+// One pixel-channel in the model of the image's mean error (section 7): its error is the shrunk
+// bias w B plus a normal noise of variance `error_variance` (the noise's, the t's variance
+// times Var_pix, plus the bias posterior's w Var B), over the metric's `denominator`, plus the
+// sparse-photon term as it stands (an upper limit). `replica` is the pixel-channel's noise
+// replica and `variance` the Var_pix that standardises it.
+struct ChannelError {
+  double mean = 0.0;        // E|e| plus the sparse term, in the metric
+  double sd = 0.0;          // sd of |e|
+  bool replicated = false;  // the replica weights apply (sigma > 0 and Var_pix > 0)
+  double linear = 0.0;      // the standardised replica weighted by g sigma
+  double rest = 0.0;        // and by sqrt(Var|e| - g^2 sigma^2)
+};
+ChannelError channel_error(double shrunk_bias, double error_variance, double sparse,
+                           double denominator, double replica, double variance);
+
+// What the prediction of an image's mean error takes (section 7): sums over its pixel-channels.
+struct MeanErrorSums {
+  double error = 0.0;      // of E|e|
+  double error_var = 0.0;  // of the pixels' Var|e| (each pixel's channels' sd added)
+  std::vector<double> replica_linear, replica_rest;  // per pixel: ChannelError's, summed
+};
+// The predicted mean absolute error over the width x height x 3 pixel-channels and its upper
+// confidence limit, with K, the pixels whose errors move together in effect, measured from the
+// replicas' cross products between pixels within the reach of the discs (2 R, from the states'
+// mean R^2, plus the jitter), and nu = i - 1 the degrees of freedom of each sigma^2.
+struct ErrorPrediction {
+  double correlated_pixels = 1.0;  // K
+  double mean = 0.0;
+  double upper = 0.0;
+};
+ErrorPrediction predict_mean_error(const MeanErrorSums& sums, int width, int height, double mean_r2,
+                                   double footprint, double nu, double confidence);
 
 }  // namespace pb

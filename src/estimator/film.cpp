@@ -109,76 +109,196 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
   return r;
 }
 
-// A summed-area table over the image: the sum of a per-pixel value over any box in O(1).
-template <class T>
-class SummedArea {
- public:
-  template <class ValueAt>
-  SummedArea(int width, int height, ValueAt value_at)
-      : w1_(size_t(width) + 1), t_((size_t(height) + 1) * w1_, T(0.0)) {
-    for (int y = 0; y < height; ++y)
-      for (int x = 0; x < width; ++x) {
-        const size_t at = size_t(y + 1) * w1_ + size_t(x + 1), up = size_t(y) * w1_ + size_t(x + 1);
-        t_[at] = value_at(size_t(y) * size_t(width) + size_t(x)) + t_[at - 1] + t_[up] - t_[up - 1];
-      }
-  }
-  // Over pixels [xa, xb) x [ya, yb).
-  T box(size_t xa, size_t ya, size_t xb, size_t yb) const {
-    return t_[yb * w1_ + xb] - t_[ya * w1_ + xb] - t_[yb * w1_ + xa] + t_[ya * w1_ + xa];
-  }
-
- private:
-  size_t w1_;
-  std::vector<T> t_;
-};
-
-// Empirical-Bayes prior of the bias (ESTIMATOR.md section 6b): per pixel and channel, the
-// variance tau^2 of the true bias around it, estimated over the (2W+1)^2 window of known
-// pixels as mean(B^2) - mean(Var B) (the estimates' own noise taken out), never below 0.
-constexpr int kPriorWindow = 4;
-
-std::vector<dvec3> bias_prior(const std::vector<PixelResult>& results, int width, int height) {
-  auto use = [&](size_t p) { return results[p].known && !results[p].exact; };
-  const SummedArea<dvec3> b2(width, height, [&](size_t p) {
-    return use(p) ? results[p].bias * results[p].bias : dvec3(0.0);
+// ESTIMATOR.md sections 5 and 10: every pixel's sums of its states.
+std::vector<PixelResult> combine_pixels(const PixelLayout& eye,
+                                        const std::vector<PointState>& states, uint64_t passes,
+                                        const FilmSettings& s) {
+  const size_t pixels = size_t(eye.width) * size_t(eye.height);
+  std::vector<PixelResult> results(pixels);
+  parallel_for(pixels, 1024, [&](size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p)
+      results[p] = combine(eye, states, p, passes, s.photons_per_pass, s.confidence);
   });
-  const SummedArea<dvec3> v(
-      width, height, [&](size_t p) { return use(p) ? results[p].bias_variance : dvec3(0.0); });
-  const SummedArea<double> n(width, height, [&](size_t p) { return use(p) ? 1.0 : 0.0; });
-  std::vector<dvec3> tau2(size_t(width) * size_t(height), dvec3(0.0));
-  parallel_for(size_t(height), 16, [&](size_t y0, size_t y1) {
-    for (size_t y = y0; y < y1; ++y)
-      for (size_t x = 0; x < size_t(width); ++x) {
-        const size_t xa = x >= kPriorWindow ? x - kPriorWindow : 0;
-        const size_t ya = y >= kPriorWindow ? y - kPriorWindow : 0;
-        const size_t xb = std::min(x + kPriorWindow + 1, size_t(width));
-        const size_t yb = std::min(y + kPriorWindow + 1, size_t(height));
-        const double count = n.box(xa, ya, xb, yb);
-        if (count > 0.0)
-          tau2[y * size_t(width) + x] =
-              glm::max(dvec3(0.0), (b2.box(xa, ya, xb, yb) - v.box(xa, ya, xb, yb)) / count);
-      }
-  });
-  return tau2;
+  return results;
 }
 
-// Sum over pixel pairs p, q within `reach` pixels of each other (both orders) of u_p u_q, by a
-// summed-area table: the window estimate of Var(sum_p u_p) for a field u whose correlation does
-// not reach further (as in a Newey-West estimate of a correlated sum). Returns the pairs q != p
-// only, never below 0: a negative sum is the estimate's own noise.
-double windowed_cross_sum(const std::vector<double>& u, int width, int height, int reach) {
-  const SummedArea<double> sat(width, height, [&](size_t p) { return u[p]; });
-  double cross = 0.0;
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) {
-      const double v = u[size_t(y) * size_t(width) + size_t(x)];
-      if (v == 0.0) continue;
-      const double box =
-          sat.box(size_t(std::max(0, x - reach)), size_t(std::max(0, y - reach)),
-                  size_t(std::min(width, x + reach + 1)), size_t(std::min(height, y + reach + 1)));
-      cross += v * (box - v);
+// ESTIMATOR.md section 7: the relative metric's floor, from the image's mean radiance.
+double relative_floor(const std::vector<PixelResult>& results) {
+  double mean_radiance = 0.0;
+  for (const PixelResult& r : results)
+    mean_radiance += (r.radiance.x + r.radiance.y + r.radiance.z);
+  mean_radiance /= 3.0 * double(std::max<size_t>(results.size(), 1));
+  return kRelativeFloor * mean_radiance;
+}
+
+// ESTIMATOR.md sections 11b and 11c: where the samples' drift with R^2 and the Laplacian
+// disagree in more than kRefutedShare of the state-channels, or the two scales in more than
+// that share of the states, no bound of this image can be trusted.
+void check_model(const std::vector<PixelResult>& results, FilmSummary& sum) {
+  uint64_t slope_tested = 0, slope_disagree = 0, scale_tested = 0, scale_disagree = 0;
+  for (const PixelResult& r : results) {
+    slope_tested += r.slope_tested;
+    slope_disagree += r.slope_disagree;
+    scale_tested += r.scale_tested;
+    scale_disagree += r.scale_disagree;
+  }
+  sum.slope_disagreement = slope_tested ? double(slope_disagree) / double(slope_tested) : 0.0;
+  sum.scale_disagreement = scale_tested ? double(scale_disagree) / double(scale_tested) : 0.0;
+  sum.model_refuted =
+      sum.slope_disagreement > kRefutedShare || sum.scale_disagreement > kRefutedShare;
+}
+
+// ESTIMATOR.md section 6b: the bias prior over the known pixels with a random state.
+std::vector<dvec3> prior_of(const std::vector<PixelResult>& results, int width, int height) {
+  std::vector<BiasEstimate> estimates(results.size());
+  for (size_t p = 0; p < results.size(); ++p)
+    estimates[p] = {results[p].bias, results[p].bias_variance,
+                    results[p].known && !results[p].exact};
+  return bias_prior(estimates, width, height);
+}
+
+// What the bounds add up to over the image (ESTIMATOR.md section 7).
+struct Tally {
+  double bound_sum = 0.0, noise_sum = 0.0, bias_sum = 0.0, bias_metric_sum = 0.0;
+  uint64_t known = 0, below = 0;
+  std::vector<float> pixel_bounds;  // largest channel, in the metric
+  // The error model's sums. The noise replicas, standardised and weighted by what of a pixel's
+  // |error| moves linearly with its noise and what otherwise: their cross products between
+  // neighbours bound the covariances of the neighbours' |error|.
+  MeanErrorSums model;
+  explicit Tally(size_t pixels) : pixel_bounds(pixels, 0.0f) {
+    model.replica_linear.assign(pixels, 0.0);
+    model.replica_rest.assign(pixels, 0.0);
+  }
+};
+
+// How a pixel's bounds are taken: the quantile at i - 1 degrees of freedom (no bound exists
+// before two passes, nu = i - 1 >= 1), the noise half-width's t, Var(T_nu) and the metric.
+struct BoundRule {
+  BoundQuantile quantile;
+  double t, nu, t_var;
+  const FilmSettings& s;
+  double relative_floor;
+  BoundRule(uint64_t passes, const FilmSettings& settings, double floor)
+      : quantile(double(std::max<uint64_t>(passes, 2) - 1), settings.confidence),
+        t(quantile.two_sided_t()),
+        nu(double(std::max<uint64_t>(passes, 2) - 1)),
+        t_var(nu > 2.0 ? nu / (nu - 2.0) : 3.0),  // Var(T_nu); 3 stands in below nu = 3
+        s(settings),
+        relative_floor(floor) {}
+};
+
+// ESTIMATOR.md sections 6b and 7: a known pixel's bound per channel, its share of the
+// mean-error model added to the tally. The bias is known only through its noisy estimate B:
+// given the prior of the neighbourhood, the error's bias part is B shrunk by
+// w = tau^2 / (tau^2 + Var B), with the posterior's variance w Var B added to the noise.
+dvec3 channel_bounds(const PixelResult& r, const dvec3& tau2, const BoundRule& rule,
+                     const dvec3& denominator, size_t p, Tally& tally) {
+  dvec3 bound(0.0);
+  double pixel_error_sd = 0.0;
+  for (int c = 0; c < 3; ++c) {
+    if (r.exact) continue;
+    const double vb = r.bias_variance[c];
+    const double w = bias_shrinkage(tau2[c], vb);
+    bound[c] = rule.quantile(w * r.bias[c], std::sqrt(r.variance[c] + w * vb)) + r.sparse[c];
+    // The same model, for the image's mean error: |w B + noise| with the noise's variance
+    // (the t's), plus the sparse-photon term as it stands (an upper limit).
+    const ChannelError e = channel_error(w * r.bias[c], r.variance[c] * rule.t_var + w * vb,
+                                         r.sparse[c], denominator[c], r.replica[c], r.variance[c]);
+    tally.model.error += e.mean;
+    pixel_error_sd += e.sd;
+    if (e.replicated) {
+      tally.model.replica_linear[p] += e.linear;
+      tally.model.replica_rest[p] += e.rest;
     }
-  return std::max(0.0, cross);
+  }
+  // A pixel's three channels come from the same photons and paths: their errors are taken as
+  // fully correlated (exactly so in a grey scene), so their sd add.
+  tally.model.error_var += pixel_error_sd * pixel_error_sd;
+  return bound;
+}
+
+void write_pixel(FilmImage& image, size_t p, const PixelResult& r, const dvec3& bound,
+                 const dvec3& noise, bool known) {
+  for (int c = 0; c < 3; ++c) {
+    image.radiance[3 * p + c] = float(r.radiance[c]);
+    image.bound[3 * p + c] = float(bound[c]);
+    image.bias[3 * p + c] = float(r.bias[c]);
+    image.noise[3 * p + c] = known ? float(noise[c]) : INFINITY;
+    image.variance[3 * p + c] = float(r.variance[c]);
+  }
+  image.photons[p] = float(r.photons);
+  image.radius[p] = r.radius;
+}
+
+// ESTIMATOR.md sections 5-7: every pixel's bound (+inf where unknown) into the tally and image.
+void bound_pixel(const PixelResult& r, const dvec3& tau2, const BoundRule& rule, bool refuted,
+                 uint64_t passes, size_t p, Tally& tally, FilmSummary& sum, FilmImage* image) {
+  const FilmSettings& s = rule.s;
+  const bool known_pixel = r.exact || (passes >= 2 && r.known && (!refuted || r.photon_free));
+  dvec3 noise(0.0), bound(std::numeric_limits<double>::infinity());
+  if (known_pixel) {
+    // PPM pixels without points see only background or exact emission: bound 0.
+    noise = r.exact ? dvec3(0.0) : rule.t * glm::sqrt(r.variance);
+    const dvec3 denominator =
+        s.metric == ErrorMetric::Relative
+            ? glm::max(r.radiance, dvec3(std::max(rule.relative_floor, 1e-300)))
+            : dvec3(1.0);
+    bound = channel_bounds(r, tau2, rule, denominator, p, tally);
+    const dvec3 metric = bound / denominator, bias_metric = glm::abs(r.bias) / denominator;
+    tally.bound_sum += metric.x + metric.y + metric.z;
+    tally.bias_metric_sum += bias_metric.x + bias_metric.y + bias_metric.z;
+    tally.noise_sum += noise.x + noise.y + noise.z;
+    tally.bias_sum += std::fabs(r.bias.x) + std::fabs(r.bias.y) + std::fabs(r.bias.z);
+    ++tally.known;
+    if (s.target > 0.0 && max_component(metric) <= s.target) ++tally.below;
+    tally.pixel_bounds[p] = float(max_component(metric));
+    if (image)
+      for (int c = 0; c < 3; ++c)
+        image->target_ratio[3 * p + c] = float(s.target > 0.0 ? metric[c] / s.target : metric[c]);
+  } else {
+    ++sum.unknown_pixels;
+    tally.pixel_bounds[p] = INFINITY;
+    if (image)
+      for (int c = 0; c < 3; ++c) image->target_ratio[3 * p + c] = INFINITY;
+  }
+  if (image) write_pixel(*image, p, r, bound, noise, known_pixel);
+}
+
+// The image's means over its known pixels and the settings' quantile of the pixels' bounds.
+void summarise(Tally& tally, const FilmSettings& s, FilmSummary& sum) {
+  const size_t pixels = tally.pixel_bounds.size();
+  if (tally.known > 0) {
+    const double known = double(tally.known);
+    sum.mean_bound = tally.bound_sum / (3.0 * known);
+    sum.mean_noise = tally.noise_sum / (3.0 * known);
+    sum.mean_abs_bias = tally.bias_sum / (3.0 * known);
+    sum.mean_bias_metric = tally.bias_metric_sum / (3.0 * known);
+  }
+  sum.below_target = double(tally.below) / double(std::max<size_t>(pixels, 1));
+  if (pixels > 0) {
+    std::vector<float>& b = tally.pixel_bounds;
+    const size_t q = std::min(pixels - 1, size_t(std::ceil(s.stop_fraction * double(pixels))) - 1);
+    std::nth_element(b.begin(), b.begin() + q, b.end());
+    sum.pixel_quantile_bound = b[q];
+  }
+}
+
+void prepare_image(FilmImage& image, int width, int height) {
+  const size_t pixels = size_t(width) * size_t(height);
+  image.width = width;
+  image.height = height;
+  for (auto* v : {&image.radiance, &image.bound, &image.bias, &image.noise, &image.variance,
+                  &image.target_ratio})
+    v->assign(3 * pixels, 0.0f);
+  image.photons.assign(pixels, 0.0f);
+  image.radius.assign(pixels, 0.0f);
+}
+
+double mean_r2(const std::vector<PointState>& states) {
+  double mean = 0.0;
+  for (const PointState& st : states) mean += st.r2;
+  return mean / double(std::max<size_t>(states.size(), 1));
 }
 
 }  // namespace
@@ -205,176 +325,27 @@ const std::vector<float>& FilmImage::plane(Channel id) const {
   return radiance;
 }
 
+// ESTIMATOR.md sections 5-7: combine, check the model, take the prior, bound and predict.
 FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& states, uint64_t passes,
                     const FilmSettings& s, FilmImage* image) {
-  const size_t pixels = size_t(eye.width) * size_t(eye.height);
-  std::vector<PixelResult> results(pixels);
-  parallel_for(pixels, 1024, [&](size_t begin, size_t end) {
-    for (size_t p = begin; p < end; ++p)
-      results[p] = combine(eye, states, p, passes, s.photons_per_pass, s.confidence);
-  });
-
-  // No bound exists before two passes (nu = i - 1 >= 1).
-  const BoundQuantile quantile(double(std::max<uint64_t>(passes, 2) - 1), s.confidence);
-  const double t = quantile.two_sided_t();
+  const std::vector<PixelResult> results = combine_pixels(eye, states, passes, s);
+  const size_t pixels = results.size();
   FilmSummary sum;
-  double mean_radiance = 0.0;
-  for (const PixelResult& r : results)
-    mean_radiance += (r.radiance.x + r.radiance.y + r.radiance.z);
-  mean_radiance /= 3.0 * double(std::max<size_t>(pixels, 1));
-  sum.relative_floor = kRelativeFloor * mean_radiance;
-
-  if (image) {
-    image->width = eye.width;
-    image->height = eye.height;
-    for (auto* v : {&image->radiance, &image->bound, &image->bias, &image->noise, &image->variance,
-                    &image->target_ratio})
-      v->assign(3 * pixels, 0.0f);
-    image->photons.assign(pixels, 0.0f);
-    image->radius.assign(pixels, 0.0f);
-  }
-
-  // The model checks (sections 11b, 11c): where the samples' drift with R^2 and the Laplacian
-  // disagree in more than kRefutedShare of the state-channels, or the two scales in more than
-  // that share of the states, no bound of this image can be trusted.
-  uint64_t slope_tested = 0, slope_disagree = 0, scale_tested = 0, scale_disagree = 0;
-  for (const PixelResult& r : results) {
-    slope_tested += r.slope_tested;
-    slope_disagree += r.slope_disagree;
-    scale_tested += r.scale_tested;
-    scale_disagree += r.scale_disagree;
-  }
-  sum.slope_disagreement = slope_tested ? double(slope_disagree) / double(slope_tested) : 0.0;
-  sum.scale_disagreement = scale_tested ? double(scale_disagree) / double(scale_tested) : 0.0;
-  sum.model_refuted =
-      sum.slope_disagreement > kRefutedShare || sum.scale_disagreement > kRefutedShare;
-
-  const std::vector<dvec3> tau2 = bias_prior(results, eye.width, eye.height);
-  double bound_sum = 0.0, noise_sum = 0.0, bias_sum = 0.0, bias_metric_sum = 0.0;
-  double error_sum = 0.0, error_var_sum = 0.0;  // of the error model (section 7)
-  const double nu = double(std::max<uint64_t>(passes, 2) - 1);
-  const double t_var = nu > 2.0 ? nu / (nu - 2.0) : 3.0;  // Var(T_nu); 3 stands in below nu = 3
-  uint64_t known = 0, below = 0;
-  std::vector<float> pixel_bounds(pixels, 0.0f);  // largest channel, in the metric
-  // The noise replicas, standardised and weighted by what of a pixel's |error| moves linearly
-  // with its noise and what otherwise (section 7): their cross products between neighbours
-  // bound the covariances of the neighbours' |error|.
-  std::vector<double> replica_linear(pixels, 0.0), replica_rest(pixels, 0.0);
-  for (size_t p = 0; p < pixels; ++p) {
-    const PixelResult& r = results[p];
-    const bool known_pixel =
-        r.exact || (passes >= 2 && r.known && (!sum.model_refuted || r.photon_free));
-    dvec3 noise(0.0), bound(std::numeric_limits<double>::infinity());
-    if (known_pixel) {
-      // PPM pixels without points see only background or exact emission: bound 0.
-      const dvec3 sd = glm::sqrt(r.variance);
-      noise = r.exact ? dvec3(0.0) : t * sd;
-      // The bias is known only through its noisy estimate B: given the prior of the
-      // neighbourhood, the error's bias part is B shrunk by w = tau^2 / (tau^2 + Var B), with
-      // the posterior's variance w Var B added to the noise (section 6b).
-      double pixel_error_sd = 0.0;
-      const dvec3 denominator =
-          s.metric == ErrorMetric::Relative
-              ? glm::max(r.radiance, dvec3(std::max(sum.relative_floor, 1e-300)))
-              : dvec3(1.0);
-      for (int c = 0; c < 3; ++c) {
-        if (r.exact) {
-          bound[c] = 0.0;
-          continue;
-        }
-        const double vb = r.bias_variance[c], prior = tau2[p][c];
-        const double w = vb > 0.0 ? prior / (prior + vb) : 1.0;
-        bound[c] = quantile(w * r.bias[c], std::sqrt(r.variance[c] + w * vb)) + r.sparse[c];
-        // The same model, for the image's mean error: |w B + noise| with the noise's variance
-        // (the t's), plus the sparse-photon term as it stands (an upper limit).
-        const double mu = w * r.bias[c] / denominator[c];
-        const double sigma = std::sqrt(r.variance[c] * t_var + w * vb) / denominator[c];
-        error_sum += expected_abs_error(mu, sigma) + r.sparse[c] / denominator[c];
-        const double v = abs_error_variance(mu, sigma);
-        pixel_error_sd += std::sqrt(v);
-        if (sigma > 0.0 && r.variance[c] > 0.0) {
-          // |mu + sigma Z| = m + g sigma He_1(Z) + sum_{k >= 2} c_k sigma He_k(Z) (Hermite),
-          // g = erf(mu / sigma sqrt 2): two pixels' |e| whose noises correlate by rho have the
-          // covariance sigma sigma' (g g' rho + sum_k k! c_k c_k' rho^k), and for 0 <= rho <= 1
-          // the sum is at most rho sqrt(r r') (Cauchy-Schwarz), r = v - g^2 sigma^2 the part of
-          // the variance beyond the linear term. The replica's z measures rho: the covariance is
-          // bounded by the cross products of g sigma z and sqrt(r) z, exactly so for identical
-          // errors (rho = 1), and by rho in place of rho^2 for the noise-dominated (the price of
-          // a bound whose every term a replica can measure without its distribution's shape).
-          const double g = std::erf(mu / (sigma * std::sqrt(2.0)));
-          const double z = r.replica[c] / std::sqrt(r.variance[c]);  // standardised replica
-          replica_linear[p] += g * sigma * z;
-          replica_rest[p] += std::sqrt(std::max(0.0, v - g * g * sigma * sigma)) * z;
-        }
-      }
-      // A pixel's three channels come from the same photons and paths: their errors are taken
-      // as fully correlated (exactly so in a grey scene), so their sd add.
-      error_var_sum += pixel_error_sd * pixel_error_sd;
-      const dvec3 metric = bound / denominator, bias_metric = glm::abs(r.bias) / denominator;
-      bound_sum += metric.x + metric.y + metric.z;
-      bias_metric_sum += bias_metric.x + bias_metric.y + bias_metric.z;
-      noise_sum += noise.x + noise.y + noise.z;
-      bias_sum += std::fabs(r.bias.x) + std::fabs(r.bias.y) + std::fabs(r.bias.z);
-      ++known;
-      if (s.target > 0.0 && max_component(metric) <= s.target) ++below;
-      pixel_bounds[p] = float(max_component(metric));
-      if (image)
-        for (int c = 0; c < 3; ++c)
-          image->target_ratio[3 * p + c] = float(s.target > 0.0 ? metric[c] / s.target : metric[c]);
-    } else {
-      ++sum.unknown_pixels;
-      pixel_bounds[p] = INFINITY;
-      if (image)
-        for (int c = 0; c < 3; ++c) image->target_ratio[3 * p + c] = INFINITY;
-    }
-    if (image) {
-      for (int c = 0; c < 3; ++c) {
-        image->radiance[3 * p + c] = float(r.radiance[c]);
-        image->bound[3 * p + c] = float(bound[c]);
-        image->bias[3 * p + c] = float(r.bias[c]);
-        image->noise[3 * p + c] = known_pixel ? float(noise[c]) : INFINITY;
-        image->variance[3 * p + c] = float(r.variance[c]);
-      }
-      image->photons[p] = float(r.photons);
-      image->radius[p] = r.radius;
-    }
-  }
-  if (known > 0) {
-    sum.mean_bound = bound_sum / (3.0 * double(known));
-    sum.mean_noise = noise_sum / (3.0 * double(known));
-    sum.mean_abs_bias = bias_sum / (3.0 * double(known));
-    sum.mean_bias_metric = bias_metric_sum / (3.0 * double(known));
-  }
-  sum.below_target = double(below) / double(std::max<size_t>(pixels, 1));
-  if (pixels > 0) {
-    const size_t q = std::min(pixels - 1, size_t(std::ceil(s.stop_fraction * double(pixels))) - 1);
-    std::nth_element(pixel_bounds.begin(), pixel_bounds.begin() + q, pixel_bounds.end());
-    sum.pixel_quantile_bound = pixel_bounds[q];
-  }
+  sum.relative_floor = relative_floor(results);
+  if (image) prepare_image(*image, eye.width, eye.height);
+  check_model(results, sum);
+  const std::vector<dvec3> tau2 = prior_of(results, eye.width, eye.height);
+  const BoundRule rule(passes, s, sum.relative_floor);
+  Tally tally(pixels);
+  for (size_t p = 0; p < pixels; ++p)
+    bound_pixel(results[p], tau2[p], rule, sum.model_refuted, passes, p, tally, sum, image);
+  summarise(tally, s, sum);
   if (sum.unknown_pixels == 0 && pixels > 0) {
-    // The mean over every pixel-channel, as `compare` takes it (exact pixels add no error).
-    // Its variance (section 7): the pixels' own, plus the covariances of neighbours' |e|,
-    // bounded by the replicas' cross products over the window their discs can share (2R, plus
-    // the jitter); plus the model's: each sigma^2 comes from i - 1 passes, and their mean over
-    // the n / K independent groups has relative error 1 / sqrt(2 (i - 1) n / K), which moves
-    // the predicted mean by half that.
-    const double n = 3.0 * double(pixels);
-    double mean_r2 = 0.0;
-    for (const PointState& st : states) mean_r2 += st.r2;
-    mean_r2 /= double(std::max<size_t>(states.size(), 1));
-    const double reach_pixels =
-        eye.footprint > 0.0 ? 2.0 * std::sqrt(mean_r2) / eye.footprint + 1.0 : 1.0;
-    const int reach =
-        int(std::ceil(std::min(reach_pixels, double(std::max(eye.width, eye.height)))));
-    const double cross = windowed_cross_sum(replica_linear, eye.width, eye.height, reach) +
-                         windowed_cross_sum(replica_rest, eye.width, eye.height, reach);
-    const double k = error_var_sum > 0.0 ? 1.0 + cross / error_var_sum : 1.0;
-    const double m = error_sum / n;
-    const double model = 0.5 * m / std::sqrt(2.0 * nu * std::max(1.0, n / k));
-    const double var = k * error_var_sum / (n * n) + model * model;
-    sum.correlated_pixels = k;
-    sum.predicted_error = m;
-    sum.predicted_error_upper = m + normal_quantile(s.confidence) * std::sqrt(var);
+    const ErrorPrediction e = predict_mean_error(
+        tally.model, eye.width, eye.height, mean_r2(states), eye.footprint, rule.nu, s.confidence);
+    sum.correlated_pixels = e.correlated_pixels;
+    sum.predicted_error = e.mean;
+    sum.predicted_error_upper = e.upper;
   }
   return sum;
 }

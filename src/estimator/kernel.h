@@ -2,6 +2,8 @@
 // rim, so its Laplacian exists everywhere and integrates to zero, which the bias estimate needs.
 #pragma once
 
+#include "estimator/disc_moments.h"
+
 namespace pb::kernel {
 
 // Per-axis second moment of the unit-mass kernel: integral of t_1^2 kappa over the disk.
@@ -28,5 +30,19 @@ inline double laplacian_weight_r2(double t) {
   if (t >= 1.0) return 0.0;
   return 105.0 * t * (1.0 - t) * (5.0 * t - 3.0);
 }
+
+// The radial integrals of the boundary quadrature (ESTIMATOR.md section 11), in closed form, for
+// 0 <= a <= 1: G(a) = integral from 0 to a of g(t) t dt for g = kappa, |u|^2 kappa, lap kappa,
+// |u|^2 lap kappa. Over the whole disc 2 pi G(1) gives 1, 5/24, 0 and 4.
+double mass_to(double a);
+double second_to(double a);
+double laplacian_mass_to(double a);
+double laplacian_second_to(double a);
+
+// The moments of the kernel and its Laplacian over the star-shaped part of a disc of radius r
+// that a point at its centre sees (ESTIMATOR.md section 11): rho[k] is the visible extent in the
+// k-th of `directions` equally spaced angles, (k + 0.5) 2 pi / directions (midpoint rule); an
+// extent of r or more is the whole radius.
+DiscMoments polar_moments(const double* rho, int directions, double r);
 
 }  // namespace pb::kernel

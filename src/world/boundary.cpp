@@ -2,6 +2,7 @@
 
 #include "util/counting_sort.h"
 #include "util/parallel.h"
+#include "world/boundary_geometry.h"
 #include "world/world.h"
 
 #include <algorithm>
@@ -14,81 +15,16 @@
 
 namespace pb {
 
-// Closed forms of the radial integrals for the quintic kernel (kernel.h, ESTIMATOR.md section 2):
-// kappa(t) = 7/(2 pi) (1 - 10 t^3 + 15 t^4 - 6 t^5), lap kappa(t) = 105/pi (-3 t + 8 t^2 - 5 t^3).
-// Each G is integral_0^a g(t) t dt; over the whole disc 2 pi G(1) gives 1, 5/24, 0 and 4.
-double kernel_mass_to(double a) {
-  const double a2 = a * a, a5 = a2 * a2 * a;
-  return 7.0 / (2.0 * kPiD) * (a2 / 2.0 + a5 * (-2.0 + a * (2.5 - a * 6.0 / 7.0)));
-}
-double kernel_second_to(double a) {
-  const double a2 = a * a, a4 = a2 * a2, a7 = a4 * a2 * a;
-  return 7.0 / (2.0 * kPiD) * (a4 / 4.0 + a7 * (-10.0 / 7.0 + a * (15.0 / 8.0 - a * 2.0 / 3.0)));
-}
-double laplacian_mass_to(double a) {
-  const double a3 = a * a * a;
-  return 105.0 / kPiD * a3 * (-1.0 + a * (2.0 - a));
-}
-double laplacian_second_to(double a) {
-  const double a5 = a * a * a * a * a;
-  return 105.0 / kPiD * a5 * (-3.0 / 5.0 + a * (4.0 / 3.0 - a * 5.0 / 7.0));
-}
-
 namespace {
 
-constexpr int kK = BoundaryIndex::kDirections;
-
-struct Directions {
-  double c[kK], s[kK];
-  Directions() {
-    for (int k = 0; k < kK; ++k) {
-      const double th = (double(k) + 0.5) * 2.0 * kPiD / kK;
-      c[k] = std::cos(th);
-      s[k] = std::sin(th);
-    }
-  }
-};
-const Directions& directions() {
-  static const Directions d;
-  return d;
-}
+using boundary_geometry::clip_to_sphere;
+using boundary_geometry::segment_distance2;
+using boundary_geometry::triangle_centre;
+using boundary_geometry::triangle_reach;
 
 // Two triangles belong to one surface for the gather when its same-side test accepts photons
 // on both: normals less than 90 degrees apart (pass_stages.cpp, gather_photons).
 bool compatible(const vec3& n, const vec3& m) { return glm::dot(n, m) > 0.0f; }
-
-double segment_distance2(const vec3& p, const vec3& a, const vec3& b) {
-  const dvec3 ab = dvec3(b) - dvec3(a), ap = dvec3(p) - dvec3(a);
-  const double len2 = glm::dot(ab, ab);
-  const double s = len2 > 0.0 ? std::clamp(glm::dot(ap, ab) / len2, 0.0, 1.0) : 0.0;
-  const dvec3 d = ap - s * ab;
-  return glm::dot(d, d);
-}
-
-vec3 triangle_centre(const vec3 v[3]) { return (v[0] + v[1] + v[2]) / 3.0f; }
-
-float triangle_reach(const vec3 v[3]) {
-  const vec3 c = triangle_centre(v);
-  return std::sqrt(std::max(
-      {glm::dot(v[0] - c, v[0] - c), glm::dot(v[1] - c, v[1] - c), glm::dot(v[2] - c, v[2] - c)}));
-}
-
-// Clips segment [a, b] to the ball (c, r); false when they do not meet.
-bool clip_to_sphere(vec3& a, vec3& b, const vec3& c, float r) {
-  const dvec3 d = dvec3(b) - dvec3(a), f = dvec3(a) - dvec3(c);
-  const double qa = glm::dot(d, d), qb = 2.0 * glm::dot(f, d), qc = glm::dot(f, f) - double(r) * r;
-  if (!(qa > 0.0)) return qc <= 0.0;
-  const double disc = qb * qb - 4.0 * qa * qc;
-  if (disc < 0.0) return false;
-  const double sq = std::sqrt(disc);
-  const double s0 = std::max(0.0, (-qb - sq) / (2.0 * qa)),
-               s1 = std::min(1.0, (-qb + sq) / (2.0 * qa));
-  if (s0 > s1) return false;
-  const dvec3 a0(a);
-  a = vec3(a0 + s0 * d);
-  b = vec3(a0 + s1 * d);
-  return true;
-}
 
 // An edge by its two corners, in a canonical order, as bit patterns (exact matching: shared
 // vertices of one mesh, and of meshes an exporter wrote from the same vertices).
@@ -133,11 +69,10 @@ bool covered(const World& world, const vec3& q, const vec3& n, float tol, uint32
   return found;
 }
 
-}  // namespace
-
-BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
+// Sorted by their corners, so that the triangles sharing an edge are neighbours (ESTIMATOR.md
+// section 11, "Geometry").
+std::vector<EdgeRecord> sorted_edges(const World& world) {
   const uint32_t n = world.triangle_count();
-  // 1. Edges: sorted by their corners, so that the triangles sharing one are neighbours.
   std::vector<EdgeRecord> edges(size_t(n) * 3);
   parallel_for(n, 4096, [&](size_t b, size_t e) {
     for (size_t t = b; t < e; ++t) {
@@ -156,18 +91,96 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
     if (key_less(y, x)) return false;
     return x.triangle < y.triangle || (x.triangle == y.triangle && x.edge < y.edge);
   });
+  return edges;
+}
 
-  // 2. Boundary edges: no neighbour on the edge whose photons the gather would accept. An edge
-  // nobody shares may still continue into a coplanar triangle that does not share its corners
-  // (a T-junction, or two meshes side by side): probed just outside the edge.
-  struct Pending {
-    uint32_t triangle;
-    Segment s;
-  };
-  std::vector<Pending> found;
+// Whether a coplanar triangle that does not share its corners continues triangle t across its
+// unshared edge (a, b), c being t's third corner (ESTIMATOR.md section 11, "Geometry"): probed
+// outward in t's plane, a thousandth of the edge's length away.
+bool continued_beyond(const World& world, uint32_t t, const vec3& a, const vec3& b, const vec3& c) {
+  const vec3& nt = world.face_normal(t);
+  const vec3 along = b - a;
+  vec3 out = glm::cross(along, nt);
+  if (glm::dot(out, c - a) > 0.0f) out = -out;
+  const float len = glm::length(along);
+  const float tol = 1e-3f * len + 1e-6f * max_component(glm::abs(a));
+  if (!(len > 0.0f)) return false;
+  out *= tol / glm::length(out);
+  return covered(world, a + 0.25f * along + out, nt, 2.0f * tol, t) &&
+         covered(world, a + 0.5f * along + out, nt, 2.0f * tol, t) &&
+         covered(world, a + 0.75f * along + out, nt, 2.0f * tol, t);
+}
+
+// Where triangle w (centre and size: its bounding sphere) crosses the plane of host triangle t
+// just above it (ESTIMATOR.md section 11, "Geometry"), at half the crossing tolerance, so that a
+// face resting on the plane counts; false where it does not cross, or the two share a corner.
+bool crossing(const World& world, const vec3 w[3], const vec3& centre, float size, uint32_t t,
+              float max_radius, vec3& from, vec3& to) {
+  vec3 v[3];
+  world.triangle(t, v[0], v[1], v[2]);
+  for (const vec3& x : v)
+    for (int k = 0; k < 3; ++k)
+      if (x == w[k]) return false;  // neighbours: their shared edge or corner is a crease
+  const vec3& nt = world.face_normal(t);
+  const float level =
+      0.5f * (1e-3f * size + 1e-6f * max_component(glm::abs(centre)));  // half the tolerance
+  float d[3];
+  for (int k = 0; k < 3; ++k) d[k] = glm::dot(w[k] - v[0], nt) - level;
+  if (!(std::min({d[0], d[1], d[2]}) < 0.0f && std::max({d[0], d[1], d[2]}) > 0.0f)) return false;
+  // The two points where w's edges cross the level.
+  vec3 cut[2];
+  int m = 0;
+  for (int k = 0; k < 3 && m < 2; ++k) {
+    const float d0 = d[k], d1 = d[(k + 1) % 3];
+    if ((d0 < 0.0f) == (d1 < 0.0f)) continue;
+    const float s = d0 / (d0 - d1);
+    cut[m++] = w[k] + s * (w[(k + 1) % 3] - w[k]);
+  }
+  // Only the part within reach of t's points matters (max_radius past t's bounding sphere):
+  // clipped there, so that a wall crossing a small triangle's plane far away adds nothing.
+  if (m != 2 || !clip_to_sphere(cut[0], cut[1], triangle_centre(v), triangle_reach(v) + max_radius))
+    return false;
+  from = cut[0];
+  to = cut[1];
+  return true;
+}
+
+bool debug_boundary() { return std::getenv("PB_BOUNDARY_DEBUG") != nullptr; }
+
+}  // namespace
+
+struct BoundaryIndex::Cut {
+  uint32_t triangle;  // the host triangle whose surface ends there
+  Segment s;
+};
+
+// ESTIMATOR.md section 11, "Geometry": the four phases below, then the lists' runs and centres.
+BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
+  const uint32_t n = world.triangle_count();
   // Points (and so discs) exist only on surfaces that are not mirrors or glass.
   std::vector<uint8_t> host(n);
   for (uint32_t t = 0; t < n; ++t) host[t] = world.may_hold_points(world.material_of(t));
+  std::vector<Cut> cuts = boundary_edges(world, host);
+  // Every segment is listed at least for its own triangle (list_near), so more segments than the
+  // pair budget there means the index is given up: counted by add_blockers, that is known before
+  // a tightly packed assembly (a CAD engine of interpenetrating parts: 4.8M cuts at a preview's
+  // radius, 0.9 GB) has listed them all.
+  const size_t budget = kPairBudget + 16 * size_t(n);
+  truncated_ = add_blockers(world, host, max_radius, budget, cuts);
+  std::vector<std::pair<uint32_t, uint32_t>> pairs =
+      list_near(world, cuts, host, max_radius, budget);
+  index_pairs(pairs, n);
+  bound_runs(n);
+  find_centres(world);
+}
+
+// Phases 1 and 2 (ESTIMATOR.md section 11, "Geometry"): edges with no neighbour on them whose
+// photons the gather would accept. An edge nobody shares may still continue into a coplanar
+// triangle that does not share its corners (a T-junction, or two meshes side by side).
+std::vector<BoundaryIndex::Cut> BoundaryIndex::boundary_edges(const World& world,
+                                                              const std::vector<uint8_t>& host) {
+  const std::vector<EdgeRecord> edges = sorted_edges(world);
+  std::vector<Cut> found;
   for (size_t i = 0; i < edges.size();) {
     size_t j = i + 1;
     while (j < edges.size() && !key_less(edges[i], edges[j])) ++j;
@@ -180,40 +193,26 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
         shared = edges[q].triangle != t && compatible(nt, world.face_normal(edges[q].triangle));
       vec3 v[3];
       world.triangle(t, v[0], v[1], v[2]);
-      const vec3 a = v[edges[k].edge], b = v[(edges[k].edge + 1) % 3];
-      if (!shared && j - i == 1) {
-        // Outward in the triangle's plane, a thousandth of the edge's length away.
-        const vec3 c = v[(edges[k].edge + 2) % 3];
-        const vec3 along = b - a;
-        vec3 out = glm::cross(along, nt);
-        if (glm::dot(out, c - a) > 0.0f) out = -out;
-        const float len = glm::length(along);
-        const float tol = 1e-3f * len + 1e-6f * max_component(glm::abs(a));
-        if (len > 0.0f) {
-          out *= tol / glm::length(out);
-          shared = covered(world, a + 0.25f * along + out, nt, 2.0f * tol, t) &&
-                   covered(world, a + 0.5f * along + out, nt, 2.0f * tol, t) &&
-                   covered(world, a + 0.75f * along + out, nt, 2.0f * tol, t);
-        }
-      }
+      const int e = edges[k].edge;
+      const vec3 a = v[e], b = v[(e + 1) % 3];
+      if (!shared && j - i == 1) shared = continued_beyond(world, t, a, b, v[(e + 2) % 3]);
       if (!shared) found.push_back({t, {a, b}});
     }
     i = j;
   }
-  std::vector<EdgeRecord>().swap(edges);
-  if (std::getenv("PB_BOUNDARY_DEBUG"))
-    std::fprintf(stderr, "boundary: %zu edge segments\n", found.size());
+  if (debug_boundary()) std::fprintf(stderr, "boundary: %zu edge segments\n", found.size());
+  return found;
+}
 
-  // 3. Blockers: a triangle u rising through the plane of a triangle t it shares no corner
-  // with (a block standing on a floor) ends t's reachable surface where it crosses, just above
-  // the plane (at half the crossing tolerance: a face resting on the plane counts).
-  // Every segment is listed at least for its own triangle (step 4), so more segments than the
-  // pair budget there means the index is given up: counted here, that is known before a
-  // tightly packed assembly (a CAD engine of interpenetrating parts: 4.8M cuts at a preview's
-  // radius, 0.9 GB) has listed them all.
-  const size_t budget = kPairBudget + 16 * size_t(n);
+// Phase 3 (ESTIMATOR.md section 11, "Geometry"): blockers, added to `found`. A triangle u rising
+// through the plane of a triangle t it shares no corner with (a block standing on a floor) ends
+// t's reachable surface where it crosses. True when the cuts pass `budget` (the index is given
+// up, and `found` emptied).
+bool BoundaryIndex::add_blockers(const World& world, const std::vector<uint8_t>& host,
+                                 float max_radius, size_t budget, std::vector<Cut>& found) {
+  const uint32_t n = world.triangle_count();
   std::atomic<size_t> cuts{found.size()};
-  std::vector<std::vector<Pending>> blockers(n);
+  std::vector<std::vector<Cut>> blockers(n);
   parallel_for(n, 256, [&](size_t b, size_t e) {
     for (size_t uu = b; uu < e; ++uu) {
       if (cuts.load(std::memory_order_relaxed) > budget) return;
@@ -221,7 +220,7 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
       vec3 w[3];
       world.triangle(u, w[0], w[1], w[2]);
       const vec3 centre = triangle_centre(w);
-      const float reach = triangle_reach(w), size = reach;
+      const float reach = triangle_reach(w);
       const uint32_t mesh_of_u = world.mesh_of(u);
       world.accel().query_sphere(centre, reach, [&](uint32_t mesh, uint32_t prim) {
         const uint32_t t = world.triangle_index(mesh, prim);
@@ -232,55 +231,38 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
         // accepts.
         if (mesh_of_u == world.mesh_of(t) || compatible(world.face_normal(t), world.face_normal(u)))
           return;
-        vec3 v[3];
-        world.triangle(t, v[0], v[1], v[2]);
-        for (const vec3& x : v)
-          for (const vec3& y : w)
-            if (x == y) return;  // neighbours: their shared edge or corner is a crease
-        const vec3& nt = world.face_normal(t);
-        const float level =
-            0.5f * (1e-3f * size + 1e-6f * max_component(glm::abs(centre)));  // half the tolerance
-        float d[3];
-        for (int k = 0; k < 3; ++k) d[k] = glm::dot(w[k] - v[0], nt) - level;
-        if (!(std::min({d[0], d[1], d[2]}) < 0.0f && std::max({d[0], d[1], d[2]}) > 0.0f)) return;
-        // The two points where u's edges cross the level.
-        vec3 cut[2];
-        int m = 0;
-        for (int k = 0; k < 3 && m < 2; ++k) {
-          const float d0 = d[k], d1 = d[(k + 1) % 3];
-          if ((d0 < 0.0f) == (d1 < 0.0f)) continue;
-          const float s = d0 / (d0 - d1);
-          cut[m++] = w[k] + s * (w[(k + 1) % 3] - w[k]);
-        }
-        // Only the part within reach of t's points matters (max_radius past t's bounding
-        // sphere): clipped there, so that a wall crossing a small triangle's plane far away
-        // adds nothing.
-        if (m == 2 &&
-            clip_to_sphere(cut[0], cut[1], triangle_centre(v), triangle_reach(v) + max_radius))
-          blockers[uu].push_back({t, {cut[0], cut[1]}});
+        Segment s;
+        if (crossing(world, w, centre, reach, t, max_radius, s.a, s.b))
+          blockers[uu].push_back({t, s});
       });
       cuts.fetch_add(blockers[uu].size(), std::memory_order_relaxed);
     }
   });
-  if (cuts.load() > budget) {
-    truncated_ = true;
+  const bool truncated = cuts.load() > budget;
+  if (truncated) {
     found.clear();
     blockers.clear();
   } else {
     found.reserve(cuts.load());  // exactly: no doubling of millions of cuts
   }
-  for (std::vector<Pending>& list : blockers) {
+  for (std::vector<Cut>& list : blockers) {
     found.insert(found.end(), list.begin(), list.end());
-    std::vector<Pending>().swap(list);
+    std::vector<Cut>().swap(list);
   }
-
-  if (std::getenv("PB_BOUNDARY_DEBUG"))
+  if (debug_boundary())
     std::fprintf(stderr, "boundary: %zu segments with blockers\n", found.size());
-  // 4. Each segment is listed for every triangle of its host's surface within max_radius.
-  // A radius far above the triangles' size over a mesh with many boundary segments (an unposed
-  // skinned character at a preview resolution) would list thousands of segments per triangle
-  // and take gigabytes: past kPairBudget pairs plus 16 per triangle the index is given up, every
-  // disc counts as whole, and the renderer warns (truncated()).
+  return truncated;
+}
+
+// Phase 4 (ESTIMATOR.md section 11, "Geometry"): each segment is listed for every triangle of its
+// host's surface within max_radius, as (triangle, segment) pairs. A radius far above the
+// triangles' size over a mesh with many boundary segments (an unposed skinned character at a
+// preview resolution) would list thousands of segments per triangle and take gigabytes: past
+// `budget` pairs the index is given up, every disc counts as whole, and the renderer warns
+// (truncated()).
+std::vector<std::pair<uint32_t, uint32_t>> BoundaryIndex::list_near(
+    const World& world, const std::vector<Cut>& found, const std::vector<uint8_t>& host,
+    float max_radius, size_t budget) {
   segments_.resize(found.size());
   // The pairs of each run of kChunk segments (sorted below, so the runs' order does not matter):
   // one vector per run, not per segment, whose headers alone took 0.3 GB for 4.8M segments.
@@ -293,7 +275,7 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
       if (listed.load(std::memory_order_relaxed) > budget) return;
       std::vector<std::pair<uint32_t, uint32_t>>& out = near[i / kChunk];
       const size_t before = out.size();
-      const Pending& f = found[i];
+      const Cut& f = found[i];
       Segment& s = segments_[i];
       s = f.s;
       s.mid = 0.5f * (s.a + s.b);
@@ -321,7 +303,12 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
     segments_.clear();
     segments_.shrink_to_fit();
   }
-  if (std::getenv("PB_BOUNDARY_DEBUG")) std::fprintf(stderr, "boundary: %zu pairs\n", pairs.size());
+  if (debug_boundary()) std::fprintf(stderr, "boundary: %zu pairs\n", pairs.size());
+  return pairs;
+}
+
+// The pairs as per-triangle lists, start_ and list_ (ESTIMATOR.md section 11, "Geometry").
+void BoundaryIndex::index_pairs(std::vector<std::pair<uint32_t, uint32_t>>& pairs, uint32_t n) {
   // Sorted by (triangle, segment): the runs were concatenated in segment order, so a stable
   // counting sort by triangle gives std::sort's order in O(pairs + triangles) (at a 4x4 preview,
   // whose radius spans the scene, scenes/unlit.gltf lists 10.7M pairs: 1 s of std::sort).
@@ -339,6 +326,11 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
   for (uint32_t t = 0; t < n; ++t) start_[t + 1] += start_[t];
   list_.resize(pairs.size());
   for (size_t k = 0; k < pairs.size(); ++k) list_[k] = pairs[k].second;
+}
+
+// The lists' runs of kGroup and kGroup^2 entries with their bounding spheres (ESTIMATOR.md
+// section 11: a far point skips a run with one test).
+void BoundaryIndex::bound_runs(uint32_t n) {
   for (int level = 0; level < 2; ++level) {
     const uint32_t span = level == 0 ? kGroup : kGroup * kGroup;  // list entries per run
     std::vector<uint32_t>& gs = group_start_[level];
@@ -367,8 +359,12 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
       }
     });
   }
-  // Centres of the triangles with segments, to tell which side of a segment through a point is
-  // its surface (moments()).
+}
+
+// Centres of the triangles with segments, to tell which side of a segment through a point is
+// its surface (moments(); ESTIMATOR.md section 11).
+void BoundaryIndex::find_centres(const World& world) {
+  const uint32_t n = world.triangle_count();
   centre_.assign(n, vec3(0.0f));
   parallel_for(n, 4096, [&](size_t b, size_t e) {
     for (size_t t = b; t < e; ++t) {
@@ -385,152 +381,6 @@ size_t BoundaryIndex::memory_bytes() const {
          (group_start_[0].capacity() + group_start_[1].capacity()) * sizeof(uint32_t) +
          (groups_[0].capacity() + groups_[1].capacity()) * sizeof(Group) +
          list_.capacity() * sizeof(uint32_t) + centre_.capacity() * sizeof(vec3);
-}
-
-template <class Skip, class Visit>
-void BoundaryIndex::scan(uint32_t triangle, Skip&& skip, Visit&& visit) const {
-  const uint32_t begin = start_[triangle], end = start_[triangle + 1];
-  for (uint32_t k = begin; k < end; ++k) {
-    const uint32_t at = k - begin;
-    if (at % (kGroup * kGroup) == 0 &&
-        skip(groups_[1][group_start_[1][triangle] + at / (kGroup * kGroup)])) {
-      k += kGroup * kGroup - 1;  // the run's last entry; the loop's ++k starts the next run
-      continue;
-    }
-    if (at % kGroup == 0 && skip(groups_[0][group_start_[0][triangle] + at / kGroup])) {
-      k += kGroup - 1;
-      continue;
-    }
-    if (!visit(segments_[list_[k]])) return;
-  }
-}
-
-float BoundaryIndex::clearance(uint32_t triangle, const vec3& p, float r) const {
-  if (start_.empty()) return r;
-  double nearest = double(r) * double(r);
-  // A run whose bounding sphere is farther than the nearest segment so far holds none nearer
-  // (with a 1e-4 relative margin for float rounding).
-  scan(
-      triangle,
-      [&](const Group& g) {
-        const float d = glm::length(p - g.centre) - g.radius;
-        return d > 0.0f && double(d) * double(d) > nearest * 1.0002;
-      },
-      [&](const Segment& s) {
-        nearest = std::min(nearest, segment_distance2(p, s.a, s.b));
-        return true;
-      });
-  if (nearest >= double(r) * double(r)) return r;
-  // Rounded down, so that a radius at or below it squares to less than every segment's
-  // distance squared, as moments() tests.
-  return std::nextafter(float(std::sqrt(nearest)), 0.0f) * (1.0f - 1e-6f);
-}
-
-DiscMoments BoundaryIndex::moments(uint32_t triangle, const vec3& p, const vec3& n, float r) const {
-  DiscMoments m;
-  if (start_.empty()) return m;
-  // The segments within r of p, projected into p's tangent plane.
-  constexpr int kMaxNear = 64;
-  double ax[kMaxNear], ay[kMaxNear], ex[kMaxNear], ey[kMaxNear];
-  int count = 0;
-  const double r2 = double(r) * double(r);
-  vec3 t1, t2;
-  orthonormal_basis(n, t1, t2);
-  // Beyond radius + r from a bounding sphere's centre nothing inside it is within r (a 1e-4
-  // relative margin covers float rounding; the exact distance decides the rest).
-  const auto far = [&](const vec3& c, float radius) {
-    const vec3 d = p - c;
-    const float reach = (radius + r) * 1.0001f;
-    return glm::dot(d, d) > reach * reach;
-  };
-  scan(
-      triangle, [&](const Group& g) { return far(g.centre, g.radius); },
-      [&](const Segment& s) {
-        if (far(s.mid, s.half) || segment_distance2(p, s.a, s.b) >= r2) return true;
-        const dvec3 a = dvec3(s.a) - dvec3(p), b = dvec3(s.b) - dvec3(p);
-        ax[count] = glm::dot(a, dvec3(t1));
-        ay[count] = glm::dot(a, dvec3(t2));
-        ex[count] = glm::dot(b, dvec3(t1)) - ax[count];
-        ey[count] = glm::dot(b, dvec3(t2)) - ay[count];
-        return ++count < kMaxNear;
-      });
-  if (count == 0) return m;
-  // A point on a segment (a pixel centre that sees exactly the line where two walls meet) sees
-  // nothing along it: every ray meets the segment at t = 0. Such a point belongs to the side of
-  // its own triangle, so the quadrature's centre moves 1e-3 r towards that triangle's centre;
-  // the moments change by O(1e-3) (the disc's part beyond the segment is then about half).
-  double min_d2 = INFINITY;
-  for (int i = 0; i < count; ++i) {
-    const double len2 = ex[i] * ex[i] + ey[i] * ey[i];
-    const double s =
-        len2 > 0.0 ? std::clamp(-(ax[i] * ex[i] + ay[i] * ey[i]) / len2, 0.0, 1.0) : 0.0;
-    const double qx = ax[i] + s * ex[i], qy = ay[i] + s * ey[i];
-    min_d2 = std::min(min_d2, qx * qx + qy * qy);
-  }
-  if (min_d2 < 1e-8 * r2) {
-    const dvec3 toward = dvec3(centre_[triangle]) - dvec3(p);
-    const double cx = glm::dot(toward, dvec3(t1)), cy = glm::dot(toward, dvec3(t2));
-    const double len = std::sqrt(cx * cx + cy * cy);
-    if (len > 0.0) {
-      const double shift = std::min(1e-3 * double(r), len);
-      for (int i = 0; i < count; ++i) {
-        ax[i] -= shift * cx / len;
-        ay[i] -= shift * cy / len;
-      }
-    }
-  }
-  // Polar quadrature about p: in each direction the visible extent rho (the first segment the
-  // ray meets, or r), and the radial integrals to rho / r (midpoint rule in the angle). A segment
-  // not through p subtends less than pi, so only the directions within the arc between its end
-  // points' angles (one more each side, for rounding) can meet it; the exact test decides.
-  const Directions& dir = directions();
-  double rho[kK];
-  std::fill(rho, rho + kK, double(r));
-  constexpr double step = 2.0 * kPiD / kK;
-  for (int i = 0; i < count; ++i) {
-    const double ta = std::atan2(ay[i], ax[i]), tb = std::atan2(ay[i] + ey[i], ax[i] + ex[i]);
-    double width = tb - ta;
-    if (width > kPiD) width -= 2.0 * kPiD;
-    if (width < -kPiD) width += 2.0 * kPiD;
-    const double from = width >= 0.0 ? ta : tb;
-    // Direction k sits at (k + 0.5) step.
-    const int k0 = int(std::floor(from / step - 0.5)) - 1;
-    const int k1 = int(std::ceil((from + std::fabs(width)) / step - 0.5)) + 1;
-    for (int kk = k0; kk <= k1 && kk < k0 + kK; ++kk) {
-      const int k = ((kk % kK) + kK) % kK;
-      const double dx = dir.c[k], dy = dir.s[k];
-      // p + t d = a + s e: t = cross(a, e) / cross(d, e), s = cross(a, d) / cross(d, e).
-      const double den = dx * ey[i] - dy * ex[i];
-      if (std::fabs(den) < 1e-300) continue;
-      const double t = (ax[i] * ey[i] - ay[i] * ex[i]) / den;
-      const double s = (ax[i] * dy - ay[i] * dx) / den;
-      if (t >= 0.0 && s >= 0.0 && s <= 1.0) rho[k] = std::min(rho[k], t);
-    }
-  }
-  static const double full[4] = {kernel_mass_to(1.0), kernel_second_to(1.0), laplacian_mass_to(1.0),
-                                 laplacian_second_to(1.0)};
-  double mass = 0.0, second = 0.0, lap = 0.0, lap2 = 0.0;
-  for (int k = 0; k < kK; ++k) {
-    if (rho[k] >= double(r)) {
-      mass += full[0];
-      second += full[1];
-      lap += full[2];
-      lap2 += full[3];
-      continue;
-    }
-    const double a = rho[k] / double(r);
-    mass += kernel_mass_to(a);
-    second += kernel_second_to(a);
-    lap += laplacian_mass_to(a);
-    lap2 += laplacian_second_to(a);
-  }
-  const double w = 2.0 * kPiD / kK;
-  m.mass = mass * w;
-  m.second = second * w;
-  m.lap_mass = lap * w;
-  m.lap_second = lap2 * w;
-  m.full = false;
-  return m;
 }
 
 }  // namespace pb

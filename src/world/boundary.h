@@ -18,12 +18,12 @@
 #include "util/math.h"
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 namespace pb {
 
 class World;
-
 
 class BoundaryIndex {
  public:
@@ -79,13 +79,19 @@ class BoundaryIndex {
   void scan(uint32_t triangle, Skip&& skip, Visit&& visit) const;
   std::vector<vec3> centre_;  // of triangles with segments (zero elsewhere)
   bool truncated_ = false;
-};
 
-// The radial integrals of moments(), in closed form (kernel.h's quintic), for 0 <= a <= 1:
-// G(a) = integral from 0 to a of g(t) t dt for g = kappa, |u|^2 kappa, lap kappa, |u|^2 lap kappa.
-double kernel_mass_to(double a);
-double kernel_second_to(double a);
-double laplacian_mass_to(double a);
-double laplacian_second_to(double a);
+  // The constructor's phases (boundary.cpp), in order. A segment found for a host triangle:
+  struct Cut;
+  static std::vector<Cut> boundary_edges(const World& world, const std::vector<uint8_t>& host);
+  static bool add_blockers(const World& world, const std::vector<uint8_t>& host, float max_radius,
+                           size_t budget, std::vector<Cut>& cuts);
+  std::vector<std::pair<uint32_t, uint32_t>> list_near(const World& world,
+                                                       const std::vector<Cut>& cuts,
+                                                       const std::vector<uint8_t>& host,
+                                                       float max_radius, size_t budget);
+  void index_pairs(std::vector<std::pair<uint32_t, uint32_t>>& pairs, uint32_t n);
+  void bound_runs(uint32_t n);
+  void find_centres(const World& world);
+};
 
 }  // namespace pb

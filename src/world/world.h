@@ -68,7 +68,7 @@ class World {
   std::string mirror_note() const;
   // The materials whose transmitting part is rough (roughness at or above the mirror's, or
   // textured) or that transmit diffusely, as "materials 'a', 'b'"; empty when none. PPM renders
-  // them as smooth glass and diffuse reflection (main.cpp).
+  // them as smooth glass and diffuse reflection (app/diagnostics.cpp).
   std::string followed_transmission_names() const;
 
   // Start point for a ray leaving surface point p (geometric normal ng, position error bound

@@ -75,11 +75,23 @@ DiscMoments brute_force(double px, double py, double r) {
 
 TEST(Boundary, RadialIntegralsOverTheWholeDisc) {
   // 2 pi G(1): mass 1, second moment 5/24, Laplacian mass 0, Laplacian second moment 4.
-  EXPECT_NEAR(2 * kPi * kernel_mass_to(1.0), 1.0, 1e-12);
-  EXPECT_NEAR(2 * kPi * kernel_second_to(1.0), 5.0 / 24.0, 1e-12);
-  EXPECT_NEAR(2 * kPi * laplacian_mass_to(1.0), 0.0, 1e-12);
-  EXPECT_NEAR(2 * kPi * laplacian_second_to(1.0), 4.0, 1e-12);
-  EXPECT_EQ(kernel_mass_to(0.0), 0.0);
+  EXPECT_NEAR(2 * kPi * kernel::mass_to(1.0), 1.0, 1e-12);
+  EXPECT_NEAR(2 * kPi * kernel::second_to(1.0), 5.0 / 24.0, 1e-12);
+  EXPECT_NEAR(2 * kPi * kernel::laplacian_mass_to(1.0), 0.0, 1e-12);
+  EXPECT_NEAR(2 * kPi * kernel::laplacian_second_to(1.0), 4.0, 1e-12);
+  EXPECT_EQ(kernel::mass_to(0.0), 0.0);
+}
+
+TEST(Boundary, PolarMomentsOfAnUnblockedDisc) {
+  // Every direction seeing the whole radius: the whole disc's moments (kernel.h).
+  double rho[BoundaryIndex::kDirections];
+  std::fill(rho, rho + BoundaryIndex::kDirections, 0.5);
+  const DiscMoments m = kernel::polar_moments(rho, BoundaryIndex::kDirections, 0.5);
+  EXPECT_NEAR(m.mass, 1.0, 1e-12);
+  EXPECT_NEAR(m.second, 5.0 / 24.0, 1e-12);
+  EXPECT_NEAR(m.lap_mass, 0.0, 1e-12);
+  EXPECT_NEAR(m.lap_second, 4.0, 1e-12);
+  EXPECT_FALSE(m.full);
 }
 
 class BoundaryMoments : public ::testing::Test {
