@@ -89,13 +89,17 @@ double normal_quantile(double p) {
 }
 
 // ESTIMATOR.md section 6b: the prior of the bias, by summed-area tables over the window.
-std::vector<dvec3> bias_prior(const std::vector<BiasEstimate>& pixels, int width, int height) {
+std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, int width,
+                              int height) {
   const SummedArea<dvec3> b2(width, height, [&](size_t p) {
-    return pixels[p].use ? pixels[p].bias * pixels[p].bias : dvec3(0.0);
+    const BiasEstimate e = pixel(p);
+    return e.use ? e.bias * e.bias : dvec3(0.0);
   });
-  const SummedArea<dvec3> v(
-      width, height, [&](size_t p) { return pixels[p].use ? pixels[p].variance : dvec3(0.0); });
-  const SummedArea<double> n(width, height, [&](size_t p) { return pixels[p].use ? 1.0 : 0.0; });
+  const SummedArea<dvec3> v(width, height, [&](size_t p) {
+    const BiasEstimate e = pixel(p);
+    return e.use ? e.variance : dvec3(0.0);
+  });
+  const SummedArea<double> n(width, height, [&](size_t p) { return pixel(p).use ? 1.0 : 0.0; });
   std::vector<dvec3> tau2(size_t(width) * size_t(height), dvec3(0.0));
   parallel_for(size_t(height), 16, [&](size_t y0, size_t y1) {
     for (size_t y = y0; y < y1; ++y)

@@ -4,6 +4,8 @@
 // absolute value, for a normal error: the folded normal distribution's moments.
 #pragma once
 
+#include <functional>
+
 #include "util/math.h"
 
 #include <vector>
@@ -41,7 +43,10 @@ struct BiasEstimate {
 // of the true bias around 0, estimated over the (2 kPriorWindow + 1)^2 window of the pixels in
 // use as mean(B^2) - mean(Var B) (the estimates' own noise taken out), never below 0.
 inline constexpr int kPriorWindow = 4;
-std::vector<dvec3> bias_prior(const std::vector<BiasEstimate>& pixels, int width, int height);
+// `pixel(p)` gives pixel p's estimate (read in place: a copy of the image's estimates would
+// raise a render's peak memory by 56 bytes per pixel).
+std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, int width,
+                              int height);
 // The shrinkage w = tau^2 / (tau^2 + Var B) of a bias estimate B under the prior tau^2 (section
 // 6b): the error's bias part is w B, and the posterior's variance w Var B; 1 when B is exact.
 double bias_shrinkage(double prior, double bias_variance);

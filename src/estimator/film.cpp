@@ -150,11 +150,12 @@ void check_model(const std::vector<PixelResult>& results, FilmSummary& sum) {
 
 // ESTIMATOR.md section 6b: the bias prior over the known pixels with a random state.
 std::vector<dvec3> prior_of(const std::vector<PixelResult>& results, int width, int height) {
-  std::vector<BiasEstimate> estimates(results.size());
-  for (size_t p = 0; p < results.size(); ++p)
-    estimates[p] = {results[p].bias, results[p].bias_variance,
-                    results[p].known && !results[p].exact};
-  return bias_prior(estimates, width, height);
+  return bias_prior(
+      [&](size_t p) {
+        const PixelResult& r = results[p];
+        return BiasEstimate{r.bias, r.bias_variance, r.known && !r.exact};
+      },
+      width, height);
 }
 
 // What the bounds add up to over the image (ESTIMATOR.md section 7).
