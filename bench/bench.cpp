@@ -115,15 +115,15 @@ double big_render_at(const std::string& path, uint64_t photons, bool goals) {
   grid.build(positions, radii);
   // What every pixel keeps from pass to pass: its state and query radius, and under SPPM its
   // pass counter, smallest kernel mass and glossy cap (the visible points themselves live in
-  // block-sized scratch). PPM keeps its measurement point instead.
+  // block-sized scratch). PPM keeps its visible point instead.
   const bool sppm = o.method == pb::Method::SPPM;
   const size_t kept = sizeof(pb::PointState) + sizeof(float) +
-                      (sppm ? sizeof(uint32_t) + 2 * sizeof(float) : sizeof(pb::MeasurementPoint));
+                      (sppm ? sizeof(uint32_t) + 2 * sizeof(float) : sizeof(pb::VisiblePoint));
   const double per_point = double(kept) + double(grid.memory_bytes()) / double(points);
   const double pass = (t.trace + t.grid + t.gather) / 2.0;
 
   std::printf("  states                   %zu (%.2f per pixel), %s; set-up %.2f s\n", points,
-              double(points) / (1920.0 * 1080.0), sppm ? "SPPM" : "PPM", t.eye);
+              double(points) / (1920.0 * 1080.0), sppm ? "SPPM" : "PPM", t.camera);
   std::printf(
       "  pass time                %.3f s (trace %.3f, grid %.3f = %.1f%%, gather+update "
       "%.3f)\n",
@@ -131,7 +131,7 @@ double big_render_at(const std::string& path, uint64_t photons, bool goals) {
   std::printf(
       "  bytes per pixel kept     %.1f = %zu PointState + 4 radius + %s + %.1f grid (%.1f MiB, %d "
       "levels)\n",
-      per_point, sizeof(pb::PointState), sppm ? "12 SPPM counters" : "MeasurementPoint",
+      per_point, sizeof(pb::PointState), sppm ? "12 SPPM counters" : "VisiblePoint",
       double(grid.memory_bytes()) / double(points), double(grid.memory_bytes()) / kMiB,
       grid.level_count());
   std::printf("  photon hits              %zu per pass (%zu bytes each)\n", hits.size(),
@@ -217,7 +217,7 @@ void probe_cost(const std::string& path, int passes) {
 }
 
 // SPPM's pass against PPM's at the renderer's defaults (512 wide, 100k photons per pass), each
-// through pb::Renderer::step: SPPM's pass includes its camera paths, PPM's eye pass is once.
+// through pb::Renderer::step: SPPM's pass includes its camera paths, PPM's camera pass is once.
 void method_pass_ratio(const std::string& path, int passes) {
   std::printf("\n== SPPM against PPM passes of %s at the default settings (pb::Renderer)\n",
               path.c_str());
@@ -310,7 +310,7 @@ void checkpoint_cost(const std::string& path, int passes) {
   const double off = loop_seconds(false, nullptr), on = loop_seconds(true, &with);
   std::filesystem::remove_all(dir);
 
-  std::printf("  measurement points       %zu; state %.1f MB (%zu B per point), EXR %.1f MB\n",
+  std::printf("  visible points       %zu; state %.1f MB (%zu B per point), EXR %.1f MB\n",
               r.states().size(), state_mb, sizeof(pb::PointState), exr_mb);
   std::printf("  pass                     %.4f s; with the snapshot copy %.4f s (+%.1f%%)\n", pass,
               snap_pass, 100.0 * (snap_pass / pass - 1.0));
@@ -382,7 +382,7 @@ void run_scene(const std::string& path, const Config& c, int all) {
        ">= 1.8x", scaling >= 1.8);
 
   const EyeSetup eye = eye_setup(world, c.width, c.height);
-  std::printf("  eye pass                 %.3f s at %dx%d (%zu points)\n", eye.seconds, c.width,
+  std::printf("  camera pass                 %.3f s at %dx%d (%zu points)\n", eye.seconds, c.width,
               c.height, eye.eye.points.size());
 
   const PassLoop L = pass_loop(world, eye, c.photons, c.loop_passes);
@@ -413,12 +413,12 @@ void run_scene(const std::string& path, const Config& c, int all) {
       "    radii shrunk 100x      grid %.3f s = %.1f%% of a %.3f s pass (%d levels; "
       "gather+update %.3f)\n",
       sgrid, 100.0 * sgrid / spass, spass, L.shrunk_grid_levels, L.shrunk_gather_on);
-  const double fixed = double(sizeof(pb::MeasurementPoint) + sizeof(pb::PointState) + 4);
+  const double fixed = double(sizeof(pb::VisiblePoint) + sizeof(pb::PointState) + 4);
   const double per_point = fixed + double(L.grid_bytes) / double(L.points);
   std::printf(
-      "  bytes per point          %.1f = %zu MeasurementPoint + %zu PointState + 4 radius + "
+      "  bytes per point          %.1f = %zu VisiblePoint + %zu PointState + 4 radius + "
       "%.1f grid (%.1f MiB)\n",
-      per_point, sizeof(pb::MeasurementPoint), sizeof(pb::PointState),
+      per_point, sizeof(pb::VisiblePoint), sizeof(pb::PointState),
       double(L.grid_bytes) / double(L.points), double(L.grid_bytes) / kMiB);
   std::printf("  peak RSS so far          %.0f MiB\n", peak_rss_bytes() / kMiB);
 

@@ -1,10 +1,10 @@
 // photonbound-bench: the measurements of issue 5 (bench/README.md), each a plain function over
 // the renderer's own stages (World, PhotonTracer, HashGrid, gather_photons, direct_light,
-// accumulate_pass, run_eye_pass), so every figure times exactly the code a render runs.
+// accumulate_pass, run_camera_pass), so every figure times exactly the code a render runs.
 #pragma once
 
 #include "estimator/estimator.h"
-#include "render/eye_pass.h"
+#include "render/camera_pass.h"
 #include "render/hash_grid.h"
 #include "render/photon_pass.h"
 #include "world/world.h"
@@ -49,9 +49,9 @@ struct PhotonRate {
 };
 PhotonRate photon_pass_rate(const pb::World& world, int threads, uint64_t photons, int passes);
 
-// Measurement points and the renderer's default initial radius (4 pixel footprints, median).
+// Visible points and the renderer's default initial radius (4 pixel footprints, median).
 struct EyeSetup {
-  pb::EyePassResult eye;
+  pb::CameraPassResult eye;
   double seconds = 0.0;
   double r0 = 0.0;
   double min_r2 = 0.0;

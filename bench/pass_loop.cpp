@@ -28,7 +28,7 @@ struct Phase {
 };
 
 // Renderer::step's stages 3-5 for PPM: pb::ppm_pass over fold blocks of 16384 points.
-void gather_on(const pb::World& world, const pb::EyePassResult& eye, const pb::HashGrid& grid,
+void gather_on(const pb::World& world, const pb::CameraPassResult& eye, const pb::HashGrid& grid,
                const std::vector<pb::PhotonHit>& hits, const pb::EstimatorParams& params,
                uint64_t pass, std::vector<pb::PointState>& states, std::vector<float>& radii,
                std::vector<pb::PassSums>& sums, std::vector<pb::OwnerValues>& owner) {
@@ -38,7 +38,7 @@ void gather_on(const pb::World& world, const pb::EyePassResult& eye, const pb::H
 
 // The same without error estimation: no Laplacian sum (gather_photons<false>) and the PPM update
 // without streaming moments (plain.h).
-void gather_off(const pb::World& world, const pb::EyePassResult& eye, const pb::HashGrid& grid,
+void gather_off(const pb::World& world, const pb::CameraPassResult& eye, const pb::HashGrid& grid,
                 const std::vector<pb::PhotonHit>& hits, const pb::EstimatorParams& params,
                 uint64_t pass, std::vector<PlainState>& states) {
   pb::parallel_for(states.size(), kGrain, [&](size_t begin, size_t end) {
@@ -58,9 +58,9 @@ EyeSetup eye_setup(const pb::World& world, int width, int height) {
   EyeSetup s;
   const pb::PinholeCamera camera(world.scene().cameras.at(0), width, height);
   const double t0 = now();
-  s.eye = pb::run_eye_pass(world, camera, pb::RenderOptions{}.max_depth);
+  s.eye = pb::run_camera_pass(world, camera, pb::RenderOptions{}.max_depth);
   s.seconds = seconds_since(t0);
-  const double r_min = pb::min_radius(world);
+  const double r_min = pb::radius_floor(world);
   s.min_r2 = r_min * r_min;
   s.r0 = pb::default_initial_radius(s.eye, world);
   return s;
@@ -68,7 +68,7 @@ EyeSetup eye_setup(const pb::World& world, int width, int height) {
 
 PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photons, int passes,
                    int build_reps) {
-  const pb::EyePassResult& eye = setup.eye;
+  const pb::CameraPassResult& eye = setup.eye;
   const size_t n = eye.points.size();
   pb::EstimatorParams params;
   params.alpha = kAlpha;

@@ -45,7 +45,7 @@ inline double glossy_plane(const vec3& p) {
 
 struct Case {
   std::string file;
-  std::function<double(const vec3&)> exact;  // pixel radiance at the pixel's measurement point
+  std::function<double(const vec3&)> exact;  // pixel radiance at the pixel's visible point
 };
 
 inline Case by_name(const std::string& name) {
@@ -57,7 +57,7 @@ inline Case by_name(const std::string& name) {
 }
 
 // Actual error and coverage of a render against the exact answer, over pixel-channels with a
-// known, nonzero bound (each of these scenes has one measurement point per pixel).
+// known, nonzero bound (each of these scenes has one visible point per pixel).
 struct Accuracy {
   double mean_abs_error = 0.0;  // mean over pixels and channels of |L - L_exact|
   double mean_bound = 0.0;      // mean over the same of the bound
@@ -66,13 +66,13 @@ struct Accuracy {
 };
 
 // The exact value of every pixel, what the render estimates: PPM, the exact answer at the
-// pixel's (first) measurement point (NaN without one: an exact pixel); SPPM, the average of the
+// pixel's (first) visible point (NaN without one: an exact pixel); SPPM, the average of the
 // exact answer over the pixel's area (ESTIMATOR.md section 10), from sub x sub stratified
 // camera rays (0 where a ray misses: black background).
 inline std::vector<double> pixel_truth(const Renderer& r,
                                        const std::function<double(const vec3&)>& exact,
                                        int sub = 16) {
-  const EyePassResult& eye = r.eye();
+  const CameraPassResult& eye = r.camera_pass();
   const size_t pixels = size_t(eye.width) * size_t(eye.height);
   std::vector<double> truth(pixels, std::nan(""));
   if (r.options().method == Method::PPM) {
@@ -102,7 +102,7 @@ inline std::vector<double> pixel_truth(const Renderer& r,
 // a box, every mesh being one box (1), farther (0), or the centre ray misses (-1). The radius is
 // the pixel's (SPPM) or its first point's (PPM) at the time of the call.
 inline std::vector<int> box_edge_band(const Renderer& r, double radii) {
-  const EyePassResult& eye = r.eye();
+  const CameraPassResult& eye = r.camera_pass();
   const size_t pixels = size_t(eye.width) * size_t(eye.height);
   std::vector<std::pair<dvec3, dvec3>> edges;  // the 12 edges of each mesh's bounds
   for (const Mesh& m : r.world().scene().meshes) {
@@ -154,7 +154,7 @@ inline Accuracy measure(const Renderer& r, const std::vector<double>& truth, dou
   double err_sum = 0.0, bound_sum = 0.0;
   size_t covered = 0;
   for (size_t p = 0; p < truth.size(); ++p) {
-    if (std::isnan(truth[p])) continue;  // no measurement point: exact pixel
+    if (std::isnan(truth[p])) continue;  // no visible point: exact pixel
     if (band && (*band)[p] != want) continue;
     for (int c = 0; c < 3; ++c) {
       const double bound = img.bound[3 * p + size_t(c)];

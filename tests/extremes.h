@@ -181,7 +181,7 @@ struct Render {
 // one thread count independent image, no progress.
 inline RenderOptions options(const std::string& scene_path, int size, uint64_t photons) {
   RenderOptions o;
-  o.method = Method::PPM;  // the suite inspects measurement points
+  o.method = Method::PPM;  // the suite inspects visible points
   o.scene = scene_path;
   o.output = "unused.exr";
   o.width = o.height = size;
@@ -209,7 +209,7 @@ inline FilmCounts check_film(const Renderer& r, const FilmSettings& s, FilmImage
   FilmImage img;
   const PixelLayout layout = r.layout();
   const FilmSummary summary = develop(layout, r.states(), r.passes(), s, &img);
-  const EyePassResult& eye = r.eye();
+  const CameraPassResult& eye = r.camera_pass();
   FilmCounts c;
   c.pixels = size_t(eye.width) * size_t(eye.height);
   for (size_t p = 0; p < c.pixels; ++p) {
@@ -274,10 +274,10 @@ inline void check_states(const Render& run) {
 inline double mean_bound(const Renderer& r, double confidence) {
   FilmSettings s = r.film_settings();
   s.confidence = confidence;
-  return develop(r.eye(), r.states(), r.passes(), s, nullptr).mean_bound;
+  return develop(r.camera_pass(), r.states(), r.passes(), s, nullptr).mean_bound;
 }
 
-// A synthetic measurement point on a uniform photon density, driven through the estimator of
+// A synthetic visible point on a uniform photon density, driven through the estimator of
 // estimator.h: in pass j, Poisson(mu0 R_j^2 / R_0^2) photons land in the point's disc, uniformly
 // (t = sqrt(u)), each of power pi / mu0 with f = 1 and M_e = 1, R_0 = 1. The exact radiance is 1
 // and the true bias 0 (ESTIMATOR.md section 3: E[w] = 1 over the disc). mu0 << 1 makes a point
@@ -476,7 +476,7 @@ inline void one_photon_per_pass(uint64_t passes) {
       "per point %llu..%llu; R from %.4g to %.4g..%.4g; unknown %zu; mean error %.4g, "
       "mean bound %.4g, coverage at 90%% %.3f\n",
       (unsigned long long)passes, (unsigned long long)arrivals, (unsigned long long)min_photons,
-      (unsigned long long)max_photons, run.r->eye().points.empty() ? 0.0 : double(report_radius),
+      (unsigned long long)max_photons, run.r->camera_pass().points.empty() ? 0.0 : double(report_radius),
       r_min, r_max, c.unknown, a.mean_abs_error, a.mean_bound, a.coverage);
   EXPECT_EQ(arrivals, shrinks);                           // the floor is never reached here
   const RenderReport report = test::run_to_stop(*run.r);  // passes already done: no new pass

@@ -5,7 +5,7 @@
 #pragma once
 
 #include "estimator/error_model.h"
-#include "render/eye_pass.h"
+#include "render/camera_pass.h"
 #include "estimator/film.h"
 #include "gltf/gltf_loader.h"
 #include "io/image_io.h"
@@ -47,21 +47,21 @@ inline Truth load(const std::string& path) {
 }
 
 // Per pixel, whether the surface its pixel-centre camera path ends on (the first non-delta hit,
-// through mirrors and glass as the eye pass follows them) lies within `radii` current search
+// through mirrors and glass as the camera pass follows them) lies within `radii` current search
 // radii of a place where that surface ends for the gather (BoundaryIndex: its border edges,
 // creases, and geometry rising through it): 1 within, 0 farther, -1 without such a point.
 // Distances reach at most the initial radius, the farthest the index looks.
 inline std::vector<int> edge_band(const Renderer& r, double radii) {
   const bool ppm = r.options().method == Method::PPM;
-  const EyePassResult eye_sppm =
-      ppm ? EyePassResult{} : run_eye_pass(r.world(), r.camera(), r.options().max_depth);
-  const EyePassResult& eye = ppm ? r.eye() : eye_sppm;
+  const CameraPassResult eye_sppm =
+      ppm ? CameraPassResult{} : run_camera_pass(r.world(), r.camera(), r.options().max_depth);
+  const CameraPassResult& eye = ppm ? r.camera_pass() : eye_sppm;
   const size_t pixels = size_t(eye.width) * size_t(eye.height);
   const double r0 = r.initial_radius();
   std::vector<int> band(pixels, -1);
   for (size_t p = 0; p < pixels; ++p) {
     if (eye.pixel_begin[p] == eye.pixel_begin[p + 1]) continue;
-    const MeasurementPoint& m = eye.points[eye.pixel_begin[p]];
+    const VisiblePoint& m = eye.points[eye.pixel_begin[p]];
     const size_t state = ppm ? size_t(eye.pixel_begin[p]) : p;
     const float reach = float(std::min(radii * std::sqrt(r.states()[state].r2), r0));
     band[p] = r.boundary().clearance(m.triangle, m.position, reach) < reach ? 1 : 0;

@@ -2,7 +2,7 @@
 
 #include "render/camera_paths.h"
 #include "render/renderer.h"
-#include "render/scene_setup.h"
+#include "render/scene_defaults.h"
 
 #include <iomanip>
 #include <sstream>

@@ -12,7 +12,7 @@
 #include "options/options.h"
 #include "render/camera_paths.h"
 #include "render/renderer.h"
-#include "render/scene_setup.h"
+#include "render/scene_defaults.h"
 #include "util/file_io.h"
 #include "util/parallel.h"
 
@@ -85,11 +85,11 @@ std::ofstream open_log(const std::string& path) {
 void check_reference_size(const pb::RenderOptions& options, const pb::ExrImage& reference,
                           const pb::Renderer& renderer) {
   if (!options.reference_path.empty() &&
-      (reference.width != renderer.eye().width || reference.height != renderer.eye().height))
+      (reference.width != renderer.camera_pass().width || reference.height != renderer.camera_pass().height))
     throw pb::ImageError(options.reference_path + " is " + std::to_string(reference.width) + "x" +
                          std::to_string(reference.height) + " but the render is " +
-                         std::to_string(renderer.eye().width) + "x" +
-                         std::to_string(renderer.eye().height));
+                         std::to_string(renderer.camera_pass().width) + "x" +
+                         std::to_string(renderer.camera_pass().height));
 }
 
 // The pass observers: the progress line, the log, and the checkpoints. A checkpoint is the image
@@ -123,7 +123,7 @@ std::string start_line(const pb::RenderOptions& options, const pb::Renderer& ren
   std::ostringstream line;
   line << "photonbound: "
        << (options.method == pb::Method::PPM
-               ? std::to_string(renderer.eye().points.size()) + " measurement points"
+               ? std::to_string(renderer.camera_pass().points.size()) + " visible points"
                : std::to_string(renderer.states().size()) + " pixels (SPPM)")
        << ", " << threads << (threads == 1 ? " thread" : " threads")
        << (resumed ? ", resumed" : "");

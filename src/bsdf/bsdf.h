@@ -78,7 +78,7 @@ struct BsdfParams {
 };
 
 // A material's scattering at one surface point, as World::surface() makes it: the one thing
-// the eye pass, the photon pass, next-event estimation and the gather ask about a surface.
+// the camera pass, the photon pass, next-event estimation and the gather ask about a surface.
 // Directions point away from the surface; either side may be hit (the normals are flipped to
 // the side of wo where that matters).
 //

@@ -42,7 +42,7 @@ void count_slopes(PixelResult& r, const PointEstimate& e) {
 }
 
 // L_pix = Le_seen + sum_k W_k L_k; B_pix = sum_k W_k B_k; Var_pix = sum_k W_k^2 S_k^2 / i
-// (ESTIMATOR.md section 5). W_k is already inside each point's estimate (MeasurementPoint::f).
+// (ESTIMATOR.md section 5). W_k is already inside each point's estimate (VisiblePoint::f).
 // SPPM (section 10): one state per pixel, whose samples carry the emission seen along the path.
 // The bound of a state's photon part while it has fewer than kMinPhotonsForBound photons.
 dvec3 sparse_term(const PixelLayout& layout, const PointState& s, size_t k, const vec3& f,
@@ -110,14 +110,14 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
 }
 
 // ESTIMATOR.md sections 5 and 10: every pixel's sums of its states.
-std::vector<PixelResult> combine_pixels(const PixelLayout& eye,
+std::vector<PixelResult> combine_pixels(const PixelLayout& layout,
                                         const std::vector<PointState>& states, uint64_t passes,
                                         const FilmSettings& s) {
-  const size_t pixels = size_t(eye.width) * size_t(eye.height);
+  const size_t pixels = size_t(layout.width) * size_t(layout.height);
   std::vector<PixelResult> results(pixels);
   parallel_for(pixels, 1024, [&](size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p)
-      results[p] = combine(eye, states, p, passes, s.photons_per_pass, s.confidence);
+      results[p] = combine(layout, states, p, passes, s.photons_per_pass, s.confidence);
   });
   return results;
 }
@@ -327,15 +327,15 @@ const std::vector<float>& FilmImage::plane(Channel id) const {
 }
 
 // ESTIMATOR.md sections 5-7: combine, check the model, take the prior, bound and predict.
-FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& states, uint64_t passes,
+FilmSummary develop(const PixelLayout& layout, const std::vector<PointState>& states, uint64_t passes,
                     const FilmSettings& s, FilmImage* image) {
-  const std::vector<PixelResult> results = combine_pixels(eye, states, passes, s);
+  const std::vector<PixelResult> results = combine_pixels(layout, states, passes, s);
   const size_t pixels = results.size();
   FilmSummary sum;
   sum.relative_floor = relative_floor(results);
-  if (image) prepare_image(*image, eye.width, eye.height);
+  if (image) prepare_image(*image, layout.width, layout.height);
   check_model(results, sum);
-  const std::vector<dvec3> tau2 = prior_of(results, eye.width, eye.height);
+  const std::vector<dvec3> tau2 = prior_of(results, layout.width, layout.height);
   const BoundRule rule(passes, s, sum.relative_floor);
   Tally tally(pixels);
   for (size_t p = 0; p < pixels; ++p)
@@ -343,7 +343,7 @@ FilmSummary develop(const PixelLayout& eye, const std::vector<PointState>& state
   summarise(tally, s, sum);
   if (sum.unknown_pixels == 0 && pixels > 0) {
     const ErrorPrediction e = predict_mean_error(
-        tally.model, eye.width, eye.height, mean_r2(states), eye.footprint, rule.nu, s.confidence);
+        tally.model, layout.width, layout.height, mean_r2(states), layout.footprint, rule.nu, s.confidence);
     sum.correlated_pixels = e.correlated_pixels;
     sum.predicted_error = e.mean;
     sum.predicted_error_upper = e.upper;

@@ -68,7 +68,7 @@ struct FilmSettings {
   double stop_fraction = 0.9;  // the share of pixels pixel_quantile_bound is taken at
 };
 
-// Each PPM point's W_k f (render/eye_pass.h, MeasurementPoint::f) read in place from the
+// Each PPM point's W_k f (render/camera_pass.h, VisiblePoint::f) read in place from the
 // points' array by its stride, so that this layer need not know the point's layout.
 struct StridedColours {
   const unsigned char* first = nullptr;
@@ -81,7 +81,7 @@ struct StridedColours {
   }
 };
 
-// Which states make up each pixel (ESTIMATOR.md sections 5 and 10): PPM's measurement points,
+// Which states make up each pixel (ESTIMATOR.md sections 5 and 10): PPM's visible points,
 // grouped by pixel, plus the emission its camera rays see exactly; or SPPM's one state per
 // pixel (pixel_begin and emission empty) with the passes in which the pixel had a visible point.
 struct PixelLayout {

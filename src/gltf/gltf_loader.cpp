@@ -354,7 +354,7 @@ void Loader::finish() {
                                          (skipped_points_lines_ == 1 ? " is" : "s are") +
                                          " points or lines, which have no area)"
                                    : std::string()));
-  // No camera and no light are not errors: scene_setup.h frames the bounds and lights the scene
+  // No camera and no light are not errors: scene_defaults.h frames the bounds and lights the scene
   // with the default sky, as glTF viewers do.
   for (const Mesh& m : scene_.meshes)
     for (uint32_t i : m.indices) scene_.bounds.extend(m.positions[i]);

@@ -13,7 +13,7 @@ namespace pb {
 // Reads a .gltf (embedded or external buffers) or .glb file. Throws SceneError for anything
 // the renderer cannot use: missing or malformed file, out-of-range accessors or indices,
 // non-finite or absurd coordinates, unsupported primitive modes or light types, lights whose
-// power overflows float. No camera and no light are allowed (scene_setup.h and view.h add the
+// power overflows float. No camera and no light are allowed (scene_defaults.h and camera_choice.h add the
 // default view and sky); what is ignored (skins, morph targets, animations, unknown extensions)
 // is in Scene::warnings. Degenerate triangles are skipped and counted.
 Scene load_gltf(const std::string& path);

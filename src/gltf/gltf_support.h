@@ -4,7 +4,7 @@
 #pragma once
 
 #include "util/math.h"
-#include "util/text.h"
+#include "util/message_text.h"
 
 #include <algorithm>
 #include <cstdint>

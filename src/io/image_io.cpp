@@ -11,7 +11,7 @@
 #include <cstring>
 
 #include "util/file_io.h"
-#include "util/text.h"
+#include "util/message_text.h"
 
 namespace pb {
 

@@ -56,11 +56,11 @@ struct RenderOptions {
   double follow_roughness = kDefaultFollowRoughness;
   std::optional<int> width, height;
   std::string camera;  // empty = first perspective camera
-  // The view (view.h): each replaces the camera's own, or the default view's when the file has
+  // The view (camera_choice.h): each replaces the camera's own, or the default view's when the file has
   // no camera.
   std::optional<std::array<double, 3>> look_from, look_at, up;
   std::optional<double> fov;  // vertical field of view, degrees
-  // The environment light (scene_setup.h): "" for none, or the default sky when the scene has
+  // The environment light (scene_defaults.h): "" for none, or the default sky when the scene has
   // no light; a colour "V" or "R,G,B"; or an .exr / .hdr equirectangular map.
   std::string environment;
   double environment_scale = 1.0;

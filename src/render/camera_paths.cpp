@@ -33,7 +33,7 @@ struct CameraPath {
   vec3 dir{0.0f};
   vec3 weight{1.0f};
   dvec3 emission{0.0};     // light the path saw (and its vertices' next-event samples)
-  MeasurementPoint point;  // the visible point; f = 0: none
+  VisiblePoint point;  // the visible point; f = 0: none
   DiscMoments disc;
   // The ray leaves a followed GGX lobe: the light it finds directly (an emitter, the
   // environment) is that vertex's direct light, which its next-event sample has counted.
@@ -86,7 +86,7 @@ LobeChoice follow_lobe(CameraPath& path, const CameraPathInputs& in, const Surfa
                  vec3& w, Bsdf& bsdf) {
   const bool glass_direct = s.bsdf.glass_lit_directly();
   const bool sharp_glass = s.bsdf.has_rough_glass() && !glass_direct;
-  const GlossyPoint whole{0, wo, sharp_glass ? s.bsdf.without_glass() : s.bsdf};
+  const PointBsdf whole{0, wo, sharp_glass ? s.bsdf.without_glass() : s.bsdf};
   path.point.f = w;
   if (in.next_event) {
     path.emission += direct_light(in.world, path.point, &whole, path.rng);
@@ -96,9 +96,9 @@ LobeChoice follow_lobe(CameraPath& path, const CameraPathInputs& in, const Surfa
   }
   const float p_lobe = s.bsdf.lobe_probability(wo, in.follow_roughness);
   if (p_lobe >= 1.0f || (p_lobe > 0.0f && path.rng.next_float() < p_lobe)) {
-    const GlossyPoint lobe{0, wo, s.bsdf.lobe_part(in.follow_roughness)};
+    const PointBsdf lobe{0, wo, s.bsdf.lobe_part(in.follow_roughness)};
     path.weight = w / p_lobe;
-    path.point = MeasurementPoint{};  // no visible point here
+    path.point = VisiblePoint{};  // no visible point here
     // At or beyond --max-depth the followed path goes on by Russian roulette, as a pass-over
     // does: the lobe's indirect light keeps its mean.
     if (!beyond_limit_survives(path, in, path.weight)) return LobeChoice::PathEnded;
@@ -128,11 +128,11 @@ LobeChoice follow_lobe(CameraPath& path, const CameraPathInputs& in, const Surfa
 Step pass_over(CameraPath& path, const CameraPathInputs& in, const Surface& s, const vec3& wo,
                vec3 w, const Bsdf& bsdf, bool direct_counted) {
   if (in.next_event && !direct_counted) {
-    const GlossyPoint here{0, wo, bsdf};
+    const PointBsdf here{0, wo, bsdf};
     path.point.f = w;
     path.emission += direct_light(in.world, path.point, &here, path.rng);
   }
-  path.point = MeasurementPoint{};
+  path.point = VisiblePoint{};
   path.disc = DiscMoments{};
   if (!beyond_limit_survives(path, in, w)) return Step::End;
   BsdfSample b;
@@ -147,10 +147,10 @@ Step pass_over(CameraPath& path, const CameraPathInputs& in, const Surface& s, c
 // The path stops at the non-delta part of surface s (chosen with 1 - p_delta): a followed lobe,
 // a pass-over, or the visible point, whose Bsdf goes to `glossy` when it is not Lambertian.
 Step stop_at(CameraPath& path, const CameraPathInputs& in, const Hit& hit, const Surface& s,
-             const vec3& wo, float p_delta, float radius, std::optional<GlossyPoint>& glossy) {
+             const vec3& wo, float p_delta, float radius, std::optional<PointBsdf>& glossy) {
   const bool front = glm::dot(wo, s.ng) > 0.0f;
   vec3 w = p_delta > 0.0f ? path.weight / (1.0f - p_delta) : path.weight;
-  MeasurementPoint& point = path.point;
+  VisiblePoint& point = path.point;
   point.position = in.world.spawn(s, wo);  // lifted off the surface: shadow rays start here
   point.normal = front ? s.ng : -s.ng;
   point.shading = front ? s.ns : -s.ns;
@@ -181,14 +181,14 @@ Step stop_at(CameraPath& path, const CameraPathInputs& in, const Hit& hit, const
     if (path.disc.mass < kValidKernelMass)
       return pass_over(path, in, s, wo, w, bsdf, direct_counted);
   }
-  if (!lambertian) glossy = GlossyPoint{0, wo, bsdf};
+  if (!lambertian) glossy = PointBsdf{0, wo, bsdf};
   return Step::End;
 }
 
 // A vertex on surface `hit`: its emission, then stop there (the non-delta part) or follow a
 // delta branch, with 1 - p_delta and p_delta.
 Step at_vertex(CameraPath& path, const CameraPathInputs& in, const Hit& hit, float radius,
-               std::optional<GlossyPoint>& glossy) {
+               std::optional<PointBsdf>& glossy) {
   const Surface s = in.world.surface(hit);
   const vec3 wo = -path.dir;
   path.weight *= in.world.transmittance(s, wo, path.origin);  // inside an absorbing volume
@@ -219,12 +219,12 @@ Step at_vertex(CameraPath& path, const CameraPathInputs& in, const Hit& hit, flo
 }  // namespace
 
 size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
-                            std::span<MeasurementPoint> points, std::span<GlossyPoint> glossy,
+                            std::span<VisiblePoint> points, std::span<PointBsdf> glossy,
                             std::span<OwnerValues> out) {
   size_t glossy_count = 0;
   for (size_t k = 0; k < points.size(); ++k) {
     CameraPath path(in, first + k);
-    std::optional<GlossyPoint> g;
+    std::optional<PointBsdf> g;
     for (;; ++path.depth) {
       Hit hit;
       const bool found =

@@ -21,7 +21,7 @@
 #include "world/boundary.h"
 #include "scene/camera.h"
 #include "estimator/estimator.h"
-#include "render/eye_pass.h"
+#include "render/camera_pass.h"
 #include "world/world.h"
 
 #include <cstdint>
@@ -48,12 +48,12 @@ struct CameraPathInputs {
 // visible point this pass, its f the path throughput times the BRDF (f = 0 when the path ends
 // without one: background, an emitter or a black surface, or the depth limit), and out[k] the
 // pixel's owner values of the pass, whose direct part holds the emission the path saw on its way. A visible point
-// on a non-Lambertian surface keeps the throughput alone in f, and its GlossyPoint (point = k)
+// on a non-Lambertian surface keeps the throughput alone in f, and its PointBsdf (point = k)
 // goes to the front of `glossy` (room for points.size()), in pixel order. radii[k] is pixel
 // first + k's search radius this pass; out[k].disc its visible point's disc moments. Returns
 // the count of glossy points.
 size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
-                            std::span<MeasurementPoint> points, std::span<GlossyPoint> glossy,
+                            std::span<VisiblePoint> points, std::span<PointBsdf> glossy,
                             std::span<OwnerValues> out);
 
 // The share of the camera's pixel-centre rays (on a grid of at most 128 x 128 of them) whose

@@ -28,7 +28,7 @@ namespace {
 // gathers tens), so the occupied buckets are a small fraction and collisions are rare. Against
 // a table of 2n buckets, the gather per pass (`photonbound-bench --profile pass`, 512x512, 1M
 // photons) differed by less than the run-to-run noise (+-5%), and 2n cost 6 more bytes per
-// measurement point at 1080p (issue 5's memory budget).
+// visible point at 1080p (issue 5's memory budget).
 int table_bits(size_t n) {
   int b = 1;
   while ((size_t(1) << b) < n) ++b;

@@ -1,5 +1,5 @@
 // Multi-level spatial hash over photon positions, for fixed-radius gathers whose radii differ
-// per measurement point and shrink over passes.
+// per visible point and shrink over passes.
 //
 // Why this shape:
 // - Counting-sort hash grid after SmallVCM (Davidovic, "HashGrid" in SmallVCM's hashgrid.hxx):

@@ -1,12 +1,12 @@
 // The interface both methods implement (PPM: ppm.h, SPPM: sppm.h), so that the renderer runs a
 // pass, saves and restores a render and develops its film without asking which method it runs.
 // The renderer owns what both share (the states, their radii, the photons and their grid); a
-// method owns its measurement points and the side state of its pixels.
+// method owns its visible points and the side state of its pixels.
 #pragma once
 
 #include "estimator/estimator.h"
 #include "estimator/film.h"
-#include "render/eye_pass.h"
+#include "render/camera_pass.h"
 #include "render/pass_stages.h"
 #include "world/boundary.h"
 
@@ -35,7 +35,7 @@ struct WorkCounters {
 struct RenderState {
   WorkCounters work;
   double initial_radius = 0.0;
-  std::vector<PointState> states;  // PPM: one per measurement point; SPPM: one per pixel
+  std::vector<PointState> states;  // PPM: one per visible point; SPPM: one per pixel
   std::vector<uint32_t> visible;   // SPPM: passes with a visible point, per pixel
   std::vector<float> min_mass;     // SPPM: smallest kernel mass of a visible point, per pixel
   double max_photon_power = 0.0;   // largest channel of a photon's power seen (section 12)
@@ -46,9 +46,9 @@ class PhotonMethod {
  public:
   virtual ~PhotonMethod() = default;
 
-  // PPM: the measurement points. SPPM: the image size and the median footprint only.
-  virtual const EyePassResult& eye() const = 0;
-  // The states the method keeps: one per measurement point (PPM) or pixel (SPPM).
+  // PPM: the visible points. SPPM: the image size and the median footprint only.
+  virtual const CameraPassResult& camera_pass() const = 0;
+  // The states the method keeps: one per visible point (PPM) or pixel (SPPM).
   size_t state_count() const { return state_count_; }
   // Once the initial radius is known: what the method precomputes against the boundary index.
   virtual void prepare(const BoundaryIndex& boundary, double initial_radius) = 0;

@@ -2,7 +2,7 @@
 
 namespace pb {
 
-dvec3 direct_light(const World& world, const MeasurementPoint& point, const GlossyPoint* glossy,
+dvec3 direct_light(const World& world, const VisiblePoint& point, const PointBsdf* glossy,
                    Rng& rng) {
   DirectSample s;
   if (!world.lights().sample_direct(point.position, point.shading, rng, s)) return dvec3(0.0);

@@ -3,7 +3,7 @@
 // (pass_stages.h) alike.
 #pragma once
 
-#include "render/eye_pass.h"
+#include "render/camera_pass.h"
 #include "util/rng.h"
 #include "world/world.h"
 
@@ -11,9 +11,9 @@ namespace pb {
 
 // One light sample with a shadow ray: D_j = f Li cos / pdf (ESTIMATOR.md section 4); with
 // `glossy`, f = point.f x f(wo, wi_light).
-dvec3 direct_light(const World& world, const MeasurementPoint& point, const GlossyPoint* glossy,
+dvec3 direct_light(const World& world, const VisiblePoint& point, const PointBsdf* glossy,
                    Rng& rng);
-inline dvec3 direct_light(const World& world, const MeasurementPoint& point, Rng& rng) {
+inline dvec3 direct_light(const World& world, const VisiblePoint& point, Rng& rng) {
   return direct_light(world, point, nullptr, rng);
 }
 // One light sample through the surface at s (Bsdf::eval_transmission: diffuse transmission, and

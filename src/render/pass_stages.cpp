@@ -54,7 +54,7 @@ namespace {
 // its power (Lambertian points, whose constant f is multiplied once below) or its power times
 // f(wo, wi) (glossy points, whose f holds the path weight alone).
 template <bool kLaplacian, class PhotonFlux>
-void gather_kernel(const MeasurementPoint& point, double r2, const HashGrid& grid,
+void gather_kernel(const VisiblePoint& point, double r2, const HashGrid& grid,
                    const std::vector<PhotonHit>& hits, PhotonFlux&& photon_flux, PassSums& out) {
   const float radius = search_radius(r2);
   const double inv_r2 = 1.0 / r2;
@@ -88,72 +88,72 @@ void gather_kernel(const MeasurementPoint& point, double r2, const HashGrid& gri
   out.count += double(count);
 }
 
-// Walks a GlossyTable alongside the points of its span, in order.
-class GlossyCursor {
+// Walks a PointBsdfTable alongside the points of its span, in order.
+class PointBsdfCursor {
  public:
-  GlossyCursor(const GlossyTable& t, size_t count) : t_(t), end_(t.base + count) {
+  PointBsdfCursor(const PointBsdfTable& t, size_t count) : t_(t), end_(t.base + count) {
     it_ = std::lower_bound(t.entries.begin(), t.entries.end(), t.base,
-                           [](const GlossyPoint& g, size_t i) { return g.point < i; });
+                           [](const PointBsdf& g, size_t i) { return g.point < i; });
   }
   // The entry of point k of the span, or null when that point is Lambertian (k ascending).
-  const GlossyPoint* at(size_t k) {
+  const PointBsdf* at(size_t k) {
     const size_t i = t_.base + k;
     while (it_ != t_.entries.end() && it_->point < i) ++it_;
     return it_ != t_.entries.end() && it_->point == i && i < end_ ? &*it_ : nullptr;
   }
 
  private:
-  GlossyTable t_;
+  PointBsdfTable t_;
   size_t end_;
-  std::span<const GlossyPoint>::iterator it_;
+  std::span<const PointBsdf>::iterator it_;
 };
 
 }  // namespace
 
 template <bool kLaplacian>
-void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& grid,
+void gather_photons(const VisiblePoint& point, double r2, const HashGrid& grid,
                     const std::vector<PhotonHit>& hits, PassSums& out) {
   gather_kernel<kLaplacian>(
       point, r2, grid, hits, [](const PhotonHit& h) { return dvec3(h.flux); }, out);
 }
 
 template <bool kLaplacian>
-void gather_photons(const MeasurementPoint& point, const GlossyPoint& glossy, double r2,
+void gather_photons(const VisiblePoint& point, const PointBsdf& glossy, double r2,
                     const HashGrid& grid, const std::vector<PhotonHit>& hits, PassSums& out) {
   gather_kernel<kLaplacian>(
       point, r2, grid, hits,
       [&](const PhotonHit& h) { return dvec3(h.flux * glossy.bsdf.eval(glossy.wo, h.wi)); }, out);
 }
 
-template void gather_photons<true>(const MeasurementPoint&, double, const HashGrid&,
+template void gather_photons<true>(const VisiblePoint&, double, const HashGrid&,
                                    const std::vector<PhotonHit>&, PassSums&);
-template void gather_photons<false>(const MeasurementPoint&, double, const HashGrid&,
+template void gather_photons<false>(const VisiblePoint&, double, const HashGrid&,
                                     const std::vector<PhotonHit>&, PassSums&);
-template void gather_photons<true>(const MeasurementPoint&, const GlossyPoint&, double,
+template void gather_photons<true>(const VisiblePoint&, const PointBsdf&, double,
                                    const HashGrid&, const std::vector<PhotonHit>&, PassSums&);
-template void gather_photons<false>(const MeasurementPoint&, const GlossyPoint&, double,
+template void gather_photons<false>(const VisiblePoint&, const PointBsdf&, double,
                                     const HashGrid&, const std::vector<PhotonHit>&, PassSums&);
 
-void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
-                 const HashGrid& grid, const std::vector<PhotonHit>& hits, GlossyTable glossy,
+void gather_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
+                 const HashGrid& grid, const std::vector<PhotonHit>& hits, PointBsdfTable glossy,
                  std::span<PassSums> out) {
   std::fill(out.begin(), out.end(), PassSums{});
-  GlossyCursor cursor(glossy, points.size());
+  PointBsdfCursor cursor(glossy, points.size());
   for (size_t k = 0; k < points.size(); ++k) {
-    const MeasurementPoint& p = points[k];
+    const VisiblePoint& p = points[k];
     if (!(max_component(p.f) > 0.0f)) continue;  // SPPM: a pixel without a visible point
-    if (const GlossyPoint* g = cursor.at(k))
+    if (const PointBsdf* g = cursor.at(k))
       gather_photons(p, *g, states[k].r2, grid, hits, out[k]);
     else
       gather_photons(p, states[k].r2, grid, hits, out[k]);
   }
 }
 
-void disc_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
+void disc_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
                const BoundaryIndex* boundary, std::span<const float> clearance,
                std::span<OwnerValues> out) {
   for (size_t k = 0; k < points.size(); ++k) {
-    const MeasurementPoint& p = points[k];
+    const VisiblePoint& p = points[k];
     if (!(max_component(p.f) > 0.0f)) continue;
     const float r = search_radius(states[k].r2);
     if (boundary && (clearance.empty() || r > clearance[k]))
@@ -161,13 +161,13 @@ void disc_pass(std::span<const MeasurementPoint> points, std::span<const PointSt
   }
 }
 
-void next_event_pass(const World& world, std::span<const MeasurementPoint> points,
-                     GlossyTable glossy, uint64_t seed, uint64_t pass, size_t first,
+void next_event_pass(const World& world, std::span<const VisiblePoint> points,
+                     PointBsdfTable glossy, uint64_t seed, uint64_t pass, size_t first,
                      std::span<OwnerValues> out) {
-  GlossyCursor cursor(glossy, points.size());
+  PointBsdfCursor cursor(glossy, points.size());
   for (size_t k = 0; k < points.size(); ++k) {
     if (!(max_component(points[k].f) > 0.0f)) continue;
-    const GlossyPoint* g = cursor.at(k);
+    const PointBsdf* g = cursor.at(k);
     if (g && g->bsdf.is_base_part()) continue;  // its camera path counted its direct light
     Rng rng(seed, pass, first + k, Stream::DirectLight);
     out[k].direct += direct_light(world, points[k], g, rng);

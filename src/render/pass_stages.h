@@ -12,7 +12,7 @@
 
 #include "world/boundary.h"
 #include "estimator/estimator.h"
-#include "render/eye_pass.h"
+#include "render/camera_pass.h"
 #include "render/hash_grid.h"
 #include "render/next_event.h"
 #include "render/photon_pass.h"
@@ -41,18 +41,18 @@ void build_photon_grid(const std::vector<PhotonHit>& hits, std::span<const float
 // variant) phi_lap_r2 is left alone. Lambertian points: the photon powers are summed and f
 // multiplied once.
 template <bool kLaplacian = true>
-void gather_photons(const MeasurementPoint& point, double r2, const HashGrid& grid,
+void gather_photons(const VisiblePoint& point, double r2, const HashGrid& grid,
                     const std::vector<PhotonHit>& hits, PassSums& out);
 // The same for a point on a non-Lambertian surface: each photon's power times f(wo, wi_photon),
 // the path weight point.f once.
 template <bool kLaplacian = true>
-void gather_photons(const MeasurementPoint& point, const GlossyPoint& glossy, double r2,
+void gather_photons(const VisiblePoint& point, const PointBsdf& glossy, double r2,
                     const HashGrid& grid, const std::vector<PhotonHit>& hits, PassSums& out);
 
-// The glossy side table of a span of points: entries sorted by GlossyPoint::point, which counts
+// The glossy side table of a span of points: entries sorted by PointBsdf::point, which counts
 // from the span's first point at `base` (entries outside the span are skipped).
-struct GlossyTable {
-  std::span<const GlossyPoint> entries;
+struct PointBsdfTable {
+  std::span<const PointBsdf> entries;
   size_t base = 0;
 };
 
@@ -60,23 +60,23 @@ struct GlossyTable {
 // phi_half, count) at the pass's radius states[k].r2. A point with f = 0 (SPPM: no visible point
 // this pass) gathers nothing and so does not shrink its radius. Points in `glossy` evaluate
 // their Bsdf per photon.
-void gather_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
-                 const HashGrid& grid, const std::vector<PhotonHit>& hits, GlossyTable glossy,
+void gather_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
+                 const HashGrid& grid, const std::vector<PhotonHit>& hits, PointBsdfTable glossy,
                  std::span<PassSums> out);
 
 // Stage 4, PPM: out[k].disc = the kernel's moments over the reachable part of points[k]'s disc
 // at the pass's radius (ESTIMATOR.md section 11); without `boundary` every disc counts as whole.
 // `clearance` holds per point BoundaryIndex::clearance: the radius up to which its disc is whole
 // without asking.
-void disc_pass(std::span<const MeasurementPoint> points, std::span<const PointState> states,
+void disc_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
                const BoundaryIndex* boundary, std::span<const float> clearance,
                std::span<OwnerValues> out);
 
 // Stage 4: adds one next-event sample (ESTIMATOR.md section 4) to out[k].direct for every
 // point with f > 0, Rng keyed by (seed, pass, first + k, DirectLight). A point on a GGX lobe's
 // diffuse base (Bsdf::is_base_part) is skipped: its camera path took its sample.
-void next_event_pass(const World& world, std::span<const MeasurementPoint> points,
-                     GlossyTable glossy, uint64_t seed, uint64_t pass, size_t first,
+void next_event_pass(const World& world, std::span<const VisiblePoint> points,
+                     PointBsdfTable glossy, uint64_t seed, uint64_t pass, size_t first,
                      std::span<OwnerValues> out);
 
 // Stage 5: folds sums[k] and owner[k] into states[k] (accumulate_pass), writes the radius the

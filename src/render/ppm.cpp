@@ -18,11 +18,11 @@ constexpr size_t kFoldBlock = 16384;
 }  // namespace
 
 PpmMethod::PpmMethod(const World& world, const PinholeCamera& camera, int max_depth)
-    : eye_(run_eye_pass(world, camera, max_depth)) {
-  state_count_ = eye_.points.size();
-  if (!eye_.glossy.empty()) {
-    capped_points_ = eye_.points;
-    for (const GlossyPoint& g : eye_.glossy) capped_points_[g.point].f *= g.bsdf.max_f(g.wo);
+    : pass_(run_camera_pass(world, camera, max_depth)) {
+  state_count_ = pass_.points.size();
+  if (!pass_.glossy.empty()) {
+    capped_points_ = pass_.points;
+    for (const PointBsdf& g : pass_.glossy) capped_points_[g.point].f *= g.bsdf.max_f(g.wo);
   }
   sums_.resize(std::min(kFoldBlock, state_count_));
   owner_.resize(sums_.size());
@@ -30,18 +30,18 @@ PpmMethod::PpmMethod(const World& world, const PinholeCamera& camera, int max_de
 
 void PpmMethod::prepare(const BoundaryIndex& boundary, double initial_radius) {
   boundary_ = &boundary;
-  clearance_.resize(eye_.points.size());
+  clearance_.resize(pass_.points.size());
   const float r0 = search_radius(initial_radius * initial_radius);
-  parallel_for(eye_.points.size(), 4096, [&](size_t b, size_t e) {
+  parallel_for(pass_.points.size(), 4096, [&](size_t b, size_t e) {
     for (size_t k = b; k < e; ++k) {
-      const MeasurementPoint& p = eye_.points[k];
+      const VisiblePoint& p = pass_.points[k];
       clearance_[k] = boundary.clearance(p.triangle, p.position, r0);
     }
   });
 }
 
-void ppm_pass(const PassInputs& in, std::span<const MeasurementPoint> points,
-              std::span<const GlossyPoint> glossy, std::span<const float> clearance,
+void ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
+              std::span<const PointBsdf> glossy, std::span<const float> clearance,
               std::span<PointState> states, std::span<float> radii, std::span<PassSums> sums,
               std::span<OwnerValues> owner, PointState* copy) {
   const size_t n = states.size(), block = sums.size();
@@ -49,9 +49,9 @@ void ppm_pass(const PassInputs& in, std::span<const MeasurementPoint> points,
     const size_t count = std::min(block, n - first);
     for_each_chunk(count, [&](size_t b, size_t m) {
       const size_t at = first + b;
-      const std::span<const MeasurementPoint> pts = points.subspan(at, m);
+      const std::span<const VisiblePoint> pts = points.subspan(at, m);
       const std::span<const PointState> st = std::span<const PointState>(states).subspan(at, m);
-      const GlossyTable table{glossy, at};
+      const PointBsdfTable table{glossy, at};
       gather_pass(pts, st, in.grid, in.hits, table, sums.subspan(b, m));
       const std::span<OwnerValues> own = owner.subspan(b, m);
       std::fill(own.begin(), own.end(), OwnerValues{});
@@ -70,7 +70,7 @@ void ppm_pass(const PassInputs& in, std::span<const MeasurementPoint> points,
 
 void PpmMethod::step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
                      PointState* copy) {
-  ppm_pass(in, eye_.points, eye_.glossy, clearance_, states, radii, sums_, owner_, copy);
+  ppm_pass(in, pass_.points, pass_.glossy, clearance_, states, radii, sums_, owner_, copy);
 }
 
 void PpmMethod::restore(const RenderState& s) {
@@ -87,14 +87,14 @@ void PpmMethod::restore(const RenderState& s) {
 }
 
 PixelLayout PpmMethod::layout(const std::vector<PointState>& states, const RenderState*) const {
-  PixelLayout l = layout_of(eye_);
+  PixelLayout l = layout_of(pass_);
   if (!capped_points_.empty()) l.point_f = colours_of(capped_points_);
   // Each point's disc's kernel mass at the current radius (the sparse-photon bound and the
   // validity of the bias model need it; points within their clearance are whole).
   l.mass.assign(states.size(), 1.0f);
   parallel_for(states.size(), 1024, [&](size_t b, size_t e) {
     for (size_t k = b; k < e; ++k) {
-      const MeasurementPoint& p = eye_.points[k];
+      const VisiblePoint& p = pass_.points[k];
       const float r = search_radius(states[k].r2);
       if (!clearance_.empty() && r <= clearance_[k]) continue;  // the whole disc: mass 1
       l.mass[k] = float(boundary_->moments(p.triangle, p.position, p.normal, r).mass);

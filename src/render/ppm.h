@@ -1,4 +1,4 @@
-// PPM with HJJ10's fixed measurement points (ESTIMATOR.md sections 3-5): one eye pass through
+// PPM with HJJ10's fixed visible points (ESTIMATOR.md sections 3-5): one camera pass through
 // the pixel centres at the start, and every pass gathers at the same points.
 #pragma once
 
@@ -12,10 +12,10 @@ namespace pb {
 // Stages 3-5 of pass in.pass at `points`, block by block of sums.size() points: gather into
 // `sums`, the disc moments (with `clearance`, per point; empty: ask the boundary index for every
 // disc) and next-event samples into `owner`, then fold into `states` and `radii`. `glossy` is
-// the points' glossy side table (EyePassResult::glossy); `copy` (sized to the points) receives
+// the points' glossy side table (CameraPassResult::glossy); `copy` (sized to the points) receives
 // the new states.
-void ppm_pass(const PassInputs& in, std::span<const MeasurementPoint> points,
-              std::span<const GlossyPoint> glossy, std::span<const float> clearance,
+void ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
+              std::span<const PointBsdf> glossy, std::span<const float> clearance,
               std::span<PointState> states, std::span<float> radii, std::span<PassSums> sums,
               std::span<OwnerValues> owner, PointState* copy);
 
@@ -23,7 +23,7 @@ class PpmMethod final : public PhotonMethod {
  public:
   PpmMethod(const World& world, const PinholeCamera& camera, int max_depth);
 
-  const EyePassResult& eye() const override { return eye_; }
+  const CameraPassResult& camera_pass() const override { return pass_; }
   void prepare(const BoundaryIndex& boundary, double initial_radius) override;
   void step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
             PointState* copy) override;
@@ -33,11 +33,11 @@ class PpmMethod final : public PhotonMethod {
                      const RenderState* saved) const override;
 
  private:
-  EyePassResult eye_;
+  CameraPassResult pass_;
   const BoundaryIndex* boundary_ = nullptr;
   std::vector<float> clearance_;  // per point, BoundaryIndex::clearance at the initial radius
   // With glossy points: the points with f times Bsdf::max_f for the sparse-photon bound.
-  std::vector<MeasurementPoint> capped_points_;
+  std::vector<VisiblePoint> capped_points_;
   std::vector<PassSums> sums_;      // one fold block's (pass_stages.h)
   std::vector<OwnerValues> owner_;  // the same block's
 };

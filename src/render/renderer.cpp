@@ -4,7 +4,7 @@
 #include "render/pass_stages.h"
 #include "render/ppm.h"
 #include "render/sppm.h"
-#include "render/scene_setup.h"
+#include "render/scene_defaults.h"
 #include "util/timer.h"
 
 #include <algorithm>
@@ -14,11 +14,11 @@ namespace pb {
 
 namespace {
 
-// Default initial radius: this many pixel footprints (median over measurement points).
+// Default initial radius: this many pixel footprints (median over visible points).
 constexpr double kFootprintsPerRadius = 4.0;
 // R is clamped from below at this fraction of the scene size (ESTIMATOR.md section 8).
 constexpr double kMinRadiusFraction = 1e-6;
-// The scene with what the options and the defaults add (scene_setup.h); main has done it already
+// The scene with what the options and the defaults add (scene_defaults.h); main has done it already
 // and printed its notes, and doing it again changes nothing.
 Scene completed(Scene scene, const RenderOptions& options) {
   complete_scene(scene, options);
@@ -38,15 +38,15 @@ std::unique_ptr<PhotonMethod> make_method(const World& world, const PinholeCamer
 
 }  // namespace
 
-double min_radius(const World& world) { return kMinRadiusFraction * world.scene_size(); }
+double radius_floor(const World& world) { return kMinRadiusFraction * world.scene_size(); }
 
-double default_initial_radius(const EyePassResult& eye, const World& world) {
+double default_initial_radius(const CameraPassResult& pass, const World& world) {
   double r = 0.01 * world.scene_size();
-  if (eye.median_footprint > 0.0f) {
-    const double f = kFootprintsPerRadius * double(eye.median_footprint);
+  if (pass.median_footprint > 0.0f) {
+    const double f = kFootprintsPerRadius * double(pass.median_footprint);
     if (f > 0.0 && std::isfinite(f)) r = f;
   }
-  return std::max(r, min_radius(world));
+  return std::max(r, radius_floor(world));
 }
 
 Renderer::Renderer(Scene scene, const RenderOptions& options)
@@ -57,13 +57,13 @@ Renderer::Renderer(Scene scene, const RenderOptions& options)
       tracer_(world_, options.direct == DirectMode::Photons) {
   const auto t0 = Clock::now();
   method_ = make_method(world_, camera_, options_);
-  timings_.eye = seconds_since(t0);
+  timings_.camera = seconds_since(t0);
   params_.alpha = options_.alpha;
   params_.photons_per_pass = double(options_.photons_per_pass);
-  const double r_min = min_radius(world_);
+  const double r_min = radius_floor(world_);
   params_.min_r2 = r_min * r_min;
   initial_radius_ = options_.radius ? std::max(*options_.radius, r_min)
-                                    : default_initial_radius(method_->eye(), world_);
+                                    : default_initial_radius(method_->camera_pass(), world_);
   // Radii only shrink: segments farther than the initial radius (as a float, what queries use)
   // from a triangle never matter to its points.
   boundary_ = BoundaryIndex(world_, std::nextafter(float(initial_radius_), INFINITY));
@@ -132,7 +132,7 @@ RenderState Renderer::snapshot(std::vector<PointState> states) const {
 void Renderer::restore(const RenderState& saved) {
   if (saved.states.size() != states_.size())
     throw StateError("the state holds " + std::to_string(saved.states.size()) +
-                     " measurement points but this scene and camera give " +
+                     " visible points but this scene and camera give " +
                      std::to_string(states_.size()));
   method_->restore(saved);
   states_ = saved.states;
@@ -146,7 +146,7 @@ PixelLayout Renderer::layout(const std::vector<PointState>& states, const Render
                              double max_photon_power) const {
   PixelLayout l = method_->layout(states, saved);
   l.photon_cap = kPeakWeight * max_photon_power / double(options_.photons_per_pass);
-  l.footprint = method_->eye().median_footprint;
+  l.footprint = method_->camera_pass().median_footprint;
   return l;
 }
 

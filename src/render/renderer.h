@@ -1,5 +1,5 @@
 // The render itself: state, step() and snapshot/restore, nothing else. The method (method.h:
-// PPM keeps the measurement points of one eye pass, SPPM traces fresh camera paths every pass
+// PPM keeps the visible points of one camera pass, SPPM traces fresh camera paths every pass
 // and keeps one state per pixel) runs the camera's side of a pass; the renderer owns what both
 // share: the states and radii, the photons (a photon index range per pass) and their grid.
 // When to stop, what to print and when to checkpoint belong to the driver (app/driver.h).
@@ -7,14 +7,14 @@
 
 #include "world/boundary.h"
 #include "estimator/estimator.h"
-#include "render/eye_pass.h"
+#include "render/camera_pass.h"
 #include "estimator/film.h"
 #include "render/hash_grid.h"
 #include "render/method.h"
 #include "io/image_io.h"
 #include "options/options.h"
 #include "render/photon_pass.h"
-#include "render/view.h"
+#include "render/camera_choice.h"
 #include "world/world.h"
 
 #include <cstdint>
@@ -26,7 +26,7 @@ namespace pb {
 
 // Wall-clock seconds spent in each phase, accumulated over all passes (for the benchmark).
 struct PhaseTimings {
-  double eye = 0.0;     // eye pass (once)
+  double camera = 0.0;  // PPM's camera pass (once); SPPM's footprint sample
   double trace = 0.0;   // photon tracing
   double grid = 0.0;    // hash grid builds
   double gather = 0.0;  // gathers, next-event samples and estimator updates
@@ -43,10 +43,10 @@ ExrImage pack_channels(const FilmImage& film);
 
 // The default initial radius: kFootprintsPerRadius pixel footprints (median over the points),
 // or 1% of the scene without points; never below the radius floor.
-double default_initial_radius(const EyePassResult& eye, const World& world);
+double default_initial_radius(const CameraPassResult& pass, const World& world);
 // The radius floor: R never falls below this fraction of the scene size (ESTIMATOR.md section
 // 8): far below it float positions cannot resolve the distance test anyway.
-double min_radius(const World& world);
+double radius_floor(const World& world);
 
 class Renderer {
  public:
@@ -79,8 +79,8 @@ class Renderer {
   ExrImage image(const RunInfo& run, const RenderState& state) const;
 
   const RenderOptions& options() const { return options_; }
-  // PPM: the measurement points. SPPM: the image size and the median footprint only.
-  const EyePassResult& eye() const { return method_->eye(); }
+  // PPM: the visible points. SPPM: the image size and the median footprint only.
+  const CameraPassResult& camera_pass() const { return method_->camera_pass(); }
   const std::vector<PointState>& states() const { return states_; }
   FilmSettings film_settings() const;
   const PhaseTimings& timings() const { return timings_; }

@@ -18,10 +18,10 @@ SppmMethod::SppmMethod(const World& world, const PinholeCamera& camera,
     : camera_(camera), settings_(settings) {
   // SPPM keeps no points: the default radius comes from the footprints of a sample of
   // pixel-centre paths (every 4th pixel each way).
-  eye_.width = camera.width();
-  eye_.height = camera.height();
-  eye_.median_footprint = median_footprint(world, camera, settings.max_depth, 4);
-  state_count_ = size_t(eye_.width) * size_t(eye_.height);
+  pass_.width = camera.width();
+  pass_.height = camera.height();
+  pass_.median_footprint = median_footprint(world, camera, settings.max_depth, 4);
+  state_count_ = size_t(pass_.width) * size_t(pass_.height);
   visible_.assign(state_count_, 0);
   min_mass_.assign(state_count_, 1.0f);
   glossy_f_.assign(state_count_, 0.0f);
@@ -48,13 +48,13 @@ void SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
     // Stages 0, 3 and 4 chunk by chunk, so that a chunk's visible points are still in cache.
     for_each_chunk(count, [&](size_t b, size_t m) {
       const size_t at = first + b;
-      const std::span<MeasurementPoint> pts = std::span(points_).subspan(b, m);
+      const std::span<VisiblePoint> pts = std::span(points_).subspan(b, m);
       const std::span<OwnerValues> own = std::span(owner_).subspan(b, m);
-      const std::span<GlossyPoint> scratch = std::span(glossy_).subspan(b, m);
+      const std::span<PointBsdf> scratch = std::span(glossy_).subspan(b, m);
       const std::span<const PointState> st = std::span<const PointState>(states).subspan(at, m);
       const size_t n_glossy = trace_visible_points(
           camera, at, std::span<const float>(radii).subspan(at, m), pts, scratch, own);
-      const GlossyTable table{scratch.first(n_glossy), 0};  // indices into pts
+      const PointBsdfTable table{scratch.first(n_glossy), 0};  // indices into pts
       gather_pass(pts, st, in.grid, in.hits, table, std::span(sums_).subspan(b, m));
       if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, at, own);
       record_visible(at, pts, own, table.entries, st);
@@ -68,9 +68,9 @@ void SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
   }
 }
 
-void SppmMethod::record_visible(size_t first, std::span<const MeasurementPoint> points,
+void SppmMethod::record_visible(size_t first, std::span<const VisiblePoint> points,
                                 std::span<const OwnerValues> owner,
-                                std::span<const GlossyPoint> glossy,
+                                std::span<const PointBsdf> glossy,
                                 std::span<const PointState> states) {
   for (size_t k = 0; k < points.size(); ++k) {
     if (!(max_component(points[k].f) > 0.0f)) continue;
@@ -78,7 +78,7 @@ void SppmMethod::record_visible(size_t first, std::span<const MeasurementPoint> 
     if (visible_[pixel] != UINT32_MAX) ++visible_[pixel];  // saturating: far beyond use
     min_mass_[pixel] = std::min(min_mass_[pixel], float(owner[k].disc.mass));
   }
-  for (const GlossyPoint& g : glossy) {  // only while the cap can still matter
+  for (const PointBsdf& g : glossy) {  // only while the cap can still matter
     if (states[g.point].photons >= kMinPhotonsForBound) continue;
     const float f = max_component(points[g.point].f * g.bsdf.max_f(g.wo));
     float& cap = glossy_f_[first + g.point];
@@ -109,8 +109,8 @@ void SppmMethod::restore(const RenderState& saved) {
 
 PixelLayout SppmMethod::layout(const std::vector<PointState>&, const RenderState* saved) const {
   PixelLayout l;
-  l.width = eye_.width;
-  l.height = eye_.height;
+  l.width = pass_.width;
+  l.height = pass_.height;
   l.visible_passes = saved ? saved->visible : visible_;
   l.max_f = max_f_;
   l.glossy_f = saved ? saved->glossy_f : glossy_f_;

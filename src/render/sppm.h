@@ -21,7 +21,7 @@ class SppmMethod final : public PhotonMethod {
  public:
   SppmMethod(const World& world, const PinholeCamera& camera, CameraPathSettings settings);
 
-  const EyePassResult& eye() const override { return eye_; }
+  const CameraPassResult& camera_pass() const override { return pass_; }
   void prepare(const BoundaryIndex&, double) override {}
   void step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
             PointState* copy) override;
@@ -34,21 +34,21 @@ class SppmMethod final : public PhotonMethod {
   // Stage 0's side of a chunk's visible points for the film (ESTIMATOR.md section 12): counts
   // each pixel's passes with a visible point, keeps the smallest kernel mass of its visible
   // points and the largest f a glossy visible point of it may have (throughput x Bsdf::max_f).
-  void record_visible(size_t first, std::span<const MeasurementPoint> points,
-                      std::span<const OwnerValues> owner, std::span<const GlossyPoint> glossy,
+  void record_visible(size_t first, std::span<const VisiblePoint> points,
+                      std::span<const OwnerValues> owner, std::span<const PointBsdf> glossy,
                       std::span<const PointState> states);
 
   const PinholeCamera& camera_;
   CameraPathSettings settings_;
-  EyePassResult eye_;  // the image size and the median footprint of pixel-centre paths
+  CameraPassResult pass_;  // the image size and the median footprint of pixel-centre paths
   vec3 max_f_{0.0f};   // the largest BRDF a Lambertian visible point can have
   std::vector<uint32_t> visible_;  // passes with a visible point, per pixel
   std::vector<float> min_mass_;    // smallest kernel mass seen, per pixel
   std::vector<float> glossy_f_;    // largest glossy f seen, per pixel
   // One fold block's visible points, their Bsdfs where not Lambertian (each chunk's at the
   // front of its chunk's share), pass sums and owner values, reused every pass.
-  std::vector<MeasurementPoint> points_;
-  std::vector<GlossyPoint> glossy_;
+  std::vector<VisiblePoint> points_;
+  std::vector<PointBsdf> glossy_;
   std::vector<PassSums> sums_;
   std::vector<OwnerValues> owner_;
 };

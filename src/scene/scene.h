@@ -186,7 +186,7 @@ struct Camera {
 // 2 pi (x + 1) / W] of the directions d = (-sin theta sin phi, cos theta, sin theta cos phi):
 // row 0 is the zenith (+Y, glTF's up), the centre column -Z (where the default view looks),
 // the left and right quarters -X and +X, the edges +Z. Not glTF: it comes from --environment, or
-// is the default sky of a scene without lights (scene_setup.h).
+// is the default sky of a scene without lights (scene_defaults.h).
 struct Environment {
   std::string source;  // for messages: "the default sky", "--environment 0.5", a file
   int width = 1, height = 1;
@@ -199,7 +199,7 @@ struct Scene {
   std::vector<Material> materials;
   std::vector<PunctualLight> lights;
   std::vector<Camera> cameras;             // every perspective camera, in node order
-  std::optional<Environment> environment;  // none unless given or defaulted (scene_setup.h)
+  std::optional<Environment> environment;  // none unless given or defaulted (scene_defaults.h)
   std::vector<Image> images;               // the decoded images the materials use
   Bounds bounds;                           // of all triangle vertices
   // Where the file's world origin lies in the coordinates stored here: positions (vertices,

@@ -57,7 +57,7 @@ class World {
     return glm::exp(-m.attenuation * glm::distance(from, s.position));
   }
 
-  // Whether measurement points can lie on a surface of this material: its Bsdf has a non-delta
+  // Whether visible points can lie on a surface of this material: its Bsdf has a non-delta
   // part for the factors, or a texture may lower its metalness or transmission.
   bool may_hold_points(const Material& m) const;
 

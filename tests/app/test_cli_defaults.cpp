@@ -4,7 +4,7 @@
 #include "process_fixture.h"
 
 #include "io/image_io.h"
-#include "render/scene_setup.h"
+#include "render/scene_defaults.h"
 #include "scene_builder.h"
 
 #include <filesystem>

@@ -9,7 +9,7 @@
 
 #include "estimator/channels.h"
 #include "io/image_io.h"
-#include "render/scene_setup.h"
+#include "render/scene_defaults.h"
 
 #include <gtest/gtest.h>
 

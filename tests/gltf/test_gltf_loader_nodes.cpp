@@ -3,8 +3,8 @@
 #include "gltf_expect.h"
 
 #include "lights/lights.h"
-#include "render/scene_setup.h"
-#include "render/view.h"
+#include "render/scene_defaults.h"
+#include "render/camera_choice.h"
 
 #include <cmath>
 
@@ -139,7 +139,7 @@ const std::vector<LoaderCase> kRows = {
            add_mesh(d, "second", 0);
          },
      .error = {"(the file has 2 meshes)"}},
-    // No camera is not an error: the render frames the bounds (view.h).
+    // No camera is not an error: the render frames the bounds (camera_choice.h).
     {.name = "NoCamera",
      .edit =
          [](Doc& d) {
@@ -202,7 +202,7 @@ const std::vector<LoaderCase> kRows = {
            EXPECT_TRUE(s.lights.empty());
            EXPECT_TRUE(s.materials[s.meshes[0].material].emits());
          }},
-    // No light is not an error either: the render adds the default sky (scene_setup.h).
+    // No light is not an error either: the render adds the default sky (scene_defaults.h).
     {.name = "NoLight",
      .edit =
          [](Doc& d) {

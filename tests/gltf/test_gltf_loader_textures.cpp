@@ -4,7 +4,7 @@
 #include "gltf_expect.h"
 
 #include "lights/lights.h"
-#include "render/scene_setup.h"
+#include "render/scene_defaults.h"
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
 // A pass in its steady state allocates nothing (issue "Stochastic progressive photon mapping":
-// the eye pass of each pass parallel and allocation-free): every buffer of Renderer::step is
+// the camera pass of each pass parallel and allocation-free): every buffer of Renderer::step is
 // sized by the first passes and reused. This binary replaces the global operator new to count
 // the calls made while a pass runs (on every thread: the counter is atomic). Allocations inside
 // oneTBB's own task pools go through its allocator, not operator new, and are not counted.

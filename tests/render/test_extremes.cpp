@@ -532,7 +532,7 @@ TEST(Extremes, ScaledScenes) {
     RenderOptions os = o;
     os.scene = path;
     Render run(path, os);
-    ASSERT_EQ(run.r->eye().points.size(), ref.r->eye().points.size());
+    ASSERT_EQ(run.r->camera_pass().points.size(), ref.r->camera_pass().points.size());
     EXPECT_NEAR(double(run.r->world().scene_size()) / double(ref.r->world().scene_size()), s,
                 1e-6 * s);
     run.passes(32);
@@ -675,7 +675,7 @@ TEST(Extremes, EmissionScaled) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// A light no measurement point can see, an all-black scene, a camera that sees only background.
+// A light no visible point can see, an all-black scene, a camera that sees only background.
 
 // The point light below the (one-sided for gathering) plane: photons land on its back, no point
 // ever gathers one, next-event samples are all shadowed. Every pixel stays unknown (+inf) at
@@ -741,7 +741,7 @@ TEST(Extremes, HiddenLightBesideVisibleOne) {
   EXPECT_GE(a.coverage, 0.85);
 }
 
-// All reflectances 0: a black surface gives no measurement point (eye_pass.cpp), so every pixel
+// All reflectances 0: a black surface gives no visible point (camera_pass.cpp), so every pixel
 // is exact: radiance and bound 0, nothing unknown, whichever way direct light is computed.
 TEST(Extremes, AllBlackScene) {
   TempDir dir;
@@ -752,7 +752,7 @@ TEST(Extremes, AllBlackScene) {
     RenderOptions o = extremes::options(path, 8, 10000);
     o.direct = mode;
     Render run(path, o);
-    EXPECT_TRUE(run.r->eye().points.empty());
+    EXPECT_TRUE(run.r->camera_pass().points.empty());
     run.passes(20);
     FilmImage img;
     FilmSummary summary;
@@ -780,7 +780,7 @@ TEST(Extremes, BlackEmittingBox) {
   for (float v : img.bound) EXPECT_EQ(v, 0.0f);
 }
 
-// The camera turned to look up, away from the plane: no measurement point at all. Bound 0
+// The camera turned to look up, away from the plane: no visible point at all. Bound 0
 // everywhere, no unknown pixel, and a target error is met at the first check.
 TEST(Extremes, CameraSeesOnlyBackground) {
   TempDir dir;
@@ -793,7 +793,7 @@ TEST(Extremes, CameraSeesOnlyBackground) {
   o.passes.reset();
   o.target_error = 1e-9;
   Render run(path, o);
-  EXPECT_TRUE(run.r->eye().points.empty());
+  EXPECT_TRUE(run.r->camera_pass().points.empty());
   const RenderReport report = test::run_to_stop(*run.r);
   EXPECT_EQ(stop_text(report.stop), "target-error");
   EXPECT_EQ(report.work.passes, o.min_passes);
@@ -832,7 +832,7 @@ TEST(Extremes, DirectOnlySceneWithNextEventHasAFallingBound) {
   EXPECT_EQ(a.samples, 3 * c.pixels);
   EXPECT_EQ(a.coverage, 1.0);  // the radiance is exact
   for (size_t p = 0; p < c.pixels; ++p) {
-    const double exact = analytic::plane_point(run.r->eye().points[p].position);
+    const double exact = analytic::plane_point(run.r->camera_pass().points[p].position);
     EXPECT_NEAR(img.radiance[3 * p], exact, 1e-5 * exact);
   }
   run.passes(80);

@@ -291,7 +291,7 @@ TEST(HashGrid, EmptyPhotonSetOrNoRadii) {
   grid.build(std::span<const vec3>(), radii);  // back to empty after a non-empty build
   grid.query(vec3(0.0f), 1.0f, [&](uint32_t, float) { ADD_FAILURE() << "visited after rebuild"; });
 
-  // No radii (no measurement points this pass): no levels, queries visit nothing, no throw.
+  // No radii (no visible points this pass): no levels, queries visit nothing, no throw.
   grid.build(pts, std::span<const float>());
   EXPECT_EQ(grid.level_count(), 0);
   EXPECT_EQ(grid.photon_count(), 1u);

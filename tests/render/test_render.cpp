@@ -68,9 +68,9 @@ TEST(Render, PointLightDirectIsExact) {
   Renderer r(scene, o);
   r.step();
   r.step();
-  ASSERT_EQ(r.eye().points.size(), 16u * 16u);
-  for (size_t k = 0; k < r.eye().points.size(); ++k) {
-    const double exact = analytic::plane_point(r.eye().points[k].position);
+  ASSERT_EQ(r.camera_pass().points.size(), 16u * 16u);
+  for (size_t k = 0; k < r.camera_pass().points.size(); ++k) {
+    const double exact = analytic::plane_point(r.camera_pass().points[k].position);
     const PointEstimate e = estimate(r.states()[k], r.passes(), double(o.photons_per_pass));
     // float geometry: a few ulps of relative error
     EXPECT_NEAR(e.radiance.x, exact, 1e-5 * exact);
@@ -86,8 +86,8 @@ TEST(Render, SpotLightCentreIsExact) {
   r.step();
   r.step();
   int checked = 0;
-  for (size_t k = 0; k < r.eye().points.size(); ++k) {
-    const vec3 p = r.eye().points[k].position;
+  for (size_t k = 0; k < r.camera_pass().points.size(); ++k) {
+    const vec3 p = r.camera_pass().points[k].position;
     const double rho2 = double(p.x) * p.x + double(p.z) * p.z;
     const double d2 = rho2 + 4.0;
     if (std::sqrt(rho2) > 0.55) continue;  // inner cone (0.3 rad at height 2) ends at 0.619
@@ -140,7 +140,7 @@ TEST(Render, RelativeMetricIsTheMeanOfBoundOverRadiance) {
   Renderer r(scene, o);
   for (int k = 0; k < 4; ++k) r.step();
   FilmImage img;
-  const FilmSummary s = develop(r.eye(), r.states(), r.passes(), r.film_settings(), &img);
+  const FilmSummary s = develop(r.camera_pass(), r.states(), r.passes(), r.film_settings(), &img);
   double mean_l = 0.0;
   for (float v : img.radiance) mean_l += v;
   mean_l /= double(img.radiance.size());

@@ -8,7 +8,7 @@
 #include "scene_builder.h"
 
 #include "util/parallel.h"
-#include "render/scene_setup.h"
+#include "render/scene_defaults.h"
 
 #include <gtest/gtest.h>
 
@@ -48,7 +48,7 @@ Rendered render(Scene scene, const RenderOptions& o) {
 
 // The unit sphere, flat-shaded (a convex polyhedron, so each facet sees its whole outer
 // half-space and L = rho Le holds on every facet), rho 0.5, seen from (0, 0, 4); no light, so
-// the render adds the default sky (scene_setup.h: uniform radiance 1).
+// the render adds the default sky (scene_defaults.h: uniform radiance 1).
 Scene furnace() {
   test::SceneBuilder b;
   b.sphere(vec3(0), 1.0f, 48, 24, b.material(vec3(0.5f)));
@@ -199,7 +199,7 @@ TEST(EnvironmentRender, MapLitPlaneMatchesTheMapsIrradiance) {
 }
 
 // PPM's pixel-centre rays that leave the scene carry the map's radiance in that direction,
-// exactly (EyePassResult::emission); SPPM's background pixels average the map over the pixel.
+// exactly (CameraPassResult::emission); SPPM's background pixels average the map over the pixel.
 TEST(EnvironmentRender, BackgroundShowsTheMap) {
   test::SceneBuilder b;
   b.quad(vec3(0, -10, 0), vec3(1, 0, 0), vec3(0, 0, -1), b.material(vec3(0.5f)));
@@ -216,8 +216,8 @@ TEST(EnvironmentRender, BackgroundShowsTheMap) {
   for (int y = 0; y < kSize; ++y)
     for (int x = 0; x < kSize; ++x) {
       const size_t p = size_t(y * kSize + x);
-      ASSERT_EQ(r.eye().pixel_begin[p], r.eye().pixel_begin[p + 1]);  // no surface in view
-      EXPECT_EQ(vec3(r.eye().emission[p]), env.radiance(cam.direction(x, y)));
+      ASSERT_EQ(r.camera_pass().pixel_begin[p], r.camera_pass().pixel_begin[p + 1]);  // no surface in view
+      EXPECT_EQ(vec3(r.camera_pass().emission[p]), env.radiance(cam.direction(x, y)));
     }
 }
 

@@ -496,8 +496,8 @@ TEST(MaterialRender, MaskCutOutsPassCameraRaysShadowRaysAndPhotons) {
   Renderer r(masked_scene(true), o);
   r.step();
   int lit = 0, dark = 0;
-  for (size_t k = 0; k < r.eye().points.size(); ++k) {
-    const MeasurementPoint& p = r.eye().points[k];
+  for (size_t k = 0; k < r.camera_pass().points.size(); ++k) {
+    const VisiblePoint& p = r.camera_pass().points[k];
     if (std::fabs(p.position.y) > 1e-4f) continue;  // on the occluder
     const double d =
         std::sqrt(double(p.position.x) * p.position.x + 1 + p.position.z * p.position.z);
@@ -518,9 +518,9 @@ TEST(MaterialRender, MaskCutOutsPassCameraRaysShadowRaysAndPhotons) {
   // The camera sees the plane through the cut-out: more plane points than without the mask.
   Renderer opaque(masked_scene(false), o);
   size_t on_plane_masked = 0, on_plane_opaque = 0;
-  for (const MeasurementPoint& p : r.eye().points)
+  for (const VisiblePoint& p : r.camera_pass().points)
     on_plane_masked += std::fabs(p.position.y) < 1e-4f;
-  for (const MeasurementPoint& p : opaque.eye().points)
+  for (const VisiblePoint& p : opaque.camera_pass().points)
     on_plane_opaque += std::fabs(p.position.y) < 1e-4f;
   EXPECT_GT(on_plane_masked, on_plane_opaque);
   // Photons pass too: with all light from photons the plane behind the cut-out is lit (within
@@ -532,8 +532,8 @@ TEST(MaterialRender, MaskCutOutsPassCameraRaysShadowRaysAndPhotons) {
   Renderer pr(masked_scene(true), po);
   for (int i = 0; i < 20; ++i) pr.step();
   double through_sum = 0.0, exact_sum = 0.0, blocked_sum = 0.0;
-  for (size_t k = 0; k < pr.eye().points.size(); ++k) {
-    const MeasurementPoint& p = pr.eye().points[k];
+  for (size_t k = 0; k < pr.camera_pass().points.size(); ++k) {
+    const VisiblePoint& p = pr.camera_pass().points[k];
     if (std::fabs(p.position.y) > 1e-4f || std::fabs(p.position.z) > 0.4f) continue;
     const double d =
         std::sqrt(double(p.position.x) * p.position.x + 1 + p.position.z * p.position.z);
@@ -569,9 +569,9 @@ TEST(MaterialRender, BaseColourTextureWithTransformAtThePoints) {
   Renderer r(b.done(), o);
   r.step();
   const Image& im = r.world().scene().images[0];
-  ASSERT_EQ(r.eye().points.size(), 64u);
+  ASSERT_EQ(r.camera_pass().points.size(), 64u);
   for (size_t k = 0; k < 64; ++k) {
-    const vec3 p = r.eye().points[k].position;
+    const vec3 p = r.camera_pass().points[k].position;
     // The quad spans x, z in [-1, 1]; u = (x + 1) / 2 and v = (z + 1) / 2 (v toward +z).
     const float s = (p.x + 1) / 2 + 0.5f, t = (p.z + 1) / 2;
     const int tx = int(std::floor((s - std::floor(s)) * 2)), ty = std::min(1, int(t * 2));
@@ -603,9 +603,9 @@ TEST(MaterialRender, NormalTextureTiltsTheShadingNormal) {
   Renderer r(b.done(), o);
   r.step();
   const vec3 ns(s30, c30, 0.0f);
-  for (size_t k = 0; k < r.eye().points.size(); ++k) {
-    const vec3 p = r.eye().points[k].position;
-    EXPECT_NEAR(glm::dot(r.eye().points[k].shading, ns), 1.0f, 1e-5f);
+  for (size_t k = 0; k < r.camera_pass().points.size(); ++k) {
+    const vec3 p = r.camera_pass().points[k].position;
+    EXPECT_NEAR(glm::dot(r.camera_pass().points[k].shading, ns), 1.0f, 1e-5f);
     const vec3 to = vec3(0, 1, 0) - p;
     const double d2 = glm::dot(to, to),
                  cos = std::max(0.0, double(glm::dot(to, ns)) / std::sqrt(d2));
@@ -641,10 +641,10 @@ TEST(MaterialRender, DefaultMaterialIsARoughWhiteMetal) {
   const RenderOptions o = options(8);
   Renderer r(b.done(), o);
   r.step();
-  ASSERT_EQ(r.eye().points.size(), 64u);  // a visible point on every pixel: not a mirror
-  ASSERT_EQ(r.eye().glossy.size(), 64u);
+  ASSERT_EQ(r.camera_pass().points.size(), 64u);  // a visible point on every pixel: not a mirror
+  ASSERT_EQ(r.camera_pass().glossy.size(), 64u);
   for (size_t k = 0; k < 64; ++k) {
-    const dvec3 p(r.eye().points[k].position);
+    const dvec3 p(r.camera_pass().points[k].position);
     const dvec3 v = glm::normalize(dvec3(0.5, 3, 0) - p), to = dvec3(0, 1, 0) - p;
     const double d2 = glm::dot(to, to);
     const dvec3 l = to / std::sqrt(d2);
@@ -684,12 +684,12 @@ TEST(MaterialRender, AnisotropyTurnsWithTheTangentTheRotationAndTheTexture) {
     const RenderOptions o = options(8);
     Renderer r(b.done(), o);
     r.step();
-    ASSERT_EQ(r.eye().points.size(), 64u);
+    ASSERT_EQ(r.camera_pass().points.size(), 64u);
     const double turn = textured ? 0.5 + phi : 0.5, strength = textured ? 0.4 : 0.8;
     const dvec3 n(0, 1, 0), t(std::cos(turn), 0, -std::sin(turn)), bt = glm::cross(n, t);
     const double alpha = 0.09, at = alpha + (1 - alpha) * strength * strength, ab = alpha;
     for (size_t k = 0; k < 64; ++k) {
-      const dvec3 p(r.eye().points[k].position);
+      const dvec3 p(r.camera_pass().points[k].position);
       const dvec3 v = glm::normalize(dvec3(0.5, 3, 0) - p), to = dvec3(0, 1, 0) - p;
       const double d2 = glm::dot(to, to);
       const dvec3 l = to / std::sqrt(d2), h = glm::normalize(v + l);

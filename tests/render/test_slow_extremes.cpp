@@ -58,7 +58,7 @@ TEST(SlowExtremes, RareArrivalsRendered) {
       for (size_t p = 0; p < n; ++p) {
         const PointState& s = run.r->states()[p];
         if (s.photons < kMinPhotonsForBound) continue;
-        const double exact = analytic::plane_point(run.r->eye().points[p].position);
+        const double exact = analytic::plane_point(run.r->camera_pass().points[p].position);
         const double l = img.radiance[3 * p], b = img.bound[3 * p];
         EXPECT_GE(b, 0.999 * q.two_sided_t() * l / std::sqrt(double(s.photons)))
             << "pixel " << p << " with " << s.photons << " photons";
@@ -114,12 +114,12 @@ TEST(SlowExtremes, AlphaSweepLong) {
     run.passes(64);
     const double b64 = extremes::mean_bound(*run.r, 0.9);
     const double noise64 =
-        develop(run.r->eye(), run.r->states(), 64, run.r->film_settings(), nullptr).mean_noise;
+        develop(run.r->camera_pass(), run.r->states(), 64, run.r->film_settings(), nullptr).mean_noise;
     run.passes(512);
     extremes::check_states(run);
     EXPECT_EQ(extremes::check_film(*run.r, run.r->film_settings()).unknown, 0u);
     const FilmSummary s512 =
-        develop(run.r->eye(), run.r->states(), 512, run.r->film_settings(), nullptr);
+        develop(run.r->camera_pass(), run.r->states(), 512, run.r->film_settings(), nullptr);
     const analytic::Accuracy a = analytic::measure(*run.r, analytic::plane_point, 0.9);
     std::printf(
         "alpha %.4f, 64 -> 512 passes: mean bound %.4g -> %.4g, noise %.4g -> %.4g, "

@@ -18,13 +18,13 @@ namespace {
 // radii from where its surface ends (BoundaryIndex). There the pixel's area average differs from
 // its centre value by the second-order term h^2/24 Lap L, below the bounds of these renders.
 std::vector<bool> smooth_interior(const Renderer& ppm) {
-  const EyePassResult& eye = ppm.eye();
+  const CameraPassResult& eye = ppm.camera_pass();
   const int w = eye.width, h = eye.height;
   const World& world = ppm.world();
   std::vector<bool> smooth(size_t(w) * size_t(h), false);
   const auto points = [&](int x, int y) {
     const size_t p = size_t(y) * size_t(w) + size_t(x);
-    return std::span<const MeasurementPoint>(eye.points.data() + eye.pixel_begin[p],
+    return std::span<const VisiblePoint>(eye.points.data() + eye.pixel_begin[p],
                                              eye.pixel_begin[p + 1] - eye.pixel_begin[p]);
   };
   for (int y = 1; y + 1 < h; ++y)

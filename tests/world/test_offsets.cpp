@@ -179,7 +179,7 @@ TEST(Offsets, DoNotDependOnTheSceneSize) {
 // A unit cube on a ground of half-size G, lit by a point light, seen close up: the mean radiance,
 // and its next-event part, of the pixels wholly on the cube for G = 1e2 ... 1e6 against the same
 // render over a ground of 10 with the same fixed radius (alpha 1). The radius is max(0.05, the
-// floor of 1e-6 x the scene's size, renderer.h min_radius), which reaches 2.8 at G = 1e6 and
+// floor of 1e-6 x the scene's size, renderer.h radius_floor), which reaches 2.8 at G = 1e6 and
 // changes the cube's photon part whatever the offsets; rendering the reference with it leaves
 // the offsets as the one difference. Beyond a few units the ground adds almost nothing (its
 // irradiance falls like 1/d^3), so the means agree within the noise; offsets of 1e-5 x the
@@ -242,7 +242,7 @@ CubeMeans cube_mean(float ground, Method method, double radius) {
 TEST(Offsets, SmallObjectOverHugeGroundKeepsItsRadiance) {
   for (Method method : {Method::PPM, Method::SPPM}) {
     for (float g : {1e2f, 1e3f, 1e4f, 1e5f, 1e6f}) {
-      // The radius floor at this ground (renderer.h min_radius): 1e-6 x the bounds' diagonal.
+      // The radius floor at this ground (renderer.h radius_floor): 1e-6 x the bounds' diagonal.
       const double radius = std::max(0.05, 1e-6 * std::sqrt(8.0 * double(g) * g + 1.0));
       const CubeMeans ref = cube_mean(10.0f, method, radius), m = cube_mean(g, method, radius);
       std::printf(

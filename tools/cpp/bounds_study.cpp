@@ -458,7 +458,7 @@ void correlation_table() {
       const std::vector<double> truth = analytic::pixel_truth(r, analytic::by_name(name).exact);
       FilmImage img;
       const double measured_k = r.develop(&img).correlated_pixels;
-      const int w = r.eye().width, h = r.eye().height;
+      const int w = r.camera_pass().width, h = r.camera_pass().height;
       std::vector<double> z(size_t(w * h)), a(size_t(w * h));
       double ma = 0.0;
       for (int p = 0; p < w * h; ++p) {
@@ -489,8 +489,8 @@ void correlation_table() {
           "%s %llu passes: sum corr(e) %.1f, sum corr(|e|) %.1f, model K %.1f, measured K %.1f "
           "(R/f %.2f)\n",
           name, (unsigned long long)passes, sz / z0, sa / a0,
-          correlated_pixels(std::sqrt(mr2), r.eye().median_footprint), measured_k,
-          std::sqrt(mr2) / r.eye().median_footprint);
+          correlated_pixels(std::sqrt(mr2), r.camera_pass().median_footprint), measured_k,
+          std::sqrt(mr2) / r.camera_pass().median_footprint);
     }
 }
 

@@ -1,4 +1,4 @@
-#include "util/text.h"
+#include "util/message_text.h"
 
 #include <sstream>
 

@@ -1,10 +1,10 @@
-#include "render/scene_setup.h"
+#include "render/scene_defaults.h"
 
 #include "estimator/channels.h"
 #include "util/file_io.h"
 #include "lights/lights.h"
 #include "util/rng.h"
-#include "render/view.h"
+#include "render/camera_choice.h"
 
 #include <cmath>
 #include <cstdio>

@@ -1,4 +1,4 @@
-#include "render/view.h"
+#include "render/camera_choice.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "render/eye_pass.h"
+#include "render/camera_pass.h"
 
 #include "bsdf/bsdf.h"
 #include "util/parallel.h"
@@ -19,9 +19,9 @@ struct PathVertex {
 };
 
 struct PixelOutput {
-  std::vector<MeasurementPoint> points;
+  std::vector<VisiblePoint> points;
   std::vector<float> footprints;    // one per point
-  std::vector<GlossyPoint> glossy;  // point = index into points
+  std::vector<PointBsdf> glossy;  // point = index into points
   dvec3 emission{0.0};
 };
 
@@ -51,7 +51,7 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
     const float length = v.length + hit.t;
     if (!s.bsdf.is_delta()) {
       const bool front = glm::dot(wo, s.ng) > 0.0f;
-      MeasurementPoint p;
+      VisiblePoint p;
       p.position = world.spawn(s, wo);  // lifted off the surface: shadow rays start here
       p.normal = front ? s.ng : -s.ng;
       p.shading = front ? s.ns : -s.ns;
@@ -78,17 +78,17 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
 
 }  // namespace
 
-EyePassResult run_eye_pass(const World& world, const PinholeCamera& camera, int max_depth) {
-  EyePassResult r;
+CameraPassResult run_camera_pass(const World& world, const PinholeCamera& camera, int max_depth) {
+  CameraPassResult r;
   r.width = camera.width();
   r.height = camera.height();
   const size_t pixels = size_t(r.width) * size_t(r.height);
   r.emission.assign(pixels, dvec3(0.0));
 
   // One output per row, joined in row order: the point order is independent of threads.
-  std::vector<std::vector<MeasurementPoint>> rows(size_t(r.height));
+  std::vector<std::vector<VisiblePoint>> rows(size_t(r.height));
   std::vector<std::vector<float>> row_footprints(size_t(r.height));
-  std::vector<std::vector<GlossyPoint>> row_glossy(size_t(r.height));
+  std::vector<std::vector<PointBsdf>> row_glossy(size_t(r.height));
   r.pixel_begin.assign(pixels + 1, 0);
   parallel_for(size_t(r.height), 1, [&](size_t begin, size_t end) {
     PixelOutput out;
@@ -116,13 +116,13 @@ EyePassResult run_eye_pass(const World& world, const PinholeCamera& camera, int 
   std::vector<float> footprints;
   footprints.reserve(total);
   for (size_t y = 0; y < rows.size(); ++y) {
-    for (GlossyPoint g : row_glossy[y]) {  // row-local indices become global ones
+    for (PointBsdf g : row_glossy[y]) {  // row-local indices become global ones
       g.point += uint32_t(r.points.size());
       r.glossy.push_back(g);
     }
     r.points.insert(r.points.end(), rows[y].begin(), rows[y].end());
     footprints.insert(footprints.end(), row_footprints[y].begin(), row_footprints[y].end());
-    std::vector<MeasurementPoint>().swap(rows[y]);
+    std::vector<VisiblePoint>().swap(rows[y]);
   }
   for (size_t p = 0; p < pixels; ++p) r.pixel_begin[p + 1] += r.pixel_begin[p];
   if (!footprints.empty()) {
@@ -153,24 +153,24 @@ float median_footprint(const World& world, const PinholeCamera& camera, int max_
   return all[all.size() / 2];
 }
 
-StridedColours colours_of(std::span<const MeasurementPoint> points) {
-  return {reinterpret_cast<const unsigned char*>(points.data()) + offsetof(MeasurementPoint, f),
-          sizeof(MeasurementPoint), points.size()};
+StridedColours colours_of(std::span<const VisiblePoint> points) {
+  return {reinterpret_cast<const unsigned char*>(points.data()) + offsetof(VisiblePoint, f),
+          sizeof(VisiblePoint), points.size()};
 }
 
-PixelLayout layout_of(const EyePassResult& eye) {
+PixelLayout layout_of(const CameraPassResult& pass) {
   PixelLayout l;
-  l.width = eye.width;
-  l.height = eye.height;
-  l.pixel_begin = eye.pixel_begin;
-  l.emission = eye.emission;
-  l.point_f = colours_of(eye.points);
+  l.width = pass.width;
+  l.height = pass.height;
+  l.pixel_begin = pass.pixel_begin;
+  l.emission = pass.emission;
+  l.point_f = colours_of(pass.points);
   return l;
 }
 
-FilmSummary develop(const EyePassResult& eye, const std::vector<PointState>& states,
+FilmSummary develop(const CameraPassResult& pass, const std::vector<PointState>& states,
                     uint64_t passes, const FilmSettings& settings, FilmImage* image) {
-  return develop(layout_of(eye), states, passes, settings, image);
+  return develop(layout_of(pass), states, passes, settings, image);
 }
 
 }  // namespace pb

@@ -1,9 +1,9 @@
-// The camera a render looks through (view.h): the default view frames the bounds of a file
+// The camera a render looks through (camera_choice.h): the default view frames the bounds of a file
 // without camera, --look-from / --look-at / --up / --fov override any camera, and --camera with
 // a wrong name lists the cameras there are.
 #include "scene_builder.h"
 
-#include "render/view.h"
+#include "render/camera_choice.h"
 
 #include <gtest/gtest.h>
 
