@@ -185,4 +185,13 @@ void fold_pass(std::span<PointState> states, std::span<const PassSums> sums,
   if (copy) store_fence();  // the streamed stores are visible before the writer reads them
 }
 
+void fold_block(size_t first, std::span<PointState> states, std::span<const PassSums> sums,
+                std::span<const OwnerValues> owner, const EstimatorParams& params, uint64_t pass,
+                std::span<float> radii, PointState* copy) {
+  for_each_chunk(sums.size(), [&](size_t b, size_t m) {
+    fold_pass(states.subspan(first + b, m), sums.subspan(b, m), owner.subspan(b, m), params, pass,
+              radii.subspan(first + b, m), copy ? copy + first + b : nullptr);
+  });
+}
+
 }  // namespace pb

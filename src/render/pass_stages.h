@@ -86,6 +86,19 @@ void fold_pass(std::span<PointState> states, std::span<const PassSums> sums,
                std::span<const OwnerValues> owner, const EstimatorParams& params, uint64_t pass,
                std::span<float> radii, PointState* copy);
 
+// Stage 5 over a fold block: the block [first, first + sums.size()) of the states, from the
+// block's sums and owner values (indexed from 0), in parallel by chunks; `copy` (sized to all
+// states) or null.
+void fold_block(size_t first, std::span<PointState> states, std::span<const PassSums> sums,
+                std::span<const OwnerValues> owner, const EstimatorParams& params, uint64_t pass,
+                std::span<float> radii, PointState* copy);
+
+// Points per fold block: the pass sums of a block are gathered (stages 3-4) into one array,
+// then folded (stage 5). 16384 points keep the block's sums and owner values (2.4 MB) and states
+// (3.4 MB) in the last-level cache between the two, and the block's PassSums exist whole for a
+// distributed reduction.
+inline constexpr size_t kFoldBlock = 16384;
+
 // What every stage of a pass reads: the world, the pass's photons and grid, the estimator's
 // parameters and the random stream's key.
 struct PassInputs {

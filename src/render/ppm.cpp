@@ -7,15 +7,6 @@
 
 namespace pb {
 
-namespace {
-
-// Points per fold block: the pass sums of a block are gathered (stages 3-4) into one array,
-// then folded (stage 5). 16384 points keep the block's sums and owner values (2.4 MB) and
-// states (3.4 MB) in the last-level cache between the two, and the block's PassSums exist
-// whole for a distributed reduction.
-constexpr size_t kFoldBlock = 16384;
-
-}  // namespace
 
 PpmMethod::PpmMethod(const World& world, const PinholeCamera& camera, int max_depth)
     : pass_(run_camera_pass(world, camera, max_depth)) {
@@ -60,11 +51,8 @@ void ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
       if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, at, own);
     });
     // A distributed render reduces sums[0, count) across machines here.
-    for_each_chunk(count, [&](size_t b, size_t m) {
-      fold_pass(states.subspan(first + b, m), std::span<const PassSums>(sums).subspan(b, m),
-                std::span<const OwnerValues>(owner).subspan(b, m), in.params, in.pass,
-                radii.subspan(first + b, m), copy ? copy + first + b : nullptr);
-    });
+    fold_block(first, states, std::span<const PassSums>(sums).first(count),
+               std::span<const OwnerValues>(owner).first(count), in.params, in.pass, radii, copy);
   }
 }
 

@@ -5,13 +5,6 @@
 
 namespace pb {
 
-namespace {
-
-// Pixels per fold block, as PPM's points (ppm.cpp): the block's sums, owner values and states
-// stay in the last-level cache between gather and fold.
-constexpr size_t kFoldBlock = 16384;
-
-}  // namespace
 
 SppmMethod::SppmMethod(const World& world, const PinholeCamera& camera,
                        CameraPathSettings settings)
@@ -60,11 +53,8 @@ void SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
       record_visible(at, pts, own, table.entries, st);
     });
     // A distributed render reduces sums_[0, count) across machines here.
-    for_each_chunk(count, [&](size_t b, size_t m) {
-      fold_pass(states.subspan(first + b, m), std::span<const PassSums>(sums_).subspan(b, m),
-                std::span<const OwnerValues>(owner_).subspan(b, m), in.params, in.pass,
-                radii.subspan(first + b, m), copy ? copy + first + b : nullptr);
-    });
+    fold_block(first, states, std::span<const PassSums>(sums_).first(count),
+               std::span<const OwnerValues>(owner_).first(count), in.params, in.pass, radii, copy);
   }
 }
 
