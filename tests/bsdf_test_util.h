@@ -1,5 +1,6 @@
-// Helpers of the Bsdf tests (test_bsdf*.cpp): random directions, a frame of the test's own,
-// MetalRoughBrdf of a BsdfParams, and the chi-square test of sample()'s directions.
+// Helpers of the Bsdf tests (test_bsdf*.cpp): random directions, a frame of the test's own, the
+// metal-rough parameters and MetalRoughBrdf of a BsdfParams, and the chi-square test of
+// sample()'s directions.
 #pragma once
 
 #include "bsdf/bsdf.h"
@@ -41,6 +42,16 @@ struct Basis {
                           float(std::sin(theta) * std::sin(phi)) * b + float(std::cos(theta)) * n);
   }
 };
+
+// The parameters every test material starts from: glTF's metal-rough core, the rest as
+// BsdfParams's defaults (each test file's builder sets its extension's).
+inline BsdfParams metal_rough(vec3 base, float metallic, float roughness) {
+  BsdfParams p;
+  p.base_color = base;
+  p.metallic = metallic;
+  p.roughness = roughness;
+  return p;
+}
 
 inline MetalRoughBrdf brdf_of(const BsdfParams& p) {
   MetalRoughBrdf m;

@@ -1,14 +1,17 @@
-// The Bsdf property suite: one parameterised test (BsdfProperties) of the properties every
-// material must have, over a registry of named Bsdf constructions (BsdfCase). Each extension's
-// test file (test_bsdf_gltf.cpp: Lambertian and glTF's metal-rough; _clearcoat, _sheen,
-// _iridescence, _anisotropy, _rough_glass, _diffuse_transmission, _dispersion) builds its cases
-// and registers them with PB_BSDF_PROPERTY_CASES(Extension, its_cases()); its own tests keep
-// only what is particular to the extension. Checked for every case:
-//  - SampleWeightIsEvalCosOverPdf: pbrt-v4's sampling contract, per draw (both transport
-//    directions; expect_sample_matches_eval), delta draws leave along a branch, weights finite;
-//  - ChiSquareSampledDirectionsFollowThePdf: the directions against pdf() (chi_square);
-//  - EvalIsReciprocal: f(wo, wi) = f(wi, wo);
-//  - AlbedoAtMostOne: the mean weight of radiance draws from outside is at most 1.
+// The Bsdf property suite: one parameterised test per property every material should have,
+// over a registry of named Bsdf constructions (BsdfCase). Each extension's test file
+// (test_bsdf_gltf.cpp: Lambertian and glTF's metal-rough; _clearcoat, _sheen, _iridescence,
+// _anisotropy, _rough_glass, _diffuse_transmission, _dispersion) builds its cases and registers
+// them with PB_BSDF_PROPERTY_CASES(Extension, its_cases()); its own tests keep only what is
+// particular to the extension. The properties (Property), each its own fixture:
+//  - BsdfSampling.SampleWeightIsEvalCosOverPdf: pbrt-v4's sampling contract, per draw (both
+//    transport directions; expect_sample_matches_eval), delta draws leave along a branch,
+//    weights finite;
+//  - BsdfChiSquare.SampledDirectionsFollowThePdf: the directions against pdf() (chi_square);
+//  - BsdfReciprocity.EvalIsReciprocal: f(wo, wi) = f(wi, wo);
+//  - BsdfEnergy.AlbedoAtMostOne: the mean weight of radiance draws from outside is at most 1.
+// A property runs over the cases it applies to: a case excludes one with BsdfCase::exclude and
+// a one-line reason, in the case's definition; nothing is instantiated to skip.
 // Included by the extensions' test files alone (one executable each: the suite runs in each
 // with that file's cases).
 #pragma once
@@ -30,6 +33,9 @@
 
 namespace pb::test {
 
+// The properties of the suite, one fixture each (below).
+enum class Property { Sampling, ChiSquare, Reciprocity, Energy };
+
 // One named Bsdf construction and how the suite checks it.
 struct BsdfCase {
   std::string name;
@@ -37,11 +43,11 @@ struct BsdfCase {
   // Every continuous draw is described by eval() and pdf() (the sampling contract and the
   // chi-square test). Not so for rough glass and diffuse transmission, whose draws through the
   // surface eval() and pdf() do not return (their files bin the draws against the definition:
-  // expect_draws_integrate_to); for them the per-draw test checks weights and branches alone.
+  // expect_draws_integrate_to); for them the per-draw test checks weights and branches alone,
+  // and the chi-square test is excluded.
   bool contract = true;
-  // f(wo, wi) = f(wi, wo). A clear coat's view weight breaks it (bsdf.h; test_bsdf_clearcoat.cpp
-  // checks the exact ratio); see rough glass's cases for theirs.
-  bool reciprocal = true;
+  // The properties that do not apply, each with its reason (exclude).
+  std::vector<std::pair<Property, std::string>> excluded;
   // The coat normal: drawn beside ng for every draw of the per-draw tests (random_normals), and
   // chi_nc in the chi-square test (zero: ns).
   bool tilt_coat_normal = false;
@@ -62,7 +68,25 @@ struct BsdfCase {
   vec3 chi_nc{0.0f};
   // The largest albedo allowed (AlbedoAtMostOne): 1 unless the case's comment justifies more.
   double albedo_max = 1.0;
+
+  // Leaves property `p` out for this case: `why`, one line, says why it does not apply.
+  BsdfCase& exclude(Property p, std::string why) {
+    excluded.emplace_back(p, std::move(why));
+    return *this;
+  }
+  bool applies(Property p) const {
+    return std::none_of(excluded.begin(), excluded.end(),
+                        [p](const auto& e) { return e.first == p; });
+  }
 };
+
+// The cases property `p` applies to, in their order (seeds are the cases' own: index stays).
+inline std::vector<BsdfCase> cases_for(const std::vector<BsdfCase>& cases, Property p) {
+  std::vector<BsdfCase> out;
+  for (const BsdfCase& c : cases)
+    if (c.applies(p)) out.push_back(c);
+  return out;
+}
 
 // gtest prints a case by its name.
 inline void PrintTo(const BsdfCase& c, std::ostream* os) { *os << c.name; }
@@ -94,9 +118,20 @@ inline std::string case_test_name(const testing::TestParamInfo<BsdfCase>& info) 
   return s;
 }
 
-class BsdfProperties : public testing::TestWithParam<BsdfCase> {};
+// One fixture per property, so that each is instantiated over the cases it applies to alone.
+class BsdfSampling : public testing::TestWithParam<BsdfCase> {};
+class BsdfChiSquare : public testing::TestWithParam<BsdfCase> {};
+class BsdfReciprocity : public testing::TestWithParam<BsdfCase> {};
+class BsdfEnergy : public testing::TestWithParam<BsdfCase> {};
 
-TEST_P(BsdfProperties, SampleWeightIsEvalCosOverPdf) {
+// An extension whose cases all exclude a property instantiates it over no case: allowed (the
+// macro below instantiates every fixture, so an empty list is the only way to none).
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(BsdfSampling);
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(BsdfChiSquare);
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(BsdfReciprocity);
+GTEST_ALLOW_UNINSTANTIATED_PARAMETERIZED_TEST(BsdfEnergy);
+
+TEST_P(BsdfSampling, SampleWeightIsEvalCosOverPdf) {
   // 20000 views from random normals (a shading normal tilted from ng), wo at least 0.02 above
   // the shading hemisphere, radiance and photons alternately. Continuous draws: pdf = pdf(wo, wi)
   // and weight = f |wi.ns| / pdf, f(wo, wi) for radiance and f(wi, wo) for photons, relative
@@ -132,12 +167,12 @@ TEST_P(BsdfProperties, SampleWeightIsEvalCosOverPdf) {
   if (c.min_delta > 0) EXPECT_GT(delta, c.min_delta) << c.name;
 }
 
-TEST_P(BsdfProperties, ChiSquareSampledDirectionsFollowThePdf) {
+TEST_P(BsdfChiSquare, SampledDirectionsFollowThePdf) {
   // chi_square at each view (expect_draws_follow_the_pdf); each extension's registration says
   // the family-wise false-alarm rate of its cases.
   const BsdfCase& c = GetParam();
-  if (!c.contract || c.chi_thetas.empty())
-    GTEST_SKIP() << "no density of every draw (or no views) for " << c.name;
+  ASSERT_TRUE(c.contract && !c.chi_thetas.empty())
+      << c.name << ": no density of every draw, or no views: exclude Property::ChiSquare";
   BsdfParams p = c.params;
   if (c.chi_nc != vec3(0.0f)) p.coat_normal = c.chi_nc;
   const Bsdf bsdf(p, c.chi_ng, c.chi_ns);
@@ -145,11 +180,10 @@ TEST_P(BsdfProperties, ChiSquareSampledDirectionsFollowThePdf) {
                               c.chi_min_p);
 }
 
-TEST_P(BsdfProperties, EvalIsReciprocal) {
+TEST_P(BsdfReciprocity, EvalIsReciprocal) {
   // f(wo, wi) = f(wi, wo) for 5000 random pairs on random normals: relative 1e-5 (the two
   // orders round differently, as GltfBsdf.ReciprocalInWorldSpace allows) + 1e-9 absolute.
   const BsdfCase& c = GetParam();
-  if (!c.reciprocal) GTEST_SKIP() << c.name << ": not reciprocal (the case's comment says why)";
   Rng rng(c.seed, c.index, 1, Stream::Test);
   for (int k = 0; k < 5000; ++k) {
     vec3 ng, ns;
@@ -161,7 +195,7 @@ TEST_P(BsdfProperties, EvalIsReciprocal) {
   }
 }
 
-TEST_P(BsdfProperties, AlbedoAtMostOne) {
+TEST_P(BsdfEnergy, AlbedoAtMostOne) {
   // Energy: the mean radiance weight of 20000 draws (absorbed draws 0; both sides and delta
   // branches counted) estimates the albedo, which single scattering keeps at or below 1, per
   // channel, at views of cosine 0.9, 0.5 and 0.15 from outside (n = +z; through a volume from
@@ -194,8 +228,22 @@ TEST_P(BsdfProperties, AlbedoAtMostOne) {
 
 }  // namespace pb::test
 
-// Registers an extension's cases (a std::vector<BsdfCase>) with the suite, as
-// Extension/BsdfProperties.Test/case_name.
-#define PB_BSDF_PROPERTY_CASES(Extension, cases)                                  \
-  INSTANTIATE_TEST_SUITE_P(Extension, BsdfProperties, ::testing::ValuesIn(cases), \
-                           ::pb::test::case_test_name)
+// Registers an extension's cases (a std::vector<BsdfCase>) with the suite: each property over
+// the cases it applies to, as Extension/BsdfSampling.SampleWeightIsEvalCosOverPdf/case_name and
+// likewise. Used at namespace scope (it declares the fixtures' names there).
+#define PB_BSDF_PROPERTY_CASES(Extension, cases)                    \
+  using ::pb::test::BsdfSampling;                                   \
+  using ::pb::test::BsdfChiSquare;                                  \
+  using ::pb::test::BsdfReciprocity;                                \
+  using ::pb::test::BsdfEnergy;                                     \
+  PB_BSDF_PROPERTY(Extension, BsdfSampling, cases, Sampling);       \
+  PB_BSDF_PROPERTY(Extension, BsdfChiSquare, cases, ChiSquare);     \
+  PB_BSDF_PROPERTY(Extension, BsdfReciprocity, cases, Reciprocity); \
+  PB_BSDF_PROPERTY(Extension, BsdfEnergy, cases, Energy)
+
+// One property's instantiation over the cases it applies to.
+#define PB_BSDF_PROPERTY(Extension, Fixture, cases, property)                            \
+  INSTANTIATE_TEST_SUITE_P(                                                              \
+      Extension, Fixture,                                                                \
+      ::testing::ValuesIn(::pb::test::cases_for(cases, ::pb::test::Property::property)), \
+      ::pb::test::case_test_name)

@@ -19,8 +19,8 @@ namespace {
 
 using glm::dvec3;
 using test::BsdfCase;
-using test::BsdfProperties;
 using test::cases_of;
+using test::Property;
 using test::random_unit;
 
 BsdfParams translucent(float dt, float roughness, float specular = 1.0f) {
@@ -124,7 +124,11 @@ std::vector<BsdfCase> diffuse_transmission_cases() {
   std::vector<BsdfCase> c = cases_of({{"half under a layer r0.5", translucent(0.5f, 0.5f)},
                                       {"all without a layer", translucent(1.0f, 1.0f, 0.0f)}},
                                      802, 0, {});
-  for (BsdfCase& x : c) x.contract = false;
+  for (BsdfCase& x : c) {
+    x.contract = false;
+    x.exclude(Property::ChiSquare,
+              "pdf() does not describe its draws through the surface (binned instead, above)");
+  }
   return c;
 }
 PB_BSDF_PROPERTY_CASES(DiffuseTransmission, diffuse_transmission_cases());

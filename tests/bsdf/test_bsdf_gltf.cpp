@@ -23,18 +23,15 @@ namespace {
 using test::Basis;
 using test::brdf_of;
 using test::BsdfCase;
-using test::BsdfProperties;
 using test::cases_of;
 using test::expect_sample_matches_eval;
+using test::metal_rough;
 using test::random_normals;
 using test::random_unit;
 
 BsdfParams params(vec3 base, float metallic, float roughness, float transmission = 0.0f,
                   bool thin = true, float specular = 1.0f) {
-  BsdfParams p;
-  p.base_color = base;
-  p.metallic = metallic;
-  p.roughness = roughness;
+  BsdfParams p = metal_rough(base, metallic, roughness);
   p.transmission = transmission;
   p.thin = thin;
   p.specular = specular;

@@ -21,9 +21,10 @@ namespace pb {
 namespace {
 
 using test::BsdfCase;
-using test::BsdfProperties;
 using test::cases_of;
 using test::expect_sample_matches_eval;
+using test::metal_rough;
+using test::random_normals;
 using test::random_unit;
 
 // The extension's "Iridescence Fresnel" GLSL, line by line in double (its evalSensitivity with
@@ -123,10 +124,7 @@ TEST(ThinFilm, PhysicalLimits) {
 }
 
 BsdfParams film(vec3 base, float metallic, float roughness, float weight, float thickness) {
-  BsdfParams p;
-  p.base_color = base;
-  p.metallic = metallic;
-  p.roughness = roughness;
+  BsdfParams p = metal_rough(base, metallic, roughness);
   p.iridescence = weight;
   p.iridescence_ior = 1.3f;
   p.iridescence_thickness = thickness;
@@ -190,9 +188,8 @@ TEST(Iridescence, ReciprocalBoundedByMaxFAndSampledByItsPdf) {
   // draws of two films by chi-square.
   Rng rng(704, 0, 0, Stream::Test);
   for (int k = 0; k < 3000; ++k) {
-    const vec3 ng = random_unit(rng);
-    vec3 ns = glm::normalize(ng + 0.3f * random_unit(rng));
-    if (glm::dot(ns, ng) < 0.2f) ns = ng;
+    vec3 ng, ns;
+    random_normals(rng, ng, ns);
     const BsdfParams p =
         film(vec3(rng.next_float()), rng.next_float(), 0.05f + 0.95f * rng.next_float(),
              rng.next_float(), 100.0f + 700.0f * rng.next_float());

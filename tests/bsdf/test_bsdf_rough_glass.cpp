@@ -20,15 +20,13 @@ namespace {
 
 using glm::dvec3;
 using test::BsdfCase;
-using test::BsdfProperties;
 using test::cases_of;
+using test::metal_rough;
+using test::Property;
 using test::random_unit;
 
 BsdfParams glass(float roughness, bool thin, vec3 base = vec3(1.0f)) {
-  BsdfParams p;
-  p.base_color = base;
-  p.metallic = 0.0f;
-  p.roughness = roughness;
+  BsdfParams p = metal_rough(base, 0.0f, roughness);
   p.transmission = 1.0f;
   p.thin = thin;
   return p;
@@ -231,12 +229,15 @@ std::vector<BsdfCase> rough_glass_cases() {
       cases_of({{"rough thin wall r0.3", glass(0.3f, true)},
                 {"rough volume r0.5", glass(0.5f, false, vec3(0.9f, 0.7f, 0.5f))}},
                801, 0, {});
-  // Not tested for reciprocity: under a tilted shading normal its reflection is 0 one way and
-  // not the other for about 1 pair in 5 (where one direction is below the shading hemisphere:
-  // the suite found it; left for a decision, the behaviour is unchanged here).
+  // Not reciprocal: where one direction of a pair is below the shading hemisphere, its
+  // reflection is 0 one way and not the other (the suite found it; a known defect left for a
+  // decision, the behaviour is unchanged here).
   for (BsdfCase& x : c) {
     x.contract = false;
-    x.reciprocal = false;
+    x.exclude(Property::ChiSquare,
+              "pdf() does not describe its draws through the surface (binned instead, above)")
+        .exclude(Property::Reciprocity,
+                 "a known defect: under tilted shading normals f is 0 one way, not the other");
   }
   return c;
 }
