@@ -108,4 +108,11 @@ Bsdf::Bsdf(const BsdfParams& p, const vec3& ng, const vec3& ns, float mirror_rou
   has_delta_ = non_delta && delta;
 }
 
+float Bsdf::lobe_roughness() const {
+  // An anisotropic lobe is followed or gathered as the isotropic one of the same peak D,
+  // 1 / (pi ax ay): roughness (ax ay)^(1/4).
+  if (!(brdf_.anisotropy > 0.0f)) return brdf_.roughness;
+  return std::sqrt(std::sqrt(brdf_.alpha_x() * brdf_.alpha_y()));
+}
+
 }  // namespace pb

@@ -1,10 +1,11 @@
 // glTF's material at a surface point (docs/materials.md): the Bsdf every stage asks, of
 // directions in world space (the pure functions it is made of are in bsdf/scattering.h).
 // Directions point away from the surface; n is the side the incoming direction is on. Its
-// definitions, by operation: bsdf.cpp (construction), bsdf_eval.cpp (eval, pdf and the
-// layering), bsdf_bounds.cpp (max_f), bsdf_sample.cpp (sampling), bsdf_delta.cpp (delta branches
-// and dispersion), bsdf_glass.cpp (rough glass, diffuse transmission) and bsdf_lobe_split.cpp
-// (SPPM's lobe split).
+// definitions, by operation: bsdf.cpp (construction, lobe_roughness), bsdf_eval.cpp (eval, pdf,
+// the layering, terms() and restricted()), bsdf_bounds.cpp (max_f), bsdf_sample.cpp (sampling,
+// lobe_share), bsdf_delta.cpp (delta branches and dispersion) and bsdf_glass.cpp (rough glass,
+// diffuse transmission). Its terms and restricted() are general; SPPM's lobe split, made of them,
+// is render/lobe_split.h (ESTIMATOR.md section 10).
 #pragma once
 
 #include "bsdf/microfacet.h"
@@ -75,6 +76,27 @@ struct BsdfParams {
   // reflected), as PPM renders them (its fixed points cannot follow a path through a surface).
   bool follows_transmission = true;
   static BsdfParams of(const Material& m);  // the factors alone (no textures)
+};
+
+// The terms of a Bsdf's non-delta part (Bsdf::terms), and a set of them (Bsdf::restricted): the
+// diffuse base, the base's GGX lobe, the clear coat's GGX lobe, the sheen, rough glass and
+// diffuse transmission.
+enum class Term : uint8_t { Diffuse, Lobe, Coat, Sheen, Glass, Transmission };
+
+class TermSet {
+ public:
+  constexpr TermSet() = default;
+  static constexpr TermSet all() { return TermSet(uint8_t((1u << 6) - 1u)); }
+  constexpr bool has(Term t) const { return (bits_ >> unsigned(t)) & 1u; }
+  constexpr TermSet with(Term t, bool add = true) const {
+    return add ? TermSet(uint8_t(bits_ | (1u << unsigned(t)))) : *this;
+  }
+  constexpr TermSet operator&(TermSet o) const { return TermSet(uint8_t(bits_ & o.bits_)); }
+  constexpr bool operator==(const TermSet&) const = default;
+
+ private:
+  explicit constexpr TermSet(uint8_t bits) : bits_(bits) {}
+  uint8_t bits_ = 0;
 };
 
 // A material's scattering at one surface point, as World::surface() makes it: the one thing
@@ -183,33 +205,46 @@ class Bsdf {
   // mirror when the directions agree); the others are weighted by 1 - k.
   int delta_branches(const vec3& wo, Transport mode, SpecularBranch out[kMaxDeltaBranches]) const;
 
-  // The split SPPM's camera paths make at a rough GGX lobe (camera_paths.h, ESTIMATOR.md
-  // section 10): the non-delta part is the diffuse base plus the lobe (MetalRoughBrdf's
-  // eval_diffuse and eval_specular), and a path may follow the lobe by sampling it and gather
-  // photons at the base alone. Rough glass is always followed (photons that cross the surface
-  // are not gathered), and with it the base's GGX lobe.
-  // True when the non-delta part has a GGX lobe that is not a mirror, of roughness below
-  // `below`, that can reflect something (metal, or a dielectric layer with specular > 0), or a
-  // clear coat's lobe (not a mirror) of roughness below `below`, or rough glass. The lobes below
-  // `below` are followed, the rest (the diffuse base, and a lobe at or above `below`) gathered.
-  bool has_lobe_below(float below) const;
-  // The probability of following the lobe instead of gathering at the base: the lobe's share
-  // of the two parts' albedo estimates (MetalRoughBrdf::specular_probability); 1 where the
-  // base is black (metal).
-  float lobe_probability(const vec3& wo, float below) const;
-  // This Bsdf with its non-delta part restricted to the base (base_part) or the lobe
-  // (lobe_part): eval, max_f and pdf of that term alone, and sample() draws from it alone
-  // (never a delta branch; delta_branches() is unchanged).
-  // Only for a Bsdf with has_lobe_below(1) (any lobe).
-  Bsdf base_part(float below) const;
-  Bsdf lobe_part(float below) const;
-  // A visible point on base_part() is where a camera path chose not to follow the lobe after
-  // it had counted the vertex's direct light with the whole Bsdf: the next-event stage skips it.
-  bool is_base_part() const { return part_ == Part::Base; }
+  // The non-delta part's terms and their estimates, for an integrator that treats them apart
+  // (SPPM's lobe split, render/lobe_split.h). terms() are those this Bsdf has (and keeps): the
+  // diffuse base and the base's GGX lobe (not a mirror), the clear coat's GGX lobe (not a
+  // mirror), the sheen, rough glass and diffuse transmission (a Lambertian Bsdf: its diffuse
+  // base, whatever it keeps; a delta-only one: none).
+  TermSet terms() const;
+  // A clear coat or a sheen lies over the material: the non-delta part is the mixture of its
+  // first four terms (term_albedos picks among them); without one the diffuse base and the lobe
+  // are MetalRoughBrdf's two parts (unlayered_albedo, lobe_share).
+  bool layered() const { return coat_ > 0.0f || sheen_max() > 0.0f; }
+  // Estimates of the albedos of the kept terms Term::Diffuse, Lobe, Coat and Sheen, in that
+  // order (0 for absent terms), as the layered non-delta part's sampling picks among them.
+  static constexpr int kLayerTerms = 4;
+  void term_albedos(const vec3& wo, float a[kLayerTerms]) const;
+  // Estimates of rough glass's and diffuse transmission's albedos (bsdf_glass.cpp), kept or not;
+  // meaningful only where the Bsdf has that term.
+  float glass_albedo(const vec3& wo) const;
+  float dt_albedo(const vec3& wo) const;
+  // Without layers: the estimate of the kept diffuse base's and lobe's albedo seen from wo, and the
+  // lobe's share of the two (MetalRoughBrdf:: specular_probability; 1 where the base is black).
+  float unlayered_albedo(const vec3& wo) const {
+    return non_delta_albedo(std::fabs(glm::dot(wo, ns_)));
+  }
+  float lobe_share(const vec3& wo) const;
+  // The base lobe's roughness (an anisotropic lobe as the isotropic one of the same peak D),
+  // and the clear coat's; whether the base lobe can reflect anything (metal, or a dielectric
+  // layer with specular > 0).
+  float lobe_roughness() const;
+  float coat_roughness() const { return coat_roughness_; }
+  bool lobe_reflects() const { return brdf_.metallic > 0.0f || brdf_.specular > 0.0f; }
+  // This Bsdf with its non-delta part restricted to the terms in `keep` (and in its own kept
+  // set): eval, max_f and pdf of those terms alone, and sample() draws from them alone, never a
+  // delta branch (delta_branches() is unchanged). kept() is the set a Bsdf keeps (every term
+  // unless restricted).
+  Bsdf restricted(TermSet keep) const;
+  TermSet kept() const { return keep_; }
+  bool is_restricted() const { return !(keep_ == TermSet::all()); }
 
  private:
   enum class Kind : uint8_t { Lambertian, Layered, Delta };
-  enum class Part : uint8_t { All, Base, Lobe };
   // eval and pdf of the non-delta part in the shading frame of wo's side (both above it).
   vec3 eval_local(const vec3& wo, const vec3& wi, float* pdf) const;
   float non_delta_albedo(float cos_o) const;
@@ -225,40 +260,34 @@ class Bsdf {
   float coat_dv(const vec3& wo, const vec3& wi, float* pdf) const;
   vec3 eval_with_view(const vec3& wo, const vec3& wi, const vec3& v, float* pdf) const;
   // Under a coat or a sheen the non-delta part is up to four terms: the diffuse base, the
-  // base's GGX lobe, the coat's and the sheen; a part (base_part, lobe_part) keeps some.
-  static constexpr int kTerms = 4;  // diffuse, the base's lobe, the coat's lobe, the sheen
+  // base's GGX lobe, the coat's and the sheen; a restricted Bsdf keeps some.
+  static constexpr int kTerms = kLayerTerms;  // diffuse, the base's lobe, the coat's lobe, sheen
   struct Terms {
     bool diffuse, lobe, coat, sheen;
   };
-  bool layered() const { return coat_ > 0.0f || sheen_max() > 0.0f; }
   float sheen_max() const { return max_component(sheen_); }
-  Terms terms() const;
-  void term_albedos(const vec3& wo, float a[kTerms]) const;  // estimates, 0 for absent terms
-  float sheen_scaling(float cos_o, float cos_i) const;       // 1 without a sheen
-  bool follows_lobe(float below) const;
-  bool follows_coat(float below) const;
-  float lobe_roughness() const;  // the base lobe's roughness for --follow-roughness
+  Terms term_flags() const;  // the first four of terms()
+  bool keeps(Term t) const { return keep_.has(t); }
+  float sheen_scaling(float cos_o, float cos_i) const;      // 1 without a sheen
   vec3 diffuse_term(const vec3& wo, const vec3& wi) const;  // local frame, both above
   float lobe_bound(const vec3& wo) const;                   // of F D V of the base's lobe (max_f)
   // The part sample() draws from apart from rough glass.
   bool sample_rest(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out,
                    const vec3& tint) const;
-  // Rough glass (bsdf_glass.cpp), in this part (not a base part's): its f in world directions
+  // Rough glass (bsdf_glass.cpp), if kept: its f in world directions
   // on either side, times the layering above it (the sheen's scaling, 1 - k at the view v),
   // and the density of sample_glass; its draw; the estimate of its albedo that picks it; that
   // of the rest of this part; and a bound of its reflection's F D V (max_f).
-  bool glass_in_part() const { return rough_glass_ && part_ != Part::Base; }
-  // Diffuse transmission (bsdf_glass.cpp), in this part: its f through the surface (local
+  bool glass_in_part() const { return rough_glass_ && keeps(Term::Glass); }
+  // Diffuse transmission (bsdf_glass.cpp), if kept: its f through the surface (local
   // directions, unlayered), its draw (cosine-weighted on the other side) and albedo estimate.
-  bool dt_in_part() const { return dt_ > 0.0f && part_ != Part::Base; }
+  bool dt_in_part() const { return dt_ > 0.0f && keeps(Term::Transmission); }
   vec3 dt_f(const vec3& lo, const vec3& li) const;
   bool sample_dt(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const;
-  float dt_albedo(const vec3& wo) const;
   vec3 glass_fresnel(float cos_h, bool front) const;
   vec3 glass_f(const vec3& lo, const vec3& li, bool front, Transport mode, float* pdf) const;
   vec3 eval_glass(const vec3& wo, const vec3& wi, const vec3& v, Transport mode, float* pdf) const;
   bool sample_glass(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out) const;
-  float glass_albedo(const vec3& wo) const;
   // What the sheen and the coat above leave of a through (or glass) term: exactly, for
   // directions at cosines cos_o, cos_i with the coat read at the view v, and as an estimate of
   // albedo seen from wo.
@@ -271,14 +300,13 @@ class Bsdf {
   bool smooth_ = false;     // GGX lobes below the mirror roughness: delta branches
   bool has_delta_ = false;  // Layered with a delta part too
   bool thin_ = true;
-  bool rough_glass_ = false;     // the transmitting part is a GGX component (bsdf_glass.cpp)
-  float dt_ = 0.0f;              // KHR_materials_diffuse_transmission's share (0: none)
-  vec3 dt_color_{1.0f};          // its colour
-  float dispersion_ = 0.0f;      // KHR_materials_dispersion, of a volume (0: none)
-  Part part_ = Part::All;        // base_part() and lobe_part()
-  bool base_non_delta_ = false;  // the uncoated material has a non-delta part
-  bool coat_smooth_ = false;     // the clear coat is a mirror
-  bool follow_lobe_ = true, follow_coat_ = true;  // which lobes a coated part follows
+  bool rough_glass_ = false;       // the transmitting part is a GGX component (bsdf_glass.cpp)
+  float dt_ = 0.0f;                // KHR_materials_diffuse_transmission's share (0: none)
+  vec3 dt_color_{1.0f};            // its colour
+  float dispersion_ = 0.0f;        // KHR_materials_dispersion, of a volume (0: none)
+  TermSet keep_ = TermSet::all();  // the terms restricted() keeps
+  bool base_non_delta_ = false;    // the uncoated material has a non-delta part
+  bool coat_smooth_ = false;       // the clear coat is a mirror
   // The reflecting parts as one MetalRoughBrdf whose metallic is m / (m + o), scaled by
   // reflect_ = m + o; the Lambertian kind keeps its reflectance in brdf_.base_color.
   MetalRoughBrdf brdf_;

@@ -73,7 +73,7 @@ vec3 Bsdf::max_f(const vec3& wo) const {
   const float mu = brdf_.metallic;
   const vec3 diffuse = (1.0f - mu) / kPi * brdf_.base_color;  // 1 - max F <= 1
   if (layered()) {  // (1 - k) (f_sheen + s f_material) + k D V, k read at wo (the gather's view)
-    const Terms t = terms();
+    const Terms t = term_flags();
     vec3 base(0.0f);
     if (t.diffuse) base += reflect_ * diffuse;
     if (t.lobe) base += vec3(reflect_ * lobe_bound(wo));
@@ -91,8 +91,9 @@ vec3 Bsdf::max_f(const vec3& wo) const {
     return out;
   }
   const vec3 glass(glass_in_part() ? glass_reflection_bound(wo) : 0.0f);
-  if (smooth_ || part_ == Part::Base || !base_non_delta_) return reflect_ * diffuse + glass;
-  return reflect_ * ((part_ == Part::Lobe ? vec3(0.0f) : diffuse) + vec3(lobe_bound(wo))) + glass;
+  const vec3 kept_diffuse = keeps(Term::Diffuse) ? diffuse : vec3(0.0f);
+  if (smooth_ || !keeps(Term::Lobe) || !base_non_delta_) return reflect_ * kept_diffuse + glass;
+  return reflect_ * (kept_diffuse + vec3(lobe_bound(wo))) + glass;
 }
 
 float Bsdf::glass_reflection_bound(const vec3& wo) const {

@@ -14,11 +14,13 @@ using bsdf_detail::Frame;
 vec3 Bsdf::eval_local(const vec3& wo, const vec3& wi, float* pdf) const {
   if (pdf) *pdf = 0.0f;
   if (wo.z <= 0.0f || wi.z <= 0.0f) return vec3(0.0f);
-  if (!smooth_ && part_ == Part::All) {
+  // The kept terms: both (MetalRoughBrdf whole), the lobe alone or the diffuse base alone.
+  if (!smooth_ && keeps(Term::Diffuse) && keeps(Term::Lobe)) {
     if (pdf) *pdf = brdf_.pdf(wo, wi);
     return reflect_ * brdf_.eval(wo, wi);
   }
-  if (part_ == Part::Lobe) {
+  if (!keeps(Term::Diffuse)) {
+    if (!keeps(Term::Lobe) || smooth_) return vec3(0.0f);
     if (pdf) *pdf = brdf_.specular_pdf(wo, wi);
     return reflect_ * brdf_.eval_specular(wo, wi);
   }
@@ -29,8 +31,8 @@ vec3 Bsdf::eval_local(const vec3& wo, const vec3& wi, float* pdf) const {
 vec3 Bsdf::diffuse_term(const vec3& wo, const vec3& wi) const {
   // The mirror limit of appendix B's dielectric: the GGX layer is a delta branch, the diffuse
   // base keeps its weight 1 - max F(v.h) at this pair's half vector (v.h averaged over both
-  // directions, so that f stays reciprocal bit for bit). base_part() is the same term of a
-  // rough lobe (MetalRoughBrdf::eval_diffuse computes it the same way).
+  // directions, so that f stays reciprocal bit for bit). A Bsdf restricted to it keeps the
+  // same term of a rough lobe (MetalRoughBrdf::eval_diffuse computes it the same way).
   const vec3 h = glm::normalize(wo + wi);
   const float v_h = 0.5f * (glm::dot(wo, h) + glm::dot(wi, h));
   const vec3 fr = brdf_.layer_fresnel(v_h);
@@ -65,16 +67,29 @@ float Bsdf::coat_dv(const vec3& wo, const vec3& wi, float* pdf) const {
   return ggx_d(glm::normalize(lo + li), alpha) * ggx_visibility(lo.z, li.z, alpha);
 }
 
-Bsdf::Terms Bsdf::terms() const {
+Bsdf::Terms Bsdf::term_flags() const {
   const bool lobe = base_non_delta_ && !smooth_, coat = coat_lobe(), sheen = sheen_max() > 0.0f;
-  switch (part_) {
-    case Part::Lobe:
-      return {false, lobe && follow_lobe_, coat && follow_coat_, false};
-    case Part::Base:
-      return {base_non_delta_, lobe && !follow_lobe_, coat && !follow_coat_, sheen};
-    default:
-      return {base_non_delta_, lobe, coat, sheen};
-  }
+  return {base_non_delta_ && keeps(Term::Diffuse), lobe && keeps(Term::Lobe),
+          coat && keeps(Term::Coat), sheen && keeps(Term::Sheen)};
+}
+
+TermSet Bsdf::terms() const {
+  if (kind_ == Kind::Lambertian) return TermSet{}.with(Term::Diffuse, keeps(Term::Diffuse));
+  if (kind_ == Kind::Delta) return TermSet{};
+  const Terms t = term_flags();
+  return TermSet{}
+      .with(Term::Diffuse, t.diffuse)
+      .with(Term::Lobe, t.lobe)
+      .with(Term::Coat, t.coat)
+      .with(Term::Sheen, t.sheen)
+      .with(Term::Glass, glass_in_part())
+      .with(Term::Transmission, dt_in_part());
+}
+
+Bsdf Bsdf::restricted(TermSet keep) const {
+  Bsdf b = *this;
+  b.keep_ = keep_ & keep;
+  return b;
 }
 
 float Bsdf::sheen_scaling(float cos_o, float cos_i) const {
@@ -92,7 +107,7 @@ void Bsdf::term_albedos(const vec3& wo, float a[kTerms]) const {
   // normal for the base's lobe, each x (1 - k) and under a sheen x (1 - max(sheen) E); k for
   // the coat's lobe (D V has albedo about 1) and (1 - k) max(sheen) E for the sheen. The floor
   // keeps each term's probability above 0.
-  const Terms t = terms();
+  const Terms t = term_flags();
   const float k = coat_weight(wo), cos_o = std::fabs(glm::dot(wo, ns_));
   const float mu = brdf_.metallic, f0 = max_component(brdf_.dielectric_f0());
   const float sm = sheen_max();
@@ -114,7 +129,7 @@ void Bsdf::term_albedos(const vec3& wo, float a[kTerms]) const {
 vec3 Bsdf::eval_with_view(const vec3& wo, const vec3& wi, const vec3& v, float* pdf) const {
   const Frame f(glm::dot(wo, ng_) > 0.0f ? ns_ : -ns_, tangent_);
   const vec3 lo = f.local(wo), li = f.local(wi);
-  const Terms t = terms();
+  const Terms t = term_flags();
   vec3 under(0.0f);  // everything below the coat
   float p[kTerms] = {0.0f, 0.0f, 0.0f, 0.0f};
   if (lo.z > 0.0f && li.z > 0.0f) {
@@ -164,7 +179,7 @@ float Bsdf::pdf(const vec3& wo, const vec3& wi) const {
     eval_with_view(wo, wi, wo, &p);
   else
     eval_local(f.local(wo), f.local(wi), &p);
-  return has_delta_ && part_ == Part::All ? (1.0f - delta_probability(wo)) * p : p;
+  return has_delta_ && !is_restricted() ? (1.0f - delta_probability(wo)) * p : p;
 }
 
 }  // namespace pb

@@ -16,11 +16,16 @@ float Bsdf::non_delta_albedo(float cos_o) const {
   const float mu = brdf_.metallic, f0 = max_component(brdf_.dielectric_f0());
   const float diffuse =
       (1.0f - mu) * (1.0f - f0) * brdf_.diffuse_weight * max_component(brdf_.base_color);
-  float a = part_ == Part::Lobe ? 0.0f : diffuse;
-  if (!smooth_ && part_ != Part::Base)
+  float a = keeps(Term::Diffuse) ? diffuse : 0.0f;
+  if (!smooth_ && keeps(Term::Lobe))
     a += (1.0f - mu) * (f0 + (brdf_.dielectric_f90() - f0) * schlick_weight(cos_o)) +
          mu * max_component(schlick_fresnel(brdf_.base_color, cos_o));
   return reflect_ * std::max(a, 0.01f);
+}
+
+float Bsdf::lobe_share(const vec3& wo) const {
+  // specular_probability reads only the cosine of wo with the shading normal.
+  return brdf_.specular_probability(vec3(0.0f, 0.0f, std::fabs(glm::dot(wo, ns_))));
 }
 
 float Bsdf::delta_probability(const vec3& wo) const {
@@ -68,10 +73,10 @@ bool Bsdf::sample(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out,
 }
 
 float Bsdf::rest_albedo(const vec3& wo) const {
-  // This part's estimate without rough glass and diffuse transmission: its delta branches (All)
-  // and its non-delta terms.
+  // This part's estimate without rough glass and diffuse transmission: its delta branches
+  // (unless restricted) and its non-delta terms.
   float a = 0.0f;
-  if (part_ == Part::All && has_delta()) {
+  if (!is_restricted() && has_delta()) {
     SpecularBranch b[kMaxDeltaBranches];
     const int n = delta_branches(wo, Transport::Importance, b);
     for (int k = 0; k < n; ++k) a += average(b[k].weight);
@@ -84,7 +89,7 @@ float Bsdf::rest_albedo(const vec3& wo) const {
   // (A diffuse base that transmits all, without a layer or metal, reflects nothing to draw.)
   const bool reflects =
       brdf_.diffuse_weight > 0.0f || brdf_.specular > 0.0f || brdf_.metallic > 0.0f;
-  if (base_non_delta_ && reflects && (part_ == Part::All || follow_lobe_))
+  if (base_non_delta_ && reflects && (keeps(Term::Diffuse) || (keeps(Term::Lobe) && !smooth_)))
     a += non_delta_albedo(std::fabs(glm::dot(wo, ns_)));
   return a;
 }
@@ -107,7 +112,7 @@ bool Bsdf::sample_rest(const vec3& wo, Rng& rng, Transport mode, BsdfSample& out
     return true;
   }
   if (kind_ == Kind::Delta) return sample_delta(wo, rng, mode, out, tint);
-  if (part_ != Part::All) return sample_non_delta(wo, rng, mode, out);  // one term, no delta
+  if (is_restricted()) return sample_non_delta(wo, rng, mode, out);  // kept terms, no delta
   const float pd = delta_probability(wo);
   if (pd > 0.0f) {
     const float u = rng.next_float();  // which part, then that part's numbers
@@ -198,7 +203,8 @@ bool Bsdf::sample_base(const vec3& wo, Rng& rng, BsdfSample& out) const {
   const Frame f(front ? ns_ : -ns_, tangent_);
   const vec3 wo_l = f.local(wo);
   if (wo_l.z <= 0.0f) return false;  // seen from below the shading hemisphere
-  if (part_ == Part::Lobe) {
+  if (!keeps(Term::Diffuse)) {       // the lobe alone
+    if (!keeps(Term::Lobe) || smooth_) return false;
     const float u1 = rng.next_float(), u2 = rng.next_float();
     vec3 wi_l, w;
     float p = 0.0f;
@@ -206,7 +212,7 @@ bool Bsdf::sample_base(const vec3& wo, Rng& rng, BsdfSample& out) const {
     out.wi = f.world(wi_l);
     out.weight = reflect_ * w;
     out.pdf = p;
-  } else if (!smooth_ && part_ == Part::All) {
+  } else if (!smooth_ && keeps(Term::Lobe)) {
     const float u_lobe = rng.next_float(), u1 = rng.next_float(), u2 = rng.next_float();
     vec3 wi_l, w;
     float p = 0.0f;

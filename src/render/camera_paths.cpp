@@ -1,6 +1,7 @@
 #include "render/camera_paths.h"
 
 #include "bsdf/bsdf.h"
+#include "render/lobe_split.h"
 #include "render/next_event.h"
 #include "util/rng.h"
 
@@ -32,8 +33,8 @@ struct CameraPath {
   float origin_error = 0.0f;
   vec3 dir{0.0f};
   vec3 weight{1.0f};
-  dvec3 emission{0.0};     // light the path saw (and its vertices' next-event samples)
-  VisiblePoint point;  // the visible point; f = 0: none
+  dvec3 emission{0.0};  // light the path saw (and its vertices' next-event samples)
+  VisiblePoint point;   // the visible point; f = 0: none
   DiscMoments disc;
   // The ray leaves a followed GGX lobe: the light it finds directly (an emitter, the
   // environment) is that vertex's direct light, which its next-event sample has counted.
@@ -74,16 +75,16 @@ bool beyond_limit_survives(CameraPath& path, const CameraPathInputs& in, vec3& w
   return true;
 }
 
-// A followed GGX lobe below --follow-roughness (section 10): this vertex's direct light with
-// its whole Bsdf (so the choice adds no noise to it), then follow the lobe with p_lobe or gather
-// photons at the diffuse base with 1 - p_lobe, each divided by its probability. Rough glass is
-// followed with all light from photons too (its photons are never gathered); its direct light
-// from the other side is one more sample, through the surface. Sharp rough glass is left out:
-// its light comes from what its paths hit. With the base chosen, w and bsdf become the diffuse
-// base's, whose direct light is counted.
+// A followed GGX lobe below --follow-roughness (section 10; the split: lobe_split.h): this vertex's
+// direct light with its whole Bsdf (so the choice adds no noise to it), then follow the lobe with
+// p_lobe or gather photons at the diffuse base with 1 - p_lobe, each divided by its probability.
+// Rough glass is followed with all light from photons too (its photons are never gathered); its
+// direct light from the other side is one more sample, through the surface. Sharp rough glass is
+// left out: its light comes from what its paths hit. With the base chosen, w and bsdf become the
+// diffuse base's, whose direct light is counted.
 enum class LobeChoice { Followed, PathEnded, Base };
-LobeChoice follow_lobe(CameraPath& path, const CameraPathInputs& in, const Surface& s, const vec3& wo,
-                 vec3& w, Bsdf& bsdf) {
+LobeChoice follow_lobe(CameraPath& path, const CameraPathInputs& in, const Surface& s,
+                       const vec3& wo, vec3& w, Bsdf& bsdf) {
   const bool glass_direct = s.bsdf.glass_lit_directly();
   const bool sharp_glass = s.bsdf.has_rough_glass() && !glass_direct;
   const PointBsdf whole{0, wo, sharp_glass ? s.bsdf.without_glass() : s.bsdf};
@@ -94,9 +95,9 @@ LobeChoice follow_lobe(CameraPath& path, const CameraPathInputs& in, const Surfa
     if (glass_direct || s.bsdf.transmits_diffusely())
       path.emission += direct_light_through(in.world, s, wo, w, glass_direct, path.rng);
   }
-  const float p_lobe = s.bsdf.lobe_probability(wo, in.follow_roughness);
+  const float p_lobe = lobe_probability(s.bsdf, wo, in.follow_roughness);
   if (p_lobe >= 1.0f || (p_lobe > 0.0f && path.rng.next_float() < p_lobe)) {
-    const PointBsdf lobe{0, wo, s.bsdf.lobe_part(in.follow_roughness)};
+    const PointBsdf lobe{0, wo, lobe_part(s.bsdf, in.follow_roughness)};
     path.weight = w / p_lobe;
     path.point = VisiblePoint{};  // no visible point here
     // At or beyond --max-depth the followed path goes on by Russian roulette, as a pass-over
@@ -113,7 +114,7 @@ LobeChoice follow_lobe(CameraPath& path, const CameraPathInputs& in, const Surfa
     return LobeChoice::Followed;
   }
   w /= 1.0f - p_lobe;
-  bsdf = s.bsdf.base_part(in.follow_roughness);  // its direct light: next_event_pass skips it
+  bsdf = base_part(s.bsdf, in.follow_roughness);  // its direct light: next_event_pass skips it
   return LobeChoice::Base;
 }
 
@@ -159,7 +160,7 @@ Step stop_at(CameraPath& path, const CameraPathInputs& in, const Hit& hit, const
   // A sharp lobe is followed at --max-depth too (by roulette beyond it): gathered with it, a
   // rare deep path would give its pixel the lobe's peak f in the sparse-photon bound
   // (ESTIMATOR.md section 12) for good.
-  if (path.depth < in.max_depth + kPassOverDepth && s.bsdf.has_lobe_below(in.follow_roughness)) {
+  if (path.depth < in.max_depth + kPassOverDepth && has_lobe_below(s.bsdf, in.follow_roughness)) {
     switch (follow_lobe(path, in, s, wo, w, bsdf)) {
       case LobeChoice::Followed:
         return Step::Continue;
@@ -227,10 +228,9 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
     std::optional<PointBsdf> g;
     for (;; ++path.depth) {
       Hit hit;
-      const bool found =
-          path.depth == 0
-              ? in.world.camera_hit(path.origin, path.dir, hit)
-              : in.world.trace(path.origin, path.origin_normal, path.origin_error, path.dir, hit);
+      const bool found = path.depth == 0 ? in.world.camera_hit(path.origin, path.dir, hit)
+                                         : in.world.trace(path.origin, path.origin_normal,
+                                                          path.origin_error, path.dir, hit);
       if (!found) {  // the environment (black without one), seen along the path
         if (!path.after_lobe)
           path.emission += dvec3(path.weight * in.world.lights().environment_radiance(path.dir));

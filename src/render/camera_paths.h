@@ -5,7 +5,7 @@
 // the visible point is the first non-delta hit. Where a surface has both (a smooth coat over a
 // diffuse base) the path stops there with Bsdf::delta_probability's complement, and both
 // choices are divided by their probability. At a GGX lobe of roughness below
-// follow_roughness (Bsdf::has_lobe_below) the path chooses, with Bsdf::lobe_probability, to
+// follow_roughness (has_lobe_below, lobe_split.h) the path chooses, with lobe_probability, to
 // follow the lobe (one next-event sample there with the lobe's f, then a direction drawn from
 // the lobe; the emitters and environment the next ray finds directly are not counted again)
 // or to stop with the diffuse base alone: a sharp lobe gathers almost no photons in its cone,
@@ -18,10 +18,10 @@
 // the non-delta part, as a path tracer would, and gathers at the next surface instead.
 #pragma once
 
-#include "world/boundary.h"
-#include "scene/camera.h"
 #include "estimator/estimator.h"
 #include "render/camera_pass.h"
+#include "scene/camera.h"
+#include "world/boundary.h"
 #include "world/world.h"
 
 #include <cstdint>
@@ -47,10 +47,10 @@ struct CameraPathInputs {
 // For pixels [first, first + points.size()) in row-major order: points[k] = pixel first + k's
 // visible point this pass, its f the path throughput times the BRDF (f = 0 when the path ends
 // without one: background, an emitter or a black surface, or the depth limit), and out[k] the
-// pixel's owner values of the pass, whose direct part holds the emission the path saw on its way. A visible point
-// on a non-Lambertian surface keeps the throughput alone in f, and its PointBsdf (point = k)
-// goes to the front of `glossy` (room for points.size()), in pixel order. radii[k] is pixel
-// first + k's search radius this pass; out[k].disc its visible point's disc moments. Returns
+// pixel's owner values of the pass, whose direct part holds the emission the path saw on its way. A
+// visible point on a non-Lambertian surface keeps the throughput alone in f, and its PointBsdf
+// (point = k) goes to the front of `glossy` (room for points.size()), in pixel order. radii[k] is
+// pixel first + k's search radius this pass; out[k].disc its visible point's disc moments. Returns
 // the count of glossy points.
 size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
                             std::span<VisiblePoint> points, std::span<PointBsdf> glossy,

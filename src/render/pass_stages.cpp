@@ -1,5 +1,6 @@
 #include "render/pass_stages.h"
 
+#include "render/lobe_split.h"
 #include "render/next_event.h"
 
 #include "util/parallel.h"
@@ -129,10 +130,10 @@ template void gather_photons<true>(const VisiblePoint&, double, const HashGrid&,
                                    const std::vector<PhotonHit>&, PassSums&);
 template void gather_photons<false>(const VisiblePoint&, double, const HashGrid&,
                                     const std::vector<PhotonHit>&, PassSums&);
-template void gather_photons<true>(const VisiblePoint&, const PointBsdf&, double,
-                                   const HashGrid&, const std::vector<PhotonHit>&, PassSums&);
-template void gather_photons<false>(const VisiblePoint&, const PointBsdf&, double,
-                                    const HashGrid&, const std::vector<PhotonHit>&, PassSums&);
+template void gather_photons<true>(const VisiblePoint&, const PointBsdf&, double, const HashGrid&,
+                                   const std::vector<PhotonHit>&, PassSums&);
+template void gather_photons<false>(const VisiblePoint&, const PointBsdf&, double, const HashGrid&,
+                                    const std::vector<PhotonHit>&, PassSums&);
 
 void gather_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
                  const HashGrid& grid, const std::vector<PhotonHit>& hits, PointBsdfTable glossy,
@@ -168,7 +169,7 @@ void next_event_pass(const World& world, std::span<const VisiblePoint> points,
   for (size_t k = 0; k < points.size(); ++k) {
     if (!(max_component(points[k].f) > 0.0f)) continue;
     const PointBsdf* g = cursor.at(k);
-    if (g && g->bsdf.is_base_part()) continue;  // its camera path counted its direct light
+    if (g && is_base_part(g->bsdf)) continue;  // its camera path counted its direct light
     Rng rng(seed, pass, first + k, Stream::DirectLight);
     out[k].direct += direct_light(world, points[k], g, rng);
   }

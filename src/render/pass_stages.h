@@ -1,6 +1,7 @@
 // The stages of one pass, each a function of plain inputs and outputs; the methods (ppm.h,
 // sppm.h) run them in this order over blocks of points:
-//   0. SPPM only: camera paths trace_visible_points (camera_paths.h) -> visible points, owner values
+//   0. SPPM only: camera paths trace_visible_points (camera_paths.h) -> visible points, owner
+//   values
 //   1. trace photons          PhotonTracer::run (photon_pass.h)       -> hits of a photon range
 //   2. build the grid         build_photon_grid                       -> grid over the hits
 //   3. gather                 gather_pass: photons within each radius  -> PassSums (phi, lap, M)
@@ -10,7 +11,6 @@
 // a pass split across machines reduces a block's PassSums array between 4 and 5.
 #pragma once
 
-#include "world/boundary.h"
 #include "estimator/estimator.h"
 #include "render/camera_pass.h"
 #include "render/hash_grid.h"
@@ -18,6 +18,7 @@
 #include "render/photon_pass.h"
 #include "util/parallel.h"
 #include "util/rng.h"
+#include "world/boundary.h"
 #include "world/world.h"
 
 #include <algorithm>
@@ -74,7 +75,7 @@ void disc_pass(std::span<const VisiblePoint> points, std::span<const PointState>
 
 // Stage 4: adds one next-event sample (ESTIMATOR.md section 4) to out[k].direct for every
 // point with f > 0, Rng keyed by (seed, pass, first + k, DirectLight). A point on a GGX lobe's
-// diffuse base (Bsdf::is_base_part) is skipped: its camera path took its sample.
+// diffuse base (is_base_part, render/lobe_split.h) is skipped: its camera path took its sample.
 void next_event_pass(const World& world, std::span<const VisiblePoint> points,
                      PointBsdfTable glossy, uint64_t seed, uint64_t pass, size_t first,
                      std::span<OwnerValues> out);

@@ -5,6 +5,7 @@
 // draw and by chi-square, reciprocity and albedo: bsdf_properties.h, over the cases below.
 #include "bsdf/bsdf.h"
 #include "bsdf/microfacet.h"
+#include "render/lobe_split.h"
 #include "util/rng.h"
 
 #include "bsdf_properties.h"
@@ -240,13 +241,13 @@ TEST(Anisotropy, AlbedoOfTheDrawsMatchesQuadrature) {
 }
 
 TEST(Anisotropy, FollowedAndGatheredPartsSumToTheWhole) {
-  // SPPM's split (camera_paths.h): base_part + lobe_part = eval (relative 1e-5), and each part
+  // SPPM's split (render/lobe_split.h): base_part + lobe_part = eval (relative 1e-5), and each part
   // samples itself (sample against its own eval and pdf).
   const BsdfCase c = anisotropy_cases()[1];
   const vec3 n = glm::normalize(vec3(0.1f, 0.2f, 1.0f));
   const Bsdf bsdf(c.params, n, n);
-  ASSERT_TRUE(bsdf.has_lobe_below(1.0f));
-  const Bsdf base = bsdf.base_part(1.0f), lobe = bsdf.lobe_part(1.0f);
+  ASSERT_TRUE(has_lobe_below(bsdf, 1.0f));
+  const Bsdf base = base_part(bsdf, 1.0f), lobe = lobe_part(bsdf, 1.0f);
   Rng rng(607, 0, 0, Stream::Test);
   for (int k = 0; k < 5000; ++k) {
     const vec3 wo = random_unit(rng), wi = random_unit(rng);
@@ -271,8 +272,8 @@ TEST(Anisotropy, AMirrorOnlyWhenNarrowInEveryDirection) {
   EXPECT_TRUE(Bsdf(brushed(vec3(0.9f), 1.0f, 0.0f, 0.0f, dir), n, n).is_delta());
   const Bsdf wide(brushed(vec3(0.9f), 1.0f, 0.0f, 0.1f, dir), n, n);
   EXPECT_FALSE(wide.has_delta());
-  EXPECT_TRUE(wide.has_lobe_below(0.05f));
-  EXPECT_FALSE(wide.has_lobe_below(0.005f));
+  EXPECT_TRUE(has_lobe_below(wide, 0.05f));
+  EXPECT_FALSE(has_lobe_below(wide, 0.005f));
   EXPECT_TRUE(Bsdf(brushed(vec3(0.9f), 1.0f, 0.0f, 0.02f, dir), n, n).is_delta());
   const Bsdf along(brushed(vec3(0.9f), 1.0f, 0.5f, 1.0f, n), n, n);
   const Bsdf iso(brushed(vec3(0.9f), 1.0f, 0.5f, 0.0f, n), n, n);

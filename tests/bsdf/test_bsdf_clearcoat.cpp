@@ -3,6 +3,7 @@
 // known in closed form or by quadrature. Per draw and by chi-square (both transport directions),
 // albedo: bsdf_properties.h, over the cases below.
 #include "bsdf/bsdf.h"
+#include "render/lobe_split.h"
 #include "util/rng.h"
 
 #include "bsdf_properties.h"
@@ -166,7 +167,7 @@ std::vector<BsdfCase> clearcoat_cases() {
 PB_BSDF_PROPERTY_CASES(Clearcoat, clearcoat_cases());
 
 TEST(Clearcoat, FollowedAndGatheredPartsSumToTheWholeAndEachSamplesItself) {
-  // SPPM follows the lobes below --follow-roughness (camera_paths.h): under a coat that is the
+  // SPPM follows the lobes below --follow-roughness (render/lobe_split.h): under a coat that is the
   // coat's lobe, the base's, or both. base_part(R) + lobe_part(R) is eval() (relative 1e-5),
   // each part's max_f bounds it, each part samples itself (weight = part eval cos / part pdf,
   // relative 2e-3), and lobe_probability is in (0, 1]. R = 0.5 follows a coat of 0.2 and a base
@@ -187,8 +188,8 @@ TEST(Clearcoat, FollowedAndGatheredPartsSumToTheWholeAndEachSamplesItself) {
   Rng rng(409, 0, 0, Stream::Test);
   for (const Split& c : splits) {
     const vec3 z(0, 0, 1);
-    EXPECT_TRUE(Bsdf(c.p, z, z).has_lobe_below(below)) << c.name;
-    EXPECT_FALSE(Bsdf(c.p, z, z).has_lobe_below(0.1f)) << c.name;
+    EXPECT_TRUE(has_lobe_below(Bsdf(c.p, z, z), below)) << c.name;
+    EXPECT_FALSE(has_lobe_below(Bsdf(c.p, z, z), 0.1f)) << c.name;
     int drawn[2] = {0, 0};
     for (int k = 0; k < 4000; ++k) {
       vec3 ng, ns, nc;
@@ -196,14 +197,14 @@ TEST(Clearcoat, FollowedAndGatheredPartsSumToTheWholeAndEachSamplesItself) {
       BsdfParams p = c.p;
       p.coat_normal = nc;
       const Bsdf bsdf(p, ng, ns);
-      const Bsdf parts[2] = {bsdf.base_part(below), bsdf.lobe_part(below)};
+      const Bsdf parts[2] = {base_part(bsdf, below), lobe_part(bsdf, below)};
       const vec3 wo = random_unit(rng), wi = random_unit(rng);
       const vec3 n = glm::dot(wo, ng) > 0.0f ? ns : -ns;
       if (glm::dot(wo, n) < 0.02f) continue;
       const vec3 whole = bsdf.eval(wo, wi), sum = parts[0].eval(wo, wi) + parts[1].eval(wo, wi);
       for (int ch = 0; ch < 3; ++ch)
         EXPECT_NEAR(sum[ch], whole[ch], 1e-5f * whole[ch] + 1e-9f) << c.name;
-      const float p_lobe = bsdf.lobe_probability(wo, below);
+      const float p_lobe = lobe_probability(bsdf, wo, below);
       EXPECT_TRUE(p_lobe > 0.0f && p_lobe < 1.0f) << c.name;
       for (int part = 0; part < 2; ++part) {
         const Bsdf& b = parts[part];
@@ -221,9 +222,8 @@ TEST(Clearcoat, FollowedAndGatheredPartsSumToTheWholeAndEachSamplesItself) {
   }
   // The followed part under a coat of 0.2 over black: its albedo by sampling is k x the D V
   // albedo by quadrature (4 standard errors + 2e-4), as the whole's was.
-  const Bsdf lobe =
-      Bsdf(coated(vec3(0.0f), 0.0f, 0.6f, 1.0f, 0.2f, 0.0f), vec3(0, 0, 1), vec3(0, 0, 1))
-          .lobe_part(below);
+  const Bsdf lobe = lobe_part(
+      Bsdf(coated(vec3(0.0f), 0.0f, 0.6f, 1.0f, 0.2f, 0.0f), vec3(0, 0, 1), vec3(0, 0, 1)), below);
   MetalRoughBrdf dv;
   dv.base_color = vec3(1.0f);
   dv.metallic = 1.0f;
@@ -346,6 +346,49 @@ TEST(Clearcoat, ZeroCoatIsTheUncoatedMaterialBitForBit) {
     ASSERT_EQ(a.sample(wo, r1, Transport::Importance, s1),
               b.sample(wo, r2, Transport::Importance, s2));
     EXPECT_EQ(s1.wi, s2.wi);
+  }
+}
+
+TEST(Clearcoat, RestrictedKeepsItsTermsAndTheTermsSumToTheWhole) {
+  // Bsdf::restricted, the general operation SPPM's split is made of: every term kept is the
+  // Bsdf itself (bit for bit, delta branches and all); a restricted Bsdf has only the terms it
+  // keeps (terms() within kept()), restricting twice keeps the intersection, and the four
+  // terms of a rough coat over a rough dielectric with a sheen, each alone, sum to eval()
+  // (relative 1e-5).
+  BsdfParams p = coated(vec3(0.6f, 0.5f, 0.4f), 0.3f, 0.4f, 0.8f, 0.3f);
+  p.sheen_color = vec3(0.5f);
+  p.sheen_roughness = 0.5f;
+  const vec3 n(0, 0, 1);
+  const Bsdf bsdf(p, n, n);
+  EXPECT_FALSE(bsdf.is_restricted());
+  const TermSet has = bsdf.terms();
+  for (Term t : {Term::Diffuse, Term::Lobe, Term::Coat, Term::Sheen}) EXPECT_TRUE(has.has(t));
+  EXPECT_FALSE(has.has(Term::Glass));
+  EXPECT_FALSE(has.has(Term::Transmission));
+  const Bsdf same = bsdf.restricted(TermSet::all());
+  EXPECT_FALSE(same.is_restricted());
+  const TermSet diffuse_lobe = TermSet{}.with(Term::Diffuse).with(Term::Lobe);
+  const Bsdf twice = bsdf.restricted(diffuse_lobe).restricted(TermSet{}.with(Term::Lobe));
+  EXPECT_TRUE(twice.is_restricted());
+  EXPECT_EQ(twice.kept(), TermSet{}.with(Term::Lobe));
+  EXPECT_EQ(twice.terms(), TermSet{}.with(Term::Lobe));
+  const Bsdf single[4] = {
+      bsdf.restricted(TermSet{}.with(Term::Diffuse)), bsdf.restricted(TermSet{}.with(Term::Lobe)),
+      bsdf.restricted(TermSet{}.with(Term::Coat)), bsdf.restricted(TermSet{}.with(Term::Sheen))};
+  Rng rng(411, 0, 0, Stream::Test);
+  for (int k = 0; k < 2000; ++k) {
+    const vec3 wo = random_unit(rng), wi = random_unit(rng);
+    if (glm::dot(wo, n) < 0.02f) continue;
+    EXPECT_EQ(same.eval(wo, wi), bsdf.eval(wo, wi));
+    EXPECT_EQ(same.pdf(wo, wi), bsdf.pdf(wo, wi));
+    EXPECT_EQ(same.max_f(wo), bsdf.max_f(wo));
+    vec3 sum(0.0f);
+    for (const Bsdf& b : single) {
+      EXPECT_FALSE(b.has_rough_glass());
+      sum += b.eval(wo, wi);
+    }
+    const vec3 whole = bsdf.eval(wo, wi);
+    for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(sum[ch], whole[ch], 1e-5f * whole[ch] + 1e-9f);
   }
 }
 

@@ -4,6 +4,7 @@
 // adjoint (photon) use, and thin against volumetric glass. Per draw (delta draws included) and by
 // chi-square, reciprocity and albedo: bsdf_properties.h, over the cases below.
 #include "bsdf/bsdf.h"
+#include "render/lobe_split.h"
 #include "util/rng.h"
 
 #include "bsdf_properties.h"
@@ -221,19 +222,19 @@ SampledAlbedo sampled_albedo(const Bsdf& bsdf, const vec3& wo, Rng& rng, int n =
 }
 
 TEST(GltfBsdf, BaseAndLobeSumToTheWholeAndEachSamplesItself) {
-  // SPPM's camera paths split a rough lobe off (camera_paths.h): base_part() + lobe_part() must
-  // be eval() (relative 1e-5: the two sums round differently), each part's max_f must bound it,
-  // and each part's sample() must draw from that part alone (weight = part eval cos / part pdf,
+  // SPPM's camera paths split a rough lobe off (render/lobe_split.h): base_part() + lobe_part()
+  // must be eval() (relative 1e-5: the two sums round differently), each part's max_f must bound
+  // it, and each part's sample() must draw from that part alone (weight = part eval cos / part pdf,
   // never a delta branch; relative 2e-3 as above). Which cases have a lobe is fixed.
   Rng rng(311, 0, 0, Stream::Test);
   int with_lobe = 0;
   for (const BsdfCase& c : gltf_cases()) {
     const Bsdf probe(c.params, vec3(0, 0, 1), vec3(0, 0, 1));
-    const bool lobe = probe.has_lobe_below(1.0f);
+    const bool lobe = has_lobe_below(probe, 1.0f);
     EXPECT_EQ(lobe, c.params.roughness >= kDefaultMirrorRoughness &&
                         !(c.params.metallic == 0.0f && c.params.specular == 0.0f))
         << c.name;
-    EXPECT_FALSE(probe.has_lobe_below(c.params.roughness)) << c.name;  // strictly below
+    EXPECT_FALSE(has_lobe_below(probe, c.params.roughness)) << c.name;  // strictly below
     if (!lobe) continue;
     ++with_lobe;
     int drawn[2] = {0, 0};
@@ -241,13 +242,13 @@ TEST(GltfBsdf, BaseAndLobeSumToTheWholeAndEachSamplesItself) {
       vec3 ng, ns;
       random_normals(rng, ng, ns);
       const Bsdf bsdf(c.params, ng, ns);
-      const Bsdf parts[2] = {bsdf.base_part(1.0f), bsdf.lobe_part(1.0f)};
+      const Bsdf parts[2] = {base_part(bsdf, 1.0f), lobe_part(bsdf, 1.0f)};
       const vec3 wo = random_unit(rng), wi = random_unit(rng);
       const vec3 n = glm::dot(wo, ng) > 0.0f ? ns : -ns;
       if (glm::dot(wo, n) < 0.02f) continue;
       const vec3 whole = bsdf.eval(wo, wi), sum = parts[0].eval(wo, wi) + parts[1].eval(wo, wi);
       for (int ch = 0; ch < 3; ++ch) EXPECT_NEAR(sum[ch], whole[ch], 1e-5f * whole[ch]) << c.name;
-      const float p_lobe = bsdf.lobe_probability(wo, 1.0f);
+      const float p_lobe = lobe_probability(bsdf, wo, 1.0f);
       EXPECT_TRUE(p_lobe > 0.0f && p_lobe <= 1.0f) << c.name;
       if (c.params.metallic == 1.0f) EXPECT_EQ(p_lobe, 1.0f) << c.name;  // no base to gather at
       for (int part = 0; part < 2; ++part) {
@@ -276,7 +277,7 @@ TEST(GltfBsdf, LobeAlbedoByItsSamplerEqualsItsQuadrature) {
   const Basis f(ng);
   for (const BsdfParams& p : {params(vec3(0.9f, 0.6f, 0.5f), 1.0f, 0.15f),
                               params(vec3(0.6f), 0.0f, 0.3f), params(vec3(0.6f), 0.5f, 0.45f)}) {
-    const Bsdf lobe = Bsdf(p, ng, ng).lobe_part(1.0f);
+    const Bsdf lobe = lobe_part(Bsdf(p, ng, ng), 1.0f);
     MetalRoughBrdf only = brdf_of(p);
     for (double mu : {0.9, 0.5, 0.2}) {
       const vec3 wo = f.world(std::acos(mu), 1.1);

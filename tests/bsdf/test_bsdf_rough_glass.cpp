@@ -6,6 +6,7 @@
 // each bin (so the draws are unbiased wherever they go); a small roughness tends to the smooth
 // glass; a white thin wall reflects and transmits the whole white GGX lobe.
 #include "bsdf/bsdf.h"
+#include "render/lobe_split.h"
 #include "util/rng.h"
 
 #include "bsdf_properties.h"
@@ -196,8 +197,8 @@ TEST(RoughGlass, FollowedAlwaysAndNeverADeltaBranch) {
   // glass (follows_transmission false) is the delta branches it was.
   const vec3 n(0, 0, 1), wo = glm::normalize(vec3(0.3f, 0.0f, 1.0f));
   const Bsdf rough = make(glass(0.4f, false), true);
-  EXPECT_TRUE(rough.has_lobe_below(0.0f));
-  EXPECT_FLOAT_EQ(rough.lobe_probability(wo, 0.0f), 1.0f);
+  EXPECT_TRUE(has_lobe_below(rough, 0.0f));
+  EXPECT_FLOAT_EQ(lobe_probability(rough, wo, 0.0f), 1.0f);
   EXPECT_EQ(rough.delta_probability(wo), 0.0f);
   SpecularBranch br[kMaxDeltaBranches];
   EXPECT_EQ(rough.delta_branches(wo, Transport::Radiance, br), 0);
@@ -211,14 +212,14 @@ TEST(RoughGlass, FollowedAlwaysAndNeverADeltaBranch) {
   BsdfParams half = glass(0.6f, true, vec3(0.5f));
   half.transmission = 0.5f;
   const Bsdf mixed(half, n, n);
-  const float p = mixed.lobe_probability(wo, 0.0f);
+  const float p = lobe_probability(mixed, wo, 0.0f);
   EXPECT_GT(p, 0.0f);
   EXPECT_LT(p, 1.0f);
   const vec3 wi = glm::normalize(vec3(-0.2f, 0.1f, 0.9f));
-  const vec3 sum = mixed.base_part(0.0f).eval(wo, wi) + mixed.lobe_part(0.0f).eval(wo, wi);
+  const vec3 sum = base_part(mixed, 0.0f).eval(wo, wi) + lobe_part(mixed, 0.0f).eval(wo, wi);
   const vec3 whole = mixed.eval(wo, wi);
   for (int c = 0; c < 3; ++c) EXPECT_NEAR(sum[c], whole[c], 1e-5f * whole[c]);
-  EXPECT_GT(mixed.base_part(0.0f).eval(wo, wi).x, 0.0f);
+  EXPECT_GT(base_part(mixed, 0.0f).eval(wo, wi).x, 0.0f);
 }
 
 // The suite's cases (bsdf_properties.h): a thin wall and a tinted volume. Their draws through
