@@ -181,32 +181,25 @@ std::vector<uint32_t> Loader::indices(size_t mesh, size_t p, const DracoPrimitiv
   return tris;
 }
 
-void Loader::add_primitive(size_t mesh_index, size_t p, const Instance& inst) {
-  const tinygltf::Mesh& gm = m_.meshes[mesh_index];
-  const tinygltf::Primitive& prim = gm.primitives[p];
-  const std::string ml = label("mesh", gm.name, mesh_index);
-  const std::string where = ml + " primitive " + std::to_string(p);
+// Whether the mode is drawn (glTF 2.0 section 3.7.2.1): triangles; points, lines warn; others fail.
+bool Loader::drawn_mode(const tinygltf::Primitive& prim, const std::string& where) {
   // Points and lines have no area: nothing of theirs reflects light. A file that mixes them with
   // surfaces (a wireframe overlay, a point cloud beside a model) renders its surfaces.
   if (prim.mode >= TINYGLTF_MODE_POINTS && prim.mode <= TINYGLTF_MODE_LINE_STRIP) {
     warn(where + " uses mode " + mode_name(prim.mode) +
          ": points and lines have no area and are not drawn");
     ++skipped_points_lines_;
-    return;
+    return false;
   }
   if (prim.mode != TINYGLTF_MODE_TRIANGLES && prim.mode != TINYGLTF_MODE_TRIANGLE_STRIP &&
       prim.mode != TINYGLTF_MODE_TRIANGLE_FAN)
     fail(where + " uses mode " + mode_name(prim.mode) + ", which glTF 2.0 does not define");
-  if (!prim.attributes.count("POSITION")) fail(where + " has no POSITION attribute");
-  const DracoPrimitive* dp = draco(mesh_index, p, where);
-  const View pos = *attribute(prim, dp, "POSITION", where);
-  if (pos.count > UINT32_MAX) fail(where + " has more than 2^32 vertices");
-  // The shape a viewer draws: the base plus the morph targets at the instance's weights, placed
-  // by the node or, skinned, by its joints.
-  const std::vector<dvec3> moved = morph_offsets(prim, dp, inst, "POSITION", pos.count, where);
-  const Placement place = placement(prim, dp, inst, pos.count, where);
-  Mesh out;
-  out.name = gm.name.empty() ? "mesh " + std::to_string(mesh_index) : gm.name;
+  return true;
+}
+
+// out.positions: POSITION plus the morph offsets, placed in world space, validated.
+void Loader::read_positions(Mesh& out, const View& pos, const std::vector<dvec3>& moved,
+                            const Placement& place, const std::string& ml) {
   out.positions.resize(pos.count);
   for (size_t i = 0; i < pos.count; ++i) {
     const dvec3 local = pos.vec3(i);
@@ -218,33 +211,44 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Instance& inst) {
            std::to_string(i) + ")");
     out.positions[i] = vec3(w - scene_.origin);
   }
-  if (const std::optional<View> nor = attribute(prim, dp, "NORMAL", where)) {
-    if (nor->count != pos.count)
-      fail(where + " has " + std::to_string(nor->count) + " normals for " +
-           std::to_string(pos.count) + " positions");
-    const std::vector<dvec3> bent = morph_offsets(prim, dp, inst, "NORMAL", pos.count, where);
-    out.normals.resize(nor->count);
-    for (size_t i = 0; i < nor->count; ++i) {
-      const dvec3 local = nor->vec3(i);
-      if (!is_finite(vec3(local)))
-        fail(ml + " has a non-finite vertex coordinate (NORMAL, vertex " + std::to_string(i) + ")");
-      const dvec3 w = place.normal(i, bent.empty() ? local : local + bent[i]);
-      const dvec3 unit = w / glm::length(w);
-      out.normals[i] = vec3(unit);
-      if (!(std::abs(glm::length(unit) - 1.0) < 1e-6)) {
-        warn(ml + ": zero or non-finite normals after transform; its normals are dropped");
-        out.normals.clear();
-        break;
-      }
+}
+
+// out.normals: NORMAL (glTF 2.0 "Meshes") plus its morph offsets, placed; none if one vanishes.
+void Loader::read_normals(Mesh& out, const tinygltf::Primitive& prim, const DracoPrimitive* dp,
+                          const Instance& inst, const Placement& place, size_t vertices,
+                          const std::string& ml, const std::string& where) {
+  const std::optional<View> nor = attribute(prim, dp, "NORMAL", where);
+  if (!nor) return;
+  if (nor->count != vertices)
+    fail(where + " has " + std::to_string(nor->count) + " normals for " + std::to_string(vertices) +
+         " positions");
+  const std::vector<dvec3> bent = morph_offsets(prim, dp, inst, "NORMAL", vertices, where);
+  out.normals.resize(nor->count);
+  for (size_t i = 0; i < nor->count; ++i) {
+    const dvec3 local = nor->vec3(i);
+    if (!is_finite(vec3(local)))
+      fail(ml + " has a non-finite vertex coordinate (NORMAL, vertex " + std::to_string(i) + ")");
+    const dvec3 w = place.normal(i, bent.empty() ? local : local + bent[i]);
+    const dvec3 unit = w / glm::length(w);
+    out.normals[i] = vec3(unit);
+    if (!(std::abs(glm::length(unit) - 1.0) < 1e-6)) {
+      warn(ml + ": zero or non-finite normals after transform; its normals are dropped");
+      out.normals.clear();
+      break;
     }
   }
+}
+
+// out.texcoords: TEXCOORD_0 and TEXCOORD_1 (glTF 2.0 "Meshes"), validated.
+void Loader::read_texcoords(Mesh& out, const tinygltf::Primitive& prim, const DracoPrimitive* dp,
+                            size_t vertices, const std::string& ml, const std::string& where) {
   for (int set = 0; set < 2; ++set) {
     const std::string name = "TEXCOORD_" + std::to_string(set);
     const std::optional<View> uv = attribute(prim, dp, name, where);
     if (!uv) continue;
-    if (uv->count != pos.count)
+    if (uv->count != vertices)
       fail(where + " has " + std::to_string(uv->count) + " " + name + " values for " +
-           std::to_string(pos.count) + " positions");
+           std::to_string(vertices) + " positions");
     std::vector<vec2>& dst = out.texcoords[set];
     dst.resize(uv->count);
     for (size_t i = 0; i < uv->count; ++i) {
@@ -254,40 +258,47 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Instance& inst) {
              std::to_string(i) + ")");
     }
   }
-  if (const std::optional<View> col = attribute(prim, dp, "COLOR_0", where)) {
-    // glTF 2.0 "Meshes": COLOR_0 multiplies the base colour, as float or normalised unsigned
-    // bytes or shorts in [0, 1]; an RGB attribute has alpha 1.
-    if (col->count != pos.count)
-      fail(where + " has " + std::to_string(col->count) + " COLOR_0 values for " +
-           std::to_string(pos.count) + " positions");
-    const bool integer = col->component != TINYGLTF_COMPONENT_TYPE_FLOAT;
-    if (col->component == TINYGLTF_COMPONENT_TYPE_BYTE ||
-        col->component == TINYGLTF_COMPONENT_TYPE_SHORT)
-      fail(where + " COLOR_0 has componentType " + component_name(col->component) +
-           "; expected FLOAT, UNSIGNED_BYTE or UNSIGNED_SHORT");
-    View v = *col;
-    if (integer && !v.normalized) {
-      warn(where + ": COLOR_0 is not marked normalized; read as normalised, as glTF requires");
-      v.normalized = true;
-    }
-    out.colors.resize(v.count);
-    bool clamped = false;
-    for (size_t i = 0; i < v.count; ++i) {
-      glm::vec4 c(1.0f);
-      for (int k = 0; k < v.components; ++k) {
-        const double x = v.scalar(i, k);
-        if (!std::isfinite(x))
-          fail(ml + " has a non-finite COLOR_0 value (vertex " + std::to_string(i) + ")");
-        clamped = clamped || x < 0.0 || x > 1.0;
-        c[k] = float(std::clamp(x, 0.0, 1.0));
-      }
-      out.colors[i] = c;
-    }
-    if (clamped) warn(where + ": COLOR_0 values outside [0, 1] are clamped to it");
+}
+
+// out.colors: COLOR_0 as RGBA in [0, 1] (glTF 2.0 "Meshes"), with its warnings.
+void Loader::read_colors(Mesh& out, const tinygltf::Primitive& prim, const DracoPrimitive* dp,
+                         size_t vertices, const std::string& ml, const std::string& where) {
+  const std::optional<View> col = attribute(prim, dp, "COLOR_0", where);
+  if (!col) return;
+  // glTF 2.0 "Meshes": COLOR_0 multiplies the base colour, as float or normalised unsigned
+  // bytes or shorts in [0, 1]; an RGB attribute has alpha 1.
+  if (col->count != vertices)
+    fail(where + " has " + std::to_string(col->count) + " COLOR_0 values for " +
+         std::to_string(vertices) + " positions");
+  const bool integer = col->component != TINYGLTF_COMPONENT_TYPE_FLOAT;
+  if (col->component == TINYGLTF_COMPONENT_TYPE_BYTE ||
+      col->component == TINYGLTF_COMPONENT_TYPE_SHORT)
+    fail(where + " COLOR_0 has componentType " + component_name(col->component) +
+         "; expected FLOAT, UNSIGNED_BYTE or UNSIGNED_SHORT");
+  View v = *col;
+  if (integer && !v.normalized) {
+    warn(where + ": COLOR_0 is not marked normalized; read as normalised, as glTF requires");
+    v.normalized = true;
   }
-  const std::vector<uint32_t> idx = indices(mesh_index, p, dp, pos.count, where);
-  out.material = material(prim.material, where);
-  const bool flip = place.flip;  // a mirroring transform: keep the counter-clockwise front
+  out.colors.resize(v.count);
+  bool clamped = false;
+  for (size_t i = 0; i < v.count; ++i) {
+    glm::vec4 c(1.0f);
+    for (int k = 0; k < v.components; ++k) {
+      const double x = v.scalar(i, k);
+      if (!std::isfinite(x))
+        fail(ml + " has a non-finite COLOR_0 value (vertex " + std::to_string(i) + ")");
+      clamped = clamped || x < 0.0 || x > 1.0;
+      c[k] = float(std::clamp(x, 0.0, 1.0));
+    }
+    out.colors[i] = c;
+  }
+  if (clamped) warn(where + ": COLOR_0 values outside [0, 1] are clamped to it");
+}
+
+// out.indices: the triangles of idx, front kept counter-clockwise, degenerate ones counted.
+void Loader::add_triangles(Mesh& out, const std::vector<uint32_t>& idx, bool flip) {
+  // flip: a mirroring transform; swapping two corners keeps the counter-clockwise front.
   for (size_t t = 0; t < idx.size(); t += 3) {
     const uint32_t a = idx[t], b = idx[t + (flip ? 2 : 1)], c = idx[t + (flip ? 1 : 2)];
     if (degenerate(out.positions, a, b, c)) {
@@ -296,12 +307,44 @@ void Loader::add_primitive(size_t mesh_index, size_t p, const Instance& inst) {
     }
     out.indices.insert(out.indices.end(), {a, b, c});
   }
-  if (out.indices.empty()) return;
+}
+
+// The warning for each texture coordinate set the mesh's material reads and the mesh lacks.
+void Loader::warn_missing_texcoords(const Mesh& out, const std::string& ml) {
   const Material& mat = scene_.materials[out.material];
   for (int set = 0; set < 2; ++set)
     if (uses_set(mat, set) && out.texcoords[set].empty())
       warn(ml + ": its material's textures read TEXCOORD_" + std::to_string(set) +
            ", which it does not have (one texel is read)");
+}
+
+// A primitive's scene mesh by phases: mode, decoding and placement, attributes, triangles,
+// tangents.
+void Loader::add_primitive(size_t mesh_index, size_t p, const Instance& inst) {
+  const tinygltf::Mesh& gm = m_.meshes[mesh_index];
+  const tinygltf::Primitive& prim = gm.primitives[p];
+  const std::string ml = label("mesh", gm.name, mesh_index);
+  const std::string where = ml + " primitive " + std::to_string(p);
+  if (!drawn_mode(prim, where)) return;
+  if (!prim.attributes.count("POSITION")) fail(where + " has no POSITION attribute");
+  const DracoPrimitive* dp = draco(mesh_index, p, where);
+  const View pos = *attribute(prim, dp, "POSITION", where);
+  if (pos.count > UINT32_MAX) fail(where + " has more than 2^32 vertices");
+  // The shape a viewer draws: the base plus the morph targets at the instance's weights, placed
+  // by the node or, skinned, by its joints.
+  const std::vector<dvec3> moved = morph_offsets(prim, dp, inst, "POSITION", pos.count, where);
+  const Placement place = placement(prim, dp, inst, pos.count, where);
+  Mesh out;
+  out.name = gm.name.empty() ? "mesh " + std::to_string(mesh_index) : gm.name;
+  read_positions(out, pos, moved, place, ml);
+  read_normals(out, prim, dp, inst, place, pos.count, ml, where);
+  read_texcoords(out, prim, dp, pos.count, ml, where);
+  read_colors(out, prim, dp, pos.count, ml, where);
+  const std::vector<uint32_t> idx = indices(mesh_index, p, dp, pos.count, where);
+  out.material = material(prim.material, where);
+  add_triangles(out, idx, place.flip);
+  if (out.indices.empty()) return;
+  warn_missing_texcoords(out, ml);
   add_tangents(out, prim, dp, place, morph_offsets(prim, dp, inst, "TANGENT", pos.count, where),
                where);
   scene_.meshes.push_back(std::move(out));

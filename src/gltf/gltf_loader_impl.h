@@ -1,8 +1,9 @@
 // The glTF loader's internals, shared by its translation units (src/gltf/gltf_loader.cpp: parsing,
-// the node walk and the final checks; src/gltf/gltf_accessor.cpp: accessors, sparse substitution and
-// EXT_meshopt_compression bufferViews; src/gltf/gltf_geometry.cpp: primitives, quantised attributes
-// and KHR_draco_mesh_compression; src/gltf/gltf_material.cpp: materials, lights and cameras;
-// src/gltf/gltf_texture.cpp: textures, images and tangents). Only these files see tinygltf types.
+// the node walk and the final checks; src/gltf/gltf_accessor.cpp: accessors, sparse substitution
+// and EXT_meshopt_compression bufferViews; src/gltf/gltf_geometry.cpp: primitives, quantised
+// attributes and KHR_draco_mesh_compression; src/gltf/gltf_material.cpp: materials, lights and
+// cameras; src/gltf/gltf_texture.cpp: textures, images and tangents). Only these files see tinygltf
+// types.
 #pragma once
 
 #include "gltf/gltf_loader.h"
@@ -118,6 +119,19 @@ class Loader {
   std::vector<uint32_t> indices(size_t mesh, size_t prim, const DracoPrimitive* draco,
                                 size_t vertices, const std::string& where);
   void add_primitive(size_t mesh, size_t prim, const Instance& inst);
+  // add_primitive()'s phases: the mode, the attributes, the triangles and a missing set's warning.
+  bool drawn_mode(const tinygltf::Primitive& prim, const std::string& where);
+  void read_positions(Mesh& out, const View& pos, const std::vector<dvec3>& moved,
+                      const Placement& place, const std::string& ml);
+  void read_normals(Mesh& out, const tinygltf::Primitive& prim, const DracoPrimitive* dp,
+                    const Instance& inst, const Placement& place, size_t vertices,
+                    const std::string& ml, const std::string& where);
+  void read_texcoords(Mesh& out, const tinygltf::Primitive& prim, const DracoPrimitive* dp,
+                      size_t vertices, const std::string& ml, const std::string& where);
+  void read_colors(Mesh& out, const tinygltf::Primitive& prim, const DracoPrimitive* dp,
+                   size_t vertices, const std::string& ml, const std::string& where);
+  void add_triangles(Mesh& out, const std::vector<uint32_t>& idx, bool flip);
+  void warn_missing_texcoords(const Mesh& out, const std::string& ml);
   // gltf_deform.cpp: morph targets at the instance's weights, skins at the joints' poses.
   std::vector<dvec3> morph_offsets(const tinygltf::Primitive& prim, const DracoPrimitive* dp,
                                    const Instance& inst, const char* attribute, size_t count,

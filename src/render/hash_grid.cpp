@@ -86,19 +86,24 @@ void HashGrid::build_level(Level& lv, std::span<const vec3> positions, int bits)
   lv.start[table] = uint32_t(n);
 }
 
-// level_of() is exact: r_min * 2^k >= r  <=>  r / r_min <= 2^k, and the double quotient of two
-// floats cannot round across a power of two (a ratio of 24-bit mantissas above 1 exceeds it by
-// at least 2^-24), so frexp() of the quotient gives the exact smallest k. With all radii equal
-// every radius maps to level 0 and exactly one level is built.
-void HashGrid::build(std::span<const vec3> positions, std::span<const float> radii) {
-  // Validate everything before touching state, so a throw leaves the previous grid usable. The
-  // scans run over fixed blocks in parallel (min, max and the bounds do not depend on order).
+namespace {
+
+// What validate_inputs() finds: the radii's range and the photons' bounds.
+struct InputRange {
+  float r_min = std::numeric_limits<float>::infinity(), r_max = 0.0f;
+  Bounds bounds;
+};
+
+// The radii's range and the photons' bounds, or a throw before any state is touched.
+InputRange validate_inputs(std::span<const vec3> positions, std::span<const float> radii) {
   struct Scan {
     float r_min = std::numeric_limits<float>::infinity(), r_max = 0.0f;
     bool bad_radius = false, bad_position = false;
     float first_bad = 0.0f;
     Bounds bounds;
   };
+  // A throw leaves the previous grid usable. The scans run over fixed blocks in parallel (min,
+  // max and the bounds do not depend on order).
   Scan scans[kBlocks];
   const size_t rblock = (radii.size() + kBlocks - 1) / kBlocks;
   const size_t pblock = (positions.size() + kBlocks - 1) / kBlocks;
@@ -120,33 +125,37 @@ void HashGrid::build(std::span<const vec3> positions, std::span<const float> rad
       }
     }
   });
-  float r_min = std::numeric_limits<float>::infinity(), r_max = 0.0f;
-  Bounds bounds;
+  InputRange in;
   for (const Scan& sc : scans) {
     if (sc.bad_radius)
       throw std::invalid_argument("HashGrid::build: query radius " + std::to_string(sc.first_bad) +
                                   " is not finite and > 0");
-    r_min = std::min(r_min, sc.r_min);
-    r_max = std::max(r_max, sc.r_max);
-    bounds.lo = glm::min(bounds.lo, sc.bounds.lo);
-    bounds.hi = glm::max(bounds.hi, sc.bounds.hi);
+    in.r_min = std::min(in.r_min, sc.r_min);
+    in.r_max = std::max(in.r_max, sc.r_max);
+    in.bounds.lo = glm::min(in.bounds.lo, sc.bounds.lo);
+    in.bounds.hi = glm::max(in.bounds.hi, sc.bounds.hi);
   }
   // Bucket indices are stored as uint32 and a table holds 2^b >= n buckets.
   if (positions.size() > (size_t(1) << 31))
     throw std::length_error("HashGrid::build: more than 2^31 photons");
   for (const Scan& sc : scans)
     if (sc.bad_position) throw std::invalid_argument("HashGrid::build: non-finite photon position");
+  return in;
+}
 
-  const size_t n = positions.size();
-  photon_count_ = n;
-  r_min_ = r_min;
-  level_count_ = 0;
-  level_map_.clear();
-  if (n == 0 || radii.empty()) return;
+}  // namespace
 
-  // Mark the levels the radii use; build those, in ascending k, into slots 0, 1, ...
+// level_of() is exact: r_min * 2^k >= r  <=>  r / r_min <= 2^k, and the double quotient of two
+// floats cannot round across a power of two (a ratio of 24-bit mantissas above 1 exceeds it by
+// at least 2^-24), so frexp() of the quotient gives the exact smallest k. With all radii equal
+// every radius maps to level 0 and exactly one level is built.
+
+// Which levels the radii R_j (ESTIMATOR.md section 3) use, in used_ and level_map_; the top one.
+int HashGrid::choose_levels(std::span<const float> radii, float r_min, float r_max) {
+  const size_t rblock = (radii.size() + kBlocks - 1) / kBlocks;
   const int top = level_of(r_max, r_min);
   const size_t levels = size_t(top) + 1;
+  // Mark the levels the radii use; build those, in ascending k, into slots 0, 1, ...
   used_.assign(kBlocks * levels, 0);  // per block, then merged into the first block's row
   parallel_for(kBlocks, 1, [&](size_t b0, size_t b1) {
     for (size_t b = b0; b < b1; ++b)
@@ -166,23 +175,39 @@ void HashGrid::build(std::span<const vec3> positions, std::span<const float> rad
   // Slots beyond this build's levels give their memory back: a render that once used more
   // levels (radii spread wider) must not keep a photon array per level it no longer has.
   for (size_t i = size_t(level_count_); i < levels_.size(); ++i) levels_[i] = Level{};
+  return top;
+}
 
+// A level's cells: their size, the hash's shift and the cell range of the photons' bounds.
+void HashGrid::size_level(Level& lv, double cell, int bits, const Bounds& bounds) {
+  lv.inv_cell = 1.0 / cell;
+  lv.shift = 64 - bits;
+  const double blo[3] = {bounds.lo.x, bounds.lo.y, bounds.lo.z};
+  const double bhi[3] = {bounds.hi.x, bounds.hi.y, bounds.hi.z};
+  for (int a = 0; a < 3; ++a) {
+    lv.lo[a] = cell_coord(blo[a], lv.inv_cell);
+    lv.hi[a] = cell_coord(bhi[a], lv.inv_cell);
+  }
+}
+
+// The grid, by phases: validate, choose the levels, then per built level its cells and photons.
+void HashGrid::build(std::span<const vec3> positions, std::span<const float> radii) {
+  const InputRange in = validate_inputs(positions, radii);
+  const size_t n = positions.size();
+  photon_count_ = n;
+  r_min_ = in.r_min;
+  level_count_ = 0;
+  level_map_.clear();
+  if (n == 0 || radii.empty()) return;
+
+  const int top = choose_levels(radii, in.r_min, in.r_max);
   const int bits = table_bits(n);
   buckets_.resize(n);
-  const double s0 = 2.0 * double(r_min);
-
+  const double s0 = 2.0 * double(in.r_min);
   for (int k = 0; k <= top; ++k) {
     if (!used_[size_t(k)]) continue;
     Level& lv = levels_[size_t(level_map_[size_t(k)])];
-    lv.inv_cell = 1.0 / std::ldexp(s0, k);
-    lv.shift = 64 - bits;
-    const double blo[3] = {bounds.lo.x, bounds.lo.y, bounds.lo.z};
-    const double bhi[3] = {bounds.hi.x, bounds.hi.y, bounds.hi.z};
-    for (int a = 0; a < 3; ++a) {
-      lv.lo[a] = cell_coord(blo[a], lv.inv_cell);
-      lv.hi[a] = cell_coord(bhi[a], lv.inv_cell);
-    }
-
+    size_level(lv, std::ldexp(s0, k), bits, in.bounds);
     build_level(lv, positions, bits);
   }
 }

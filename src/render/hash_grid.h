@@ -117,7 +117,10 @@ class HashGrid {
     }
   }
 
-  // Hashes and sorts every photon into one level (hash_grid.cpp).
+  // build()'s phases after validation (hash_grid.cpp): the levels the radii use, a level's
+  // cells, and every photon hashed and sorted into one level.
+  int choose_levels(std::span<const float> radii, float r_min, float r_max);
+  static void size_level(Level& lv, double cell, int bits, const Bounds& bounds);
   void build_level(Level& lv, std::span<const vec3> positions, int bits);
 
   std::vector<Level> levels_;      // [0, level_count_) in use; the rest empty

@@ -52,27 +52,116 @@ vec3 anisotropy_direction(const Material& m, const vec3& ns, const glm::vec4& ta
   return r.x * t + r.y * b;
 }
 
-}  // namespace
+// The hit's triangle: its corners' vertex indices and barycentric weights (w, hit.u, hit.v).
+struct Corners {
+  const Hit& hit;
+  uint32_t i0, i1, i2;
+  float w;  // 1 - hit.u - hit.v
+  // A vertex attribute at the hit: w a[i0] + u a[i1] + v a[i2].
+  template <class T>
+  T at(const T* a) const {
+    return w * a[i0] + hit.u * a[i1] + hit.v * a[i2];
+  }
+};
 
-Surface World::surface(const Hit& hit) const {
-  const MeshView& mesh = meshes_[hit.mesh];
-  const uint32_t* tri = mesh.indices + 3 * size_t(hit.prim);
-  const uint32_t i0 = tri[0], i1 = tri[1], i2 = tri[2];
-  const float w = 1.0f - hit.u - hit.v;
+// The hit's position, error bound (ray_offset.h), geometric and interpolated shading normals.
+Surface geometry(const vec3* positions, const vec3* normals, const vec3& ng, const Corners& c) {
   Surface s;
   // Barycentric interpolation is more accurate than origin + t dir far from the origin.
-  s.position = w * mesh.positions[i0] + hit.u * mesh.positions[i1] + hit.v * mesh.positions[i2];
-  s.ng = mesh.face_normals[hit.prim];
-  s.error = surface_error(mesh.positions[i0], mesh.positions[i1], mesh.positions[i2], s.ng);
+  s.position = c.at(positions);
+  s.ng = ng;
+  s.error = surface_error(positions[c.i0], positions[c.i1], positions[c.i2], s.ng);
   s.ns = s.ng;
-  if (mesh.normals) {
-    const vec3 n = w * mesh.normals[i0] + hit.u * mesh.normals[i1] + hit.v * mesh.normals[i2];
+  if (normals) {
+    const vec3 n = c.at(normals);
     const float len = glm::length(n);
     if (len > 0.0f) {
       s.ns = n / len;
       if (glm::dot(s.ns, s.ng) < 0.0f) s.ns = -s.ns;
     }
   }
+  return s;
+}
+
+// The base layer's factors times its textures (glTF 2.0 "Metallic-Roughness Material").
+void base_textures(BsdfParams& p, const Material& m, std::span<const Image> images,
+                   const vec2 uv[2], const glm::vec4* colors, const Corners& c) {
+  // Each texture multiplies its factor; colour textures are sRGB, the others linear; metalness
+  // in B, roughness in G.
+  p.base_color *= vec3(lookup(images, m.base_color_texture, uv, true));
+  if (colors)  // COLOR_0 multiplies the base colour (glTF 2.0 "Metallic-Roughness Material")
+    p.base_color *= vec3(c.at(colors));
+  const glm::vec4 mr = lookup(images, m.metallic_roughness_texture, uv, false);
+  p.metallic *= mr.z;   // B: metalness
+  p.roughness *= mr.y;  // G: roughness
+  if (m.specular_glossiness_texture.present()) {
+    // KHR_materials_pbrSpecularGlossiness (gltf_material.cpp): specular = factor x RGB (sRGB),
+    // glossiness = factor x A; c_diff = diffuse (1 - max specular), f0 = specular.
+    const glm::vec4 sg = lookup(images, m.specular_glossiness_texture, uv, true);
+    const vec3 specular = m.sg_specular * vec3(sg);
+    p.base_color *= 1.0f - max_component(specular);
+    p.specular_color = specular / 0.04f;
+    p.roughness = 1.0f - m.sg_glossiness * sg.w;
+  }
+}
+
+// The KHR_materials_* layers' factors times their textures (each extension cited at its layer).
+void extension_textures(BsdfParams& p, const Material& m, std::span<const Image> images,
+                        const vec2 uv[2]) {
+  p.transmission *= lookup(images, m.transmission_texture, uv, false).x;
+  if (p.diffuse_transmission > 0.0f) {  // KHR_materials_diffuse_transmission: A; colour sRGB
+    p.diffuse_transmission *= lookup(images, m.diffuse_transmission_texture, uv, false).w;
+    p.diffuse_transmission_color *=
+        vec3(lookup(images, m.diffuse_transmission_color_texture, uv, true));
+  }
+  p.specular *= lookup(images, m.specular_texture, uv, false).w;
+  p.specular_color *= vec3(lookup(images, m.specular_color_texture, uv, true));
+  if (p.clearcoat > 0.0f) {  // KHR_materials_clearcoat: clearcoat x R, roughness x G
+    p.clearcoat *= lookup(images, m.clearcoat_texture, uv, false).x;
+    p.clearcoat_roughness *= lookup(images, m.clearcoat_roughness_texture, uv, false).y;
+  }
+  if (max_component(p.sheen_color) > 0.0f) {  // KHR_materials_sheen: colour sRGB, roughness A
+    p.sheen_color *= vec3(lookup(images, m.sheen_color_texture, uv, true));
+    p.sheen_roughness *= lookup(images, m.sheen_roughness_texture, uv, false).w;
+  }
+  if (p.iridescence > 0.0f) {  // KHR_materials_iridescence: factor x R; thickness mixed by G
+    p.iridescence *= lookup(images, m.iridescence_texture, uv, false).x;
+    if (m.iridescence_thickness_texture.present())
+      p.iridescence_thickness =
+          glm::mix(m.iridescence_thickness_minimum, m.iridescence_thickness_maximum,
+                   lookup(images, m.iridescence_thickness_texture, uv, false).y);
+  }
+}
+
+// Anisotropy direction, coat normal and mapped ns in the tangent frame (glTF 2.0 "normalTexture").
+void tangent_frame(BsdfParams& p, vec3& ns, const vec3& ng, const Material& m,
+                   std::span<const Image> images, const vec2 uv[2], const glm::vec4* tangents,
+                   const Corners& c) {
+  const glm::vec4 t = c.at(tangents);
+  if (p.anisotropy > 0.0f)
+    p.anisotropy_direction = anisotropy_direction(m, ns, t, images, uv, p.anisotropy);
+  // The coat's normal: its own texture, or the interpolated normal ("no normal mapping is
+  // applied to the clear coat layer, even if normal mapping is applied to the base").
+  if (p.clearcoat > 0.0f && m.clearcoat_normal_texture.present())
+    p.coat_normal =
+        mapped_normal(ns, ng, t, vec3(lookup(images, m.clearcoat_normal_texture, uv, false)),
+                      m.clearcoat_normal_scale);
+  else
+    p.coat_normal = ns;
+  if (m.normal_texture.present()) {
+    const vec3 tex = vec3(lookup(images, m.normal_texture, uv, false));
+    ns = mapped_normal(ns, ng, t, tex, m.normal_scale);
+  }
+}
+
+}  // namespace
+
+// The hit's Surface by phases: geometry; if textured, uv, textured factors, tangent frame; Bsdf.
+Surface World::surface(const Hit& hit) const {
+  const MeshView& mesh = meshes_[hit.mesh];
+  const uint32_t* tri = mesh.indices + 3 * size_t(hit.prim);
+  const Corners c{hit, tri[0], tri[1], tri[2], 1.0f - hit.u - hit.v};
+  Surface s = geometry(mesh.positions, mesh.normals, mesh.face_normals[hit.prim], c);
   const Material& m = *mesh.material;
   s.material = &m;
   if (!mesh.textured) {
@@ -83,70 +172,16 @@ Surface World::surface(const Hit& hit) const {
   }
   for (int set = 0; set < 2; ++set) {
     const vec2* uv = mesh.texcoords[set];
-    if (uv) s.uv[set] = w * uv[i0] + hit.u * uv[i1] + hit.v * uv[i2];
+    if (uv) s.uv[set] = c.at(uv);
   }
-  // glTF 2.0 "Metallic-Roughness Material": each texture multiplies its factor; colour textures
-  // are sRGB, the others linear; metalness in B, roughness in G.
   const std::span<const Image> images = scene_.images;
   BsdfParams p = BsdfParams::of(m);
   p.follows_transmission = follows_transmission_;
-  p.base_color *= vec3(lookup(images, m.base_color_texture, s.uv, true));
-  if (mesh.colors)  // COLOR_0 multiplies the base colour (glTF 2.0 "Metallic-Roughness Material")
-    p.base_color *= vec3(w * mesh.colors[i0] + hit.u * mesh.colors[i1] + hit.v * mesh.colors[i2]);
-  const glm::vec4 mr = lookup(images, m.metallic_roughness_texture, s.uv, false);
-  p.metallic *= mr.z;   // B: metalness
-  p.roughness *= mr.y;  // G: roughness
-  if (m.specular_glossiness_texture.present()) {
-    // KHR_materials_pbrSpecularGlossiness (gltf_material.cpp): specular = factor x RGB (sRGB),
-    // glossiness = factor x A; c_diff = diffuse (1 - max specular), f0 = specular.
-    const glm::vec4 sg = lookup(images, m.specular_glossiness_texture, s.uv, true);
-    const vec3 specular = m.sg_specular * vec3(sg);
-    p.base_color *= 1.0f - max_component(specular);
-    p.specular_color = specular / 0.04f;
-    p.roughness = 1.0f - m.sg_glossiness * sg.w;
-  }
-  p.transmission *= lookup(images, m.transmission_texture, s.uv, false).x;
-  if (p.diffuse_transmission > 0.0f) {  // KHR_materials_diffuse_transmission: A; colour sRGB
-    p.diffuse_transmission *= lookup(images, m.diffuse_transmission_texture, s.uv, false).w;
-    p.diffuse_transmission_color *=
-        vec3(lookup(images, m.diffuse_transmission_color_texture, s.uv, true));
-  }
-  p.specular *= lookup(images, m.specular_texture, s.uv, false).w;
-  p.specular_color *= vec3(lookup(images, m.specular_color_texture, s.uv, true));
-  if (p.clearcoat > 0.0f) {  // KHR_materials_clearcoat: clearcoat x R, roughness x G
-    p.clearcoat *= lookup(images, m.clearcoat_texture, s.uv, false).x;
-    p.clearcoat_roughness *= lookup(images, m.clearcoat_roughness_texture, s.uv, false).y;
-  }
-  if (max_component(p.sheen_color) > 0.0f) {  // KHR_materials_sheen: colour sRGB, roughness A
-    p.sheen_color *= vec3(lookup(images, m.sheen_color_texture, s.uv, true));
-    p.sheen_roughness *= lookup(images, m.sheen_roughness_texture, s.uv, false).w;
-  }
-  if (p.iridescence > 0.0f) {  // KHR_materials_iridescence: factor x R; thickness mixed by G
-    p.iridescence *= lookup(images, m.iridescence_texture, s.uv, false).x;
-    if (m.iridescence_thickness_texture.present())
-      p.iridescence_thickness =
-          glm::mix(m.iridescence_thickness_minimum, m.iridescence_thickness_maximum,
-                   lookup(images, m.iridescence_thickness_texture, s.uv, false).y);
-  }
+  base_textures(p, m, images, s.uv, mesh.colors, c);
+  extension_textures(p, m, images, s.uv);
   if (mesh.tangents &&
-      (m.normal_texture.present() || m.clearcoat_normal_texture.present() || p.anisotropy > 0.0f)) {
-    const glm::vec4 t =
-        w * mesh.tangents[i0] + hit.u * mesh.tangents[i1] + hit.v * mesh.tangents[i2];
-    if (p.anisotropy > 0.0f)
-      p.anisotropy_direction = anisotropy_direction(m, s.ns, t, images, s.uv, p.anisotropy);
-    // The coat's normal: its own texture, or the interpolated normal ("no normal mapping is
-    // applied to the clear coat layer, even if normal mapping is applied to the base").
-    if (p.clearcoat > 0.0f && m.clearcoat_normal_texture.present())
-      p.coat_normal = mapped_normal(s.ns, s.ng, t,
-                                    vec3(lookup(images, m.clearcoat_normal_texture, s.uv, false)),
-                                    m.clearcoat_normal_scale);
-    else
-      p.coat_normal = s.ns;
-    if (m.normal_texture.present()) {
-      const vec3 tex = vec3(lookup(images, m.normal_texture, s.uv, false));
-      s.ns = mapped_normal(s.ns, s.ng, t, tex, m.normal_scale);
-    }
-  }
+      (m.normal_texture.present() || m.clearcoat_normal_texture.present() || p.anisotropy > 0.0f))
+    tangent_frame(p, s.ns, s.ng, m, images, s.uv, mesh.tangents, c);
   s.bsdf = Bsdf(p, s.ng, s.ns, mirror_roughness_);
   return s;
 }
