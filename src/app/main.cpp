@@ -61,12 +61,15 @@ std::vector<std::string> check_render_outputs(const pb::RenderOptions& o,
   if (pb::environment_is_map(o.environment))
     inputs.push_back({"the --environment map", o.environment});
   if (!o.reference_path.empty()) inputs.push_back({"the --reference image", o.reference_path});
-  std::vector<pb::NamedFile> all = outputs, not_state;
+  // The lock files first: an output naming one is reported by its own flag.
+  std::vector<pb::NamedFile> all, not_state;
   for (size_t k = 0; k < outputs.size(); ++k) {
-    all.push_back({"the lock file of " + outputs[k].role, pb::lock_path(outputs[k].path)});
+    all.push_back({outputs[k].role + "'s lock file", pb::lock_path(outputs[k].path)});
     if (k != 1) not_state.push_back(outputs[k]);  // outputs[1]: the state
   }
-  pb::check_distinct(all, inputs);
+  all.insert(all.end(), outputs.begin(), outputs.end());
+  pb::check_distinct(outputs, inputs);
+  pb::check_distinct(all, inputs);  // what is left: a lock file that is an input or an output
   if (!o.resume_from.empty())
     pb::check_distinct(not_state, {{"the state being resumed", o.resume_from}});
   std::vector<std::string> paths;
