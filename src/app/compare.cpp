@@ -84,12 +84,21 @@ CompareResult compare_images(const ExrImage& a, const ExrImage& ref, const std::
 std::string to_json(const CompareResult& r) {
   std::ostringstream s;
   s.precision(10);
+  // JSON has no NaN or infinity: a non-finite number is null (docs/usage.md "compare and
+  // preview").
+  auto num = [](double v) {
+    if (!std::isfinite(v)) return std::string("null");
+    std::ostringstream t;
+    t.precision(10);
+    t << v;
+    return t.str();
+  };
   s << "{\"width\": " << r.width << ", \"height\": " << r.height
-    << ", \"mean_abs_error\": " << r.mean_abs_error << ", \"rmse\": " << r.rmse
-    << ", \"coverage\": " << r.coverage << ", \"mean_bound\": " << r.mean_bound
-    << ", \"mean_bounded_error\": " << r.mean_bounded_error
-    << ", \"bound_over_error\": " << (std::isfinite(r.bound_over_error) ? r.bound_over_error : -1.0)
-    << ", \"bias_dominated\": " << r.bias_dominated << ", \"bounded\": " << r.bounded
+    << ", \"mean_abs_error\": " << num(r.mean_abs_error) << ", \"rmse\": " << num(r.rmse)
+    << ", \"coverage\": " << num(r.coverage) << ", \"mean_bound\": " << num(r.mean_bound)
+    << ", \"mean_bounded_error\": " << num(r.mean_bounded_error)
+    << ", \"bound_over_error\": " << num(r.bound_over_error)
+    << ", \"bias_dominated\": " << num(r.bias_dominated) << ", \"bounded\": " << r.bounded
     << ", \"exact\": " << r.exact << ", \"unknown\": " << r.unknown << "}\n";
   return s.str();
 }

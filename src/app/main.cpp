@@ -5,6 +5,7 @@
 #include "app/compare.h"
 #include "app/diagnostics.h"
 #include "app/driver.h"
+#include "app/outputs.h"
 #include "app/progress.h"
 #include "estimator/channels.h"
 #include "gltf/gltf_loader.h"
@@ -31,9 +32,60 @@ namespace {
 
 std::atomic<bool> g_stop{false};
 
-// First Ctrl-C (or SIGTERM): finish the pass and write the image. Second: leave at once.
+// First Ctrl-C (or SIGTERM, SIGHUP): finish the pass and write the image. Second: leave at once,
+// removing the temporary files being written and the lock files first (file_io.h's registry).
 extern "C" void on_signal(int sig) {
-  if (g_stop.exchange(true)) _exit(128 + sig);
+  if (g_stop.exchange(true)) {
+    pb::unlink_registered_files();
+    _exit(128 + sig);
+  }
+}
+
+// The files a render writes: -o, the state (written at the end, at checkpoints, or on Ctrl-C)
+// and the log.
+std::vector<pb::NamedFile> render_outputs(const pb::RenderOptions& o, const std::string& state) {
+  std::vector<pb::NamedFile> out = {{"-o", o.output},
+                                    {o.state_path.empty() ? "the state file" : "--state", state}};
+  if (!o.log_path.empty()) out.push_back({"--log", o.log_path});
+  return out;
+}
+
+// Every output (and its lock file) against the inputs named on the command line, before the scene
+// loads; each output path checked, then locked for the whole render, and the temporaries a crashed
+// render left beside them removed. The state being resumed may be replaced by its own
+// continuation (docs/usage.md: `resume c.pbstate -o c.exr` carries on in place): it is read
+// whole before anything is written, and the new state is written atomically.
+std::vector<std::string> check_render_outputs(const pb::RenderOptions& o,
+                                              const std::vector<pb::NamedFile>& outputs) {
+  std::vector<pb::NamedFile> inputs = {{"the scene file", o.scene}};
+  if (pb::environment_is_map(o.environment))
+    inputs.push_back({"the --environment map", o.environment});
+  if (!o.reference_path.empty()) inputs.push_back({"the --reference image", o.reference_path});
+  // The lock files first: an output naming one is reported by its own flag.
+  std::vector<pb::NamedFile> all, not_state;
+  for (size_t k = 0; k < outputs.size(); ++k) {
+    all.push_back({outputs[k].role + "'s lock file", pb::lock_path(outputs[k].path)});
+    if (k != 1) not_state.push_back(outputs[k]);  // outputs[1]: the state
+  }
+  all.insert(all.end(), outputs.begin(), outputs.end());
+  pb::check_distinct(outputs, inputs);
+  pb::check_distinct(all, inputs);  // what is left: a lock file that is an input or an output
+  if (!o.resume_from.empty())
+    pb::check_distinct(not_state, {{"the state being resumed", o.resume_from}});
+  std::vector<std::string> paths;
+  for (const pb::NamedFile& f : outputs) {
+    pb::check_output_path(f);
+    paths.push_back(f.path);
+  }
+  return paths;
+}
+
+// After the scene loaded: no output is a file the loader read (an external buffer or image).
+void check_scene_files(const std::vector<pb::NamedFile>& outputs, const pb::Scene& scene) {
+  std::vector<pb::NamedFile> files;
+  for (size_t k = 0; k < scene.files.size(); ++k)
+    files.push_back({k == 0 ? "the scene file" : "a file the scene loads", scene.files[k]});
+  pb::check_distinct(outputs, files);
 }
 
 // What the stop line reports: the quantity the stop rule tests, then the mean bound.
@@ -84,8 +136,8 @@ std::ofstream open_log(const std::string& path) {
 
 void check_reference_size(const pb::RenderOptions& options, const pb::ExrImage& reference,
                           const pb::Renderer& renderer) {
-  if (!options.reference_path.empty() &&
-      (reference.width != renderer.camera_pass().width || reference.height != renderer.camera_pass().height))
+  if (!options.reference_path.empty() && (reference.width != renderer.camera_pass().width ||
+                                          reference.height != renderer.camera_pass().height))
     throw pb::ImageError(options.reference_path + " is " + std::to_string(reference.width) + "x" +
                          std::to_string(reference.height) + " but the render is " +
                          std::to_string(renderer.camera_pass().width) + "x" +
@@ -151,10 +203,16 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   // Installed first: a Ctrl-C while the scene loads still ends with an image and a state.
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  pb::check_writable(options.output);  // fail before hours of rendering, not after
+  std::signal(SIGHUP, on_signal);  // a closed terminal: the same, not a death with nothing written
   const bool keep_state = options.checkpoint_every || !options.state_path.empty();
   const std::string state_path = pb::state_path_for(options);
+  // Fail before hours of rendering, not after; and never write over an input.
+  const std::vector<pb::NamedFile> outputs = render_outputs(options, state_path);
+  const pb::OutputLock lock(check_render_outputs(options, outputs));
+  pb::remove_stale_temporaries(options.output);
+  pb::remove_stale_temporaries(state_path);
   pb::Scene scene = load_scene(options, saved);
+  check_scene_files(outputs, scene);
   const uint64_t scene_hash = scene.content_hash;
   pb::ExrImage reference;
   if (!options.reference_path.empty()) reference = pb::read_exr(options.reference_path);
@@ -196,6 +254,8 @@ int compare(const pb::CompareOptions& o) {
 
 // sRGB-encoded PNG of the radiance channels, for quick looks and the README.
 int preview(const pb::PreviewOptions& o) {
+  pb::check_distinct({{"-o", o.output}}, {{"the input image", o.input}});
+  pb::check_output_path({"-o", o.output});
   const pb::ExrImage in = pb::read_exr(o.input);
   const int r = in.channel_index(pb::channel_name(pb::Channel::Radiance, 0));
   const int g = in.channel_index(pb::channel_name(pb::Channel::Radiance, 1));

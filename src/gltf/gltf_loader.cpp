@@ -23,8 +23,8 @@
 // Lambertian material named "default" with base_color 0.8 (one warning).
 #include "gltf/gltf_loader_impl.h"
 
-#include "util/file_io.h"
 #include "lights/lights.h"
+#include "util/file_io.h"
 
 #include <algorithm>
 #include <cctype>
@@ -46,6 +46,15 @@ bool keep_image(tinygltf::Image* image, const int, std::string*, std::string*, i
   return true;
 }
 
+// tinygltf's own file reading, noting each file it reads (Scene::files): its external buffers
+// and images.
+bool read_noting(std::vector<unsigned char>* out, std::string* err, const std::string& path,
+                 void* files) {
+  const bool ok = tinygltf::ReadWholeFile(out, err, path, nullptr);
+  if (ok) static_cast<std::vector<std::string>*>(files)->push_back(path);
+  return ok;
+}
+
 // tinygltf 2.7 parses "inverseBindMatrices" as required (glTF makes it optional: identity
 // matrices) but still reads the skin; this is the one error line it then reports.
 bool spurious(const std::string& line) {
@@ -56,7 +65,8 @@ bool spurious(const std::string& line) {
 // (gltf_prepass.h). Every error tinygltf reports is fatal, even when it returns true (2.7 drops
 // e.g. a baseColorFactor of the wrong length with only a message), but the spurious ones.
 tinygltf::Model parse(const std::string& path, const std::vector<unsigned char>& bytes,
-                      std::vector<std::string>& warnings, Prepass& pre) {
+                      std::vector<std::string>& files, std::vector<std::string>& warnings,
+                      Prepass& pre) {
   // By the magic bytes, whatever the name: a .glb saved as .gltf is still binary. A name ending
   // in .glb (any case: BOX.GLB) without the magic is a broken GLB, and check_glb says so.
   std::string ext = std::filesystem::path(path).extension().string();
@@ -86,6 +96,8 @@ tinygltf::Model parse(const std::string& path, const std::vector<unsigned char>&
   const std::string dir = std::filesystem::path(path).parent_path().string();
   tinygltf::TinyGLTF reader;
   reader.SetImageLoader(&keep_image, nullptr);
+  reader.SetFsCallbacks({&tinygltf::FileExists, &tinygltf::ExpandFilePath, &read_noting,
+                         &tinygltf::WriteWholeFile, &files});
   tinygltf::Model model;
   std::string err, warn;
   bool ok = false;
@@ -369,13 +381,19 @@ void Loader::finish() {
 
 }  // namespace gltf
 
-Scene load_gltf(const std::string& path) { return load_gltf_bytes(path, gltf::read_file(path)); }
+Scene load_gltf(const std::string& path) {
+  Scene scene = load_gltf_bytes(path, gltf::read_file(path));
+  scene.files.insert(scene.files.begin(), path);
+  return scene;
+}
 
 Scene load_gltf_bytes(const std::string& path, const std::vector<unsigned char>& bytes) {
   std::vector<std::string> warnings;
   gltf::Prepass pre;
-  const tinygltf::Model model = gltf::parse(path, bytes, warnings, pre);
+  std::vector<std::string> files;
+  const tinygltf::Model model = gltf::parse(path, bytes, files, warnings, pre);
   Scene scene = gltf::Loader(path, model, pre).run(warnings);
+  scene.files = std::move(files);
   // External images are part of the identity too (embedded ones already are: their bytes are in
   // the file or a buffer).
   uint64_t total = bytes.size();

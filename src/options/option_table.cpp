@@ -110,8 +110,10 @@ std::vector<OptionSpec> make_table() {
   const char* measure = "measuring";
   constexpr double kInf = std::numeric_limits<double>::infinity();
   std::vector<OptionSpec> t;
-  t.push_back(text(base("-o", "output", "OUT.exr", run, K::Run, "the EXR to write"),
-                   &RenderOptions::output));
+  t.push_back(text(
+      base("-o", "output", "OUT.exr", run, K::Run, "the EXR to write (the name must end in .exr)"),
+      &RenderOptions::output));
+  t.back().accepted = {"x.exr"};  // validate() refuses any other extension
   t.push_back(integer(base("--passes", "passes", "N", stop, K::Stop, "passes to run"),
                       &RenderOptions::passes, {1, 1000000000000ULL}, "none"));
   t.push_back(real(base("--time", "time", "S", stop, K::Stop,

@@ -3,13 +3,27 @@
 #include "options/options.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 
 namespace pb {
 
 namespace {
 
 [[noreturn]] void fail(const std::string& message) { throw UsageError(message); }
+
+// -o names an OpenEXR file: the bound channels and float radiance exist only there (another
+// extension would make OpenImageIO write another format, dropping them, or fail after the render).
+void check_exr_output(const std::string& output) {
+  std::string ext = std::filesystem::path(output).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext != ".exr")
+    fail("-o " + output +
+         ": the output must be an OpenEXR file ending in .exr (only EXR holds the float radiance "
+         "and the bound channels)");
+}
 
 double parse_exposure(const std::string& text) {
   size_t used = 0;
@@ -86,6 +100,7 @@ ResumeOptions parse_resume(int argc, const char* const* argv, int first) {
     fail("resume: usage: photonbound resume STATE -o OUT.exr [stop conditions]");
   r.state = positional[0];
   if (check.output.empty()) fail("resume: no output file given (-o OUT.exr)");
+  check_exr_output(check.output);
   if (!check.reference_path.empty() && check.log_path.empty())
     fail("--reference: only used by --log (give --log FILE.jsonl too)");
   return r;
@@ -139,6 +154,7 @@ CompareOptions parse_compare(int argc, const char* const* argv, int first) {
 void validate(const RenderOptions& o) {
   if (o.scene.empty()) fail("render: no scene file given");
   if (o.output.empty()) fail("render: no output file given (-o OUT.exr)");
+  check_exr_output(o.output);
   if (!o.passes && !o.time_seconds && !o.target_error)
     fail("render: no stop condition: give --passes, --time or --target-error");
   for (const OptionSpec& s : option_table()) s.check(o);

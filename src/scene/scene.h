@@ -213,6 +213,9 @@ struct Scene {
   // Identity of the loaded content (the file's bytes, every buffer and image it loads), which
   // resume compares: an edited external .bin must not continue a render of the old one.
   uint64_t content_hash = 0;
+  // Every file the loader read, as it opened them: the scene file first (load_gltf), then its
+  // external buffers and images. The outputs of a render must be none of them.
+  std::vector<std::string> files;
 
   size_t triangle_count() const {
     size_t n = 0;

@@ -3,9 +3,11 @@
 #include "util/rng.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <atomic>
 #include <cerrno>
 #include <cstdio>
 #include <filesystem>
@@ -15,14 +17,16 @@ namespace pb {
 
 namespace {
 
-// ".NAME.tmpPID.EXT" beside `path`: hidden, unique to this process, with path's extension.
-std::string temporary_name(const std::string& path, const std::string& extension_if_none = "") {
-  const std::filesystem::path p(path);
-  std::string name = ".";  // appended piecewise: GCC 12 misreports operator+ chains (-Wrestrict)
-  name.append(p.stem().string()).append(".tmp").append(std::to_string(::getpid()));
-  name.append(p.extension().empty() ? extension_if_none : p.extension().string());
-  return (p.parent_path() / name).string();
-}
+// The registry of files a dying process removes (register_cleanup): a slot is free (0), being
+// filled (1) or holds a path (2); the handler reads only slots in state 2.
+constexpr int kCleanupSlots = 16;
+constexpr size_t kCleanupPathMax = 4096;
+struct CleanupSlot {
+  std::atomic<int> state{0};
+  char path[kCleanupPathMax];
+};
+CleanupSlot g_cleanup[kCleanupSlots];
+static_assert(std::atomic<int>::is_always_lock_free, "the signal handler reads these");
 
 std::string errno_text() { return std::strerror(errno); }
 
@@ -35,9 +39,65 @@ void fsync_path(const std::string& path, int flags) {
 
 }  // namespace
 
+// ".NAME.tmpPID.EXT" beside `path`: hidden, unique to this process, with path's extension.
+std::string temporary_name(const std::string& path, const std::string& extension_if_none) {
+  const std::filesystem::path p(path);
+  std::string name = ".";  // appended piecewise: GCC 12 misreports operator+ chains (-Wrestrict)
+  name.append(p.stem().string()).append(".tmp").append(std::to_string(::getpid()));
+  name.append(p.extension().empty() ? extension_if_none : p.extension().string());
+  return (p.parent_path() / name).string();
+}
+
+bool register_cleanup(const std::string& path, int& slot) {
+  if (path.size() >= kCleanupPathMax) return false;
+  for (int k = 0; k < kCleanupSlots; ++k) {
+    int free = 0;
+    if (!g_cleanup[k].state.compare_exchange_strong(free, 1)) continue;
+    std::memcpy(g_cleanup[k].path, path.c_str(), path.size() + 1);
+    g_cleanup[k].state.store(2, std::memory_order_release);
+    slot = k;
+    return true;
+  }
+  return false;
+}
+
+void unregister_cleanup(int slot) {
+  if (slot >= 0 && slot < kCleanupSlots) g_cleanup[slot].state.store(0, std::memory_order_release);
+}
+
+void unlink_registered_files() noexcept {
+  for (CleanupSlot& s : g_cleanup)
+    if (s.state.load(std::memory_order_acquire) == 2) ::unlink(s.path);
+}
+
+int remove_stale_temporaries(const std::string& path, const std::string& extension_if_none) {
+  namespace fs = std::filesystem;
+  const fs::path p(path);
+  const std::string prefix = "." + p.stem().string() + ".tmp";
+  const std::string ext = p.extension().empty() ? extension_if_none : p.extension().string();
+  const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+  int removed = 0;
+  std::error_code ec;
+  for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.size() <= prefix.size() + ext.size() || name.compare(0, prefix.size(), prefix) != 0 ||
+        name.compare(name.size() - ext.size(), ext.size(), ext) != 0)
+      continue;
+    const std::string digits = name.substr(prefix.size(), name.size() - prefix.size() - ext.size());
+    if (digits.size() > 9 || digits.find_first_not_of("0123456789") != std::string::npos) continue;
+    const pid_t pid = pid_t(std::stol(digits));
+    std::error_code sec;
+    if (pid <= 0 || pid == ::getpid() || !it->is_regular_file(sec)) continue;
+    if (::kill(pid, 0) == 0 || errno != ESRCH) continue;  // alive (or not ours to judge)
+    if (fs::remove(it->path(), sec)) ++removed;
+  }
+  return removed;
+}
+
 void write_atomically(const std::string& path, const std::function<void(const std::string&)>& write,
                       const std::string& extension_if_none) {
   const std::string tmp = temporary_name(path, extension_if_none);
+  const CleanupGuard cleanup(tmp);  // a second Ctrl-C while writing removes it
   try {
     write(tmp);
   } catch (...) {
@@ -66,6 +126,7 @@ void write_atomically(const std::string& path, const std::function<void(const st
 void check_writable(const std::string& path) {
   if (std::filesystem::is_directory(path)) throw FileError(path + ": is a directory");
   const std::string tmp = temporary_name(path);
+  const CleanupGuard cleanup(tmp);
   std::ofstream f(tmp, std::ios::binary);
   if (!f) throw FileError(path + ": cannot write here (" + errno_text() + ")");
   f.close();

@@ -147,9 +147,14 @@ TEST_F(Cli, UnwritableOutputFailsBeforeRendering) {
   EXPECT_EQ(r.code, 1);
   EXPECT_NE(r.err.find("out.exr"), std::string::npos) << r.err;
   expect_one_line(r);
-  r = run("render " + quote(scene("cornell.gltf")) + " -o " + quote(dir_.string()) + " --passes 1");
+  const fs::path folder = dir_ / "d.exr";  // a directory where the image should go
+  fs::create_directory(folder);
+  r = run("render " + quote(scene("cornell.gltf")) + " -o " + quote(folder.string()) +
+          " --passes 1");
   EXPECT_EQ(r.code, 1);
   expect_one_line(r);
+  EXPECT_TRUE(fs::is_empty(folder));
+  fs::remove(folder);
   EXPECT_TRUE(folder_empty());
 }
 
