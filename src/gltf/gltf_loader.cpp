@@ -23,6 +23,7 @@
 // Lambertian material named "default" with base_color 0.8 (one warning).
 #include "gltf/gltf_loader_impl.h"
 
+#include "gltf/gltf_files.h"
 #include "lights/lights.h"
 #include "util/file_io.h"
 
@@ -46,27 +47,45 @@ bool keep_image(tinygltf::Image* image, const int, std::string*, std::string*, i
   return true;
 }
 
-// tinygltf's own file reading, noting each file it reads (Scene::files): its external buffers
-// and images.
-bool read_noting(std::vector<unsigned char>* out, std::string* err, const std::string& path,
-                 void* files) {
-  const bool ok = tinygltf::ReadWholeFile(out, err, path, nullptr);
-  if (ok) static_cast<std::vector<std::string>*>(files)->push_back(path);
-  return ok;
-}
-
 // tinygltf 2.7 parses "inverseBindMatrices" as required (glTF makes it optional: identity
 // matrices) but still reads the skin; this is the one error line it then reports.
 bool spurious(const std::string& line) {
   return line == "'inverseBindMatrices' property is missing in Skin.";
 }
 
+// tinygltf's file-system callbacks, over AssetFiles: tinygltf asks whether `base/NAME` exists,
+// then for its bytes; it would then try `./NAME` (the working directory), which is never there.
+std::optional<std::string> name_under(const AssetFiles& files, const std::string& joined) {
+  const std::string& base = files.base();
+  const std::string prefix = !base.empty() && base.back() == '/' ? base : base + "/";
+  if (joined.rfind(prefix, 0) != 0) return std::nullopt;
+  return joined.substr(prefix.size());
+}
+bool fs_exists(const std::string& joined, void* user) {
+  auto& files = *static_cast<AssetFiles*>(user);
+  const std::optional<std::string> name = name_under(files, joined);
+  return name && files.check(*name) == AssetFiles::Verdict::Readable;
+}
+std::string fs_expand(const std::string& path, void*) { return path; }
+bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& joined,
+             void* user) {
+  auto& files = *static_cast<AssetFiles*>(user);
+  const std::optional<std::string> name = name_under(files, joined);
+  std::string why = "refused";
+  const bool ok = name && files.read(*name, *out, why);
+  if (!ok && err) *err = why;
+  return ok;
+}
+bool fs_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err = "the loader writes no files";
+  return false;
+}
+
 // GLB by its magic, otherwise glTF JSON, rewritten first where tinygltf needs it
 // (gltf_prepass.h). Every error tinygltf reports is fatal, even when it returns true (2.7 drops
 // e.g. a baseColorFactor of the wrong length with only a message), but the spurious ones.
 tinygltf::Model parse(const std::string& path, const std::vector<unsigned char>& bytes,
-                      std::vector<std::string>& files, std::vector<std::string>& warnings,
-                      Prepass& pre) {
+                      std::vector<std::string>& warnings, Prepass& pre, AssetFiles& files) {
   // By the magic bytes, whatever the name: a .glb saved as .gltf is still binary. A name ending
   // in .glb (any case: BOX.GLB) without the magic is a broken GLB, and check_glb says so.
   std::string ext = std::filesystem::path(path).extension().string();
@@ -83,6 +102,9 @@ tinygltf::Model parse(const std::string& path, const std::vector<unsigned char>&
   std::vector<unsigned char> rewritten_glb;
   const std::string_view text =
       glb ? glb_json(in) : std::string_view(reinterpret_cast<const char*>(data), size);
+  // Before any recursive parser (nlohmann's, in the prepass and in tinygltf) sees the text.
+  if (const std::string problem = json_problem(text); !problem.empty())
+    throw SceneError(path + ": " + one_line(problem));
   if (prepass(text, glb, pre, json)) {
     if (glb) {
       rewritten_glb = replace_glb_json(in, size, json);
@@ -93,11 +115,10 @@ tinygltf::Model parse(const std::string& path, const std::vector<unsigned char>&
       size = uint32_t(json.size());
     }
   }
-  const std::string dir = std::filesystem::path(path).parent_path().string();
   tinygltf::TinyGLTF reader;
   reader.SetImageLoader(&keep_image, nullptr);
-  reader.SetFsCallbacks({&tinygltf::FileExists, &tinygltf::ExpandFilePath, &read_noting,
-                         &tinygltf::WriteWholeFile, &files});
+  reader.SetFsCallbacks(tinygltf::FsCallbacks{&fs_exists, &fs_expand, &fs_read, &fs_write, &files});
+  const std::string& dir = files.base();
   tinygltf::Model model;
   std::string err, warn;
   bool ok = false;
@@ -109,6 +130,9 @@ tinygltf::Model parse(const std::string& path, const std::vector<unsigned char>&
     err = e.what();
     ok = false;
   }
+  // A refused file is the error, whatever tinygltf made of it (for an image only a warning).
+  if (const auto& refused = files.refusal())
+    throw SceneError(path + ": " + uri_owner(text, refused->first) + " " + refused->second);
   std::vector<std::string> errors = nonempty_lines(err);
   const std::vector<std::string> notes = nonempty_lines(warn);
   const std::vector<std::string> all_errors = errors;
@@ -381,19 +405,20 @@ void Loader::finish() {
 
 }  // namespace gltf
 
-Scene load_gltf(const std::string& path) {
-  Scene scene = load_gltf_bytes(path, gltf::read_file(path));
+Scene load_gltf(const std::string& path, const LoadPolicy& policy) {
+  Scene scene = load_gltf_bytes(path, gltf::read_file(path), policy);
   scene.files.insert(scene.files.begin(), path);
   return scene;
 }
 
-Scene load_gltf_bytes(const std::string& path, const std::vector<unsigned char>& bytes) {
+Scene load_gltf_bytes(const std::string& path, const std::vector<unsigned char>& bytes,
+                      const LoadPolicy& policy) {
   std::vector<std::string> warnings;
   gltf::Prepass pre;
-  std::vector<std::string> files;
-  const tinygltf::Model model = gltf::parse(path, bytes, files, warnings, pre);
+  gltf::AssetFiles files(path, policy.asset_dirs);
+  const tinygltf::Model model = gltf::parse(path, bytes, warnings, pre, files);
   Scene scene = gltf::Loader(path, model, pre).run(warnings);
-  scene.files = std::move(files);
+  scene.files = files.read_paths();
   // External images are part of the identity too (embedded ones already are: their bytes are in
   // the file or a buffer).
   uint64_t total = bytes.size();

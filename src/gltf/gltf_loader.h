@@ -10,17 +10,26 @@
 
 namespace pb {
 
+// Which files outside the scene file a load may read (docs/gltf.md "Which files a scene may
+// read"): a buffer or image URI must resolve, after percent-decoding and following symlinks,
+// to a regular file inside the scene file's own folder or inside one of `asset_dirs` (--asset-dir).
+// Anything else is refused before it is opened, with a message that says nothing about it.
+struct LoadPolicy {
+  std::vector<std::string> asset_dirs;  // further folders files may be read from
+};
+
 // Reads a .gltf (embedded or external buffers) or .glb file. Throws SceneError for anything
 // the renderer cannot use: missing or malformed file, out-of-range accessors or indices,
 // non-finite or absurd coordinates, unsupported primitive modes or light types, lights whose
-// power overflows float. No camera and no light are allowed (scene_defaults.h and camera_choice.h add the
-// default view and sky); what is ignored (skins, morph targets, animations, unknown extensions)
-// is in Scene::warnings. Degenerate triangles are skipped and counted.
-Scene load_gltf(const std::string& path);
+// power overflows float. No camera and no light are allowed (scene_defaults.h and camera_choice.h
+// add the default view and sky); what is ignored (skins, morph targets, animations, unknown
+// extensions) is in Scene::warnings. Degenerate triangles are skipped and counted.
+Scene load_gltf(const std::string& path, const LoadPolicy& policy = {});
 
 // The same for a file already in memory (the fuzz target's entry point). `path` names the input
 // in messages, its extension picks .glb or JSON, and its folder is where external buffers are
-// looked up.
-Scene load_gltf_bytes(const std::string& path, const std::vector<unsigned char>& bytes);
+// looked up (under `policy`).
+Scene load_gltf_bytes(const std::string& path, const std::vector<unsigned char>& bytes,
+                      const LoadPolicy& policy = {});
 
 }  // namespace pb

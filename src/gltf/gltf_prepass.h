@@ -34,4 +34,20 @@ struct Prepass {
 // or nests deeper than 512 levels, is left to tinygltf to report.
 bool prepass(std::string_view json, bool glb, Prepass& out, std::string& rewritten);
 
+// Nesting deeper than this is refused before any recursive parser sees the text.
+inline constexpr size_t kMaxJsonNesting = 512;
+
+// What is wrong with the JSON text that tinygltf 2.7 would not say, found in one pass over the
+// bytes before any parser runs: "JSON nested deeper than 512 levels" (nlohmann's parser and
+// dump() recurse once per level: 100,000 nested arrays overflow the stack), or a string or
+// boolean where glTF requires a number or an array of numbers (tinygltf takes the default
+// without a word: "intensity": "NaN" is intensity 1), named by its JSON path. Empty when
+// nothing is. Members under "extras" are the author's own and are not checked.
+std::string json_problem(std::string_view json);
+
+// Who refers to `decoded` (a URI as tinygltf_decoded() gives it), for messages:
+// "buffer 0 uri '../x.bin'" or "image 2 uri '%2e%2e/x.png'"; "uri '<decoded>'" when no buffer or
+// image of `json` does.
+std::string uri_owner(std::string_view json, const std::string& decoded);
+
 }  // namespace pb::gltf

@@ -7,8 +7,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cstdio>
 #include <cstring>
+#include <filesystem>
 
 #include "util/file_io.h"
 #include "util/message_text.h"
@@ -95,6 +97,11 @@ std::string format_name(const unsigned char* d, size_t n, const std::string& nam
   return name;
 }
 
+// A reader that takes its bytes from an IOProxy; "null" makes images up from the name alone.
+bool from_memory(const OIIO::ImageInput& reader) {
+  return reader.supports("ioproxy") && std::string(reader.format_name()) != "null";
+}
+
 }  // namespace
 
 bool is_ktx2(const unsigned char* data, size_t size) {
@@ -142,14 +149,59 @@ Image decode_image(const unsigned char* data, size_t size, const std::string& na
                      ": cannot decode the image: it is KTX2 (Basis Universal), which "
                      "photonbound does not read");
   const QuietStderr quiet;
+  const std::string file = format_name(data, size, name);
   OIIO::Filesystem::IOMemReader memory(data, size);
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);  // keep colour as stored, not premultiplied
   // With a configuration the readers take the proxy from it (ioproxy_retrieve_from_config).
   OIIO::Filesystem::IOProxy* proxy = &memory;
   config.attribute("oiio:ioproxy", OIIO::TypeDesc::PTR, &proxy);
-  auto in = OIIO::ImageInput::open(format_name(data, size, name), &config, &memory);
-  if (!in) throw ImageError(name + ": cannot decode the image: " + one_line(OIIO::geterror()));
+  // Only readers that take the bytes from the proxy: ImageInput::open would, for a format whose
+  // reader cannot (SGI, ICO, ...), or when the extension's reader fails and it tries the others,
+  // open `name` as a file relative to the working directory instead.
+  std::unique_ptr<OIIO::ImageInput> in;
+  std::string first_error;
+  auto attempt = [&](const std::string& format) {
+    auto reader = OIIO::ImageInput::create(format, false, &config);
+    if (!reader || !from_memory(*reader)) return false;
+    memory.seek(0);
+    reader->set_ioproxy(&memory);
+    OIIO::ImageSpec opened;
+    if (reader->open(file, opened, config)) {
+      in = std::move(reader);
+      return true;
+    }
+    if (first_error.empty()) first_error = reader->geterror();
+    return false;
+  };
+  std::string extension = std::filesystem::path(file).extension().string();
+  if (!extension.empty()) extension.erase(0, 1);
+  std::transform(extension.begin(), extension.end(), extension.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  std::string named_format;  // the reader the extension names, when it names one
+  if (!extension.empty())
+    if (auto reader = OIIO::ImageInput::create(extension, false)) {
+      named_format = reader->format_name();
+      if (!from_memory(*reader))
+        throw ImageError(name + ": cannot decode the image: OpenImageIO's " + named_format +
+                         " reader reads files by name, not bytes in memory, and photonbound "
+                         "decodes images only from the bytes the scene holds (use PNG, JPEG, "
+                         "WebP, TIFF, EXR, HDR, BMP or TGA)");
+    }
+  if (named_format.empty() || !attempt(named_format)) {
+    const std::string list = OIIO::get_string_attribute("input_format_list");
+    for (size_t at = 0; at <= list.size() && !in;) {
+      const size_t comma = std::min(list.find(',', at), list.size());
+      const std::string format = list.substr(at, comma - at);
+      at = comma + 1;
+      if (!format.empty() && format != named_format) attempt(format);
+    }
+  }
+  if (!in)
+    throw ImageError(name + ": cannot decode the image: " +
+                     (first_error.empty()
+                          ? std::string("not an image in a format photonbound reads")
+                          : one_line(first_error)));
   const OIIO::ImageSpec& spec = in->spec();
   Image im;
   im.name = name;

@@ -100,6 +100,37 @@ OptionSpec stop_rule() {
   return s;
 }
 
+// --asset-dir: repeatable, each folder appended, made absolute (the state is resumed from any
+// working directory). The list is one text, a folder a line, so that a state or the metadata
+// reads it back (a name with a line break is read as two folders).
+OptionSpec asset_dirs() {
+  OptionSpec s = base("--asset-dir", "asset_dir", "DIR", "rendering", OptionKind::Image,
+                      "a folder the scene's buffers and images may also be read from (besides "
+                      "the scene file's own); repeatable");
+  s.unset = "the scene's folder only";
+  s.parse = [](RenderOptions& o, const std::string& t) {
+    for (size_t at = 0; at <= t.size();) {
+      const size_t end = std::min(t.find('\n', at), t.size());
+      const std::string dir = t.substr(at, end - at);
+      at = end + 1;
+      if (dir.empty()) fail("--asset-dir", "an empty folder name");
+      std::error_code ec;
+      const std::filesystem::path abs = std::filesystem::absolute(dir, ec);
+      o.asset_dirs.push_back(ec ? dir : abs.lexically_normal().string());
+    }
+  };
+  s.check = [](const RenderOptions&) {};
+  s.format = [](const RenderOptions& o) {
+    std::string t;
+    for (const std::string& d : o.asset_dirs) t += (t.empty() ? "" : "\n") + d;
+    return t;
+  };
+  s.reset = [](RenderOptions& o) { o.asset_dirs.clear(); };
+  s.accepted = {"/tmp", "assets"};
+  s.rejected = {""};
+  return s;
+}
+
 std::vector<OptionSpec> make_table() {
   using K = OptionKind;
   const char* stop = "stop conditions (at least one; whichever is reached first)";
@@ -173,6 +204,7 @@ std::vector<OptionSpec> make_table() {
   t.push_back(real(base("--environment-scale", "environment_scale", "S", render, K::Image,
                         "factor on the environment's radiance"),
                    &RenderOptions::environment_scale, {0, 1e30, true, false, "", ""}));
+  t.push_back(asset_dirs());
   t.push_back(integer(base("--threads", "threads", "T", run, K::Run,
                            "worker threads, 0 = all; the image does not depend on it"),
                       &RenderOptions::threads, {0, 1024}));

@@ -40,6 +40,9 @@ inline constexpr double kDefaultFollowRoughness = 0.7;
 
 struct RenderOptions {
   std::string scene;   // glTF file (the positional argument, not an option)
+  // Folders besides the scene's own that its buffers and images may be read from (--asset-dir,
+  // repeatable; absolute: the state is resumed from anywhere).
+  std::vector<std::string> asset_dirs;
   std::string output;  // -o
   // Stop conditions: whichever comes first; at least one is required.
   std::optional<uint64_t> passes;
