@@ -6,9 +6,9 @@
 #include "app/checkpoint_writer.h"
 #include "app/driver.h"
 #include "gltf/gltf_loader.h"
-#include "util/parallel.h"
 #include "render/pass_stages.h"
 #include "render/renderer.h"
+#include "util/parallel.h"
 
 #include <unistd.h>
 

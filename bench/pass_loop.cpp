@@ -3,12 +3,12 @@
 #include "bench.h"
 #include "plain.h"
 
-#include "scene/camera.h"
 #include "options/options.h"
-#include "util/parallel.h"
 #include "render/pass_stages.h"
 #include "render/ppm.h"
 #include "render/renderer.h"
+#include "scene/camera.h"
+#include "util/parallel.h"
 #include "util/rng.h"
 
 #include <algorithm>

@@ -3,8 +3,8 @@
 // prepare or be refused with a SceneError. Anything else (a crash, a sanitizer report, another
 // exception type, a hang) is a finding. tools/fuzz.sh builds and runs it.
 #include "gltf/gltf_loader.h"
-#include "render/scene_defaults.h"
 #include "render/camera_choice.h"
+#include "render/scene_defaults.h"
 #include "world/world.h"
 
 #include <cstdint>

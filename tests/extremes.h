@@ -4,8 +4,8 @@
 // bounds exactly where a point never received a photon, positive radii at or above the floor).
 #pragma once
 
-#include "pass_sample.h"
 #include "analytic.h"
+#include "pass_sample.h"
 #include "render_fixture.h"
 
 #include "estimator/estimator.h"
@@ -476,8 +476,9 @@ inline void one_photon_per_pass(uint64_t passes) {
       "per point %llu..%llu; R from %.4g to %.4g..%.4g; unknown %zu; mean error %.4g, "
       "mean bound %.4g, coverage at 90%% %.3f\n",
       (unsigned long long)passes, (unsigned long long)arrivals, (unsigned long long)min_photons,
-      (unsigned long long)max_photons, run.r->camera_pass().points.empty() ? 0.0 : double(report_radius),
-      r_min, r_max, c.unknown, a.mean_abs_error, a.mean_bound, a.coverage);
+      (unsigned long long)max_photons,
+      run.r->camera_pass().points.empty() ? 0.0 : double(report_radius), r_min, r_max, c.unknown,
+      a.mean_abs_error, a.mean_bound, a.coverage);
   EXPECT_EQ(arrivals, shrinks);                           // the floor is never reached here
   const RenderReport report = test::run_to_stop(*run.r);  // passes already done: no new pass
   EXPECT_EQ(report.work.passes, passes);

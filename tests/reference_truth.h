@@ -5,10 +5,10 @@
 #pragma once
 
 #include "estimator/error_model.h"
-#include "render/camera_pass.h"
 #include "estimator/film.h"
 #include "gltf/gltf_loader.h"
 #include "io/image_io.h"
+#include "render/camera_pass.h"
 #include "render/renderer.h"
 
 #include <algorithm>

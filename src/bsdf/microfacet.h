@@ -25,7 +25,6 @@ namespace pb {
 // roughness >= 0.032 (alpha >= 1e-3) keeps alpha wo.z >= 1e-6 down to wo.z = 1e-3.
 inline constexpr float kMinGgxAlpha = 1e-4f;
 
-
 // glTF's remapping of perceptual roughness: alpha = roughness^2 (appendix B "Specular BRDF"),
 // roughness clamped to [0, 1] and alpha raised to kMinGgxAlpha.
 float ggx_alpha(float roughness);
@@ -126,7 +125,8 @@ float dielectric_f0(float ior);
 // energy conserving: fresnel_mix weights the diffuse base by 1 - F(v.h) at the half vector of
 // each pair of directions, so a bright dielectric reflects more than it receives at oblique
 // angles. A white one (roughness 0.05) has albedo 1.15 at wo.z = 0.3 and 1.84 near grazing, 1.04
-// averaged over incidence; tests/bsdf/test_microfacet.cpp gives the brightest base colour that stays
+// averaged over incidence; tests/bsdf/test_microfacet.cpp gives the brightest base colour that
+// stays
 // <= 1 per roughness. The metal lobe conserves energy (single scattering loses some when rough).
 struct MetalRoughBrdf {
   vec3 base_color{1.0f};      // linear RGB in [0, 1]: diffuse colour, and f0 of the metal

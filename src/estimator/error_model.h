@@ -12,8 +12,8 @@
 
 namespace pb {
 
-// What --target-error measures (docs/usage.md "Stop rules"): the absolute error, or the error relative
-// to max(L, kRelativeFloor x the image's mean radiance) (film.h).
+// What --target-error measures (docs/usage.md "Stop rules"): the absolute error, or the error
+// relative to max(L, kRelativeFloor x the image's mean radiance) (film.h).
 enum class ErrorMetric { Absolute, Relative };
 
 // E|mu + sigma Z| = sigma sqrt(2/pi) exp(-mu^2 / (2 sigma^2)) + mu erf(mu / (sigma sqrt 2)).

@@ -131,7 +131,8 @@ inline constexpr double kBiasNoiseRatio = 0.36025628811821314;
 // Beyond ESTIMATOR.md section 7 (a point without photons is unknown): a t-interval over a
 // handful of Poisson arrivals is too short on the high side. Measured with a photon once per
 // 1,000 passes, points with 1-4 photons covered 69-80% at a nominal 90%, points with 5 or more
-// 90-100% (tests/render/test_slow_extremes.cpp). Below this many photons the bound is unknown (+inf).
+// 90-100% (tests/render/test_slow_extremes.cpp). Below this many photons the bound is unknown
+// (+inf).
 inline constexpr uint64_t kMinPhotonsForBound = 5;
 
 // The photon part of L_i computed from the PPM accumulators, tau / (pi R^2 i M_e). Equal to the

@@ -327,8 +327,8 @@ const std::vector<float>& FilmImage::plane(Channel id) const {
 }
 
 // ESTIMATOR.md sections 5-7: combine, check the model, take the prior, bound and predict.
-FilmSummary develop(const PixelLayout& layout, const std::vector<PointState>& states, uint64_t passes,
-                    const FilmSettings& s, FilmImage* image) {
+FilmSummary develop(const PixelLayout& layout, const std::vector<PointState>& states,
+                    uint64_t passes, const FilmSettings& s, FilmImage* image) {
   const std::vector<PixelResult> results = combine_pixels(layout, states, passes, s);
   const size_t pixels = results.size();
   FilmSummary sum;
@@ -342,8 +342,9 @@ FilmSummary develop(const PixelLayout& layout, const std::vector<PointState>& st
     bound_pixel(results[p], tau2[p], rule, sum.model_refuted, passes, p, tally, sum, image);
   summarise(tally, s, sum);
   if (sum.unknown_pixels == 0 && pixels > 0) {
-    const ErrorPrediction e = predict_mean_error(
-        tally.model, layout.width, layout.height, mean_r2(states), layout.footprint, rule.nu, s.confidence);
+    const ErrorPrediction e =
+        predict_mean_error(tally.model, layout.width, layout.height, mean_r2(states),
+                           layout.footprint, rule.nu, s.confidence);
     sum.correlated_pixels = e.correlated_pixels;
     sum.predicted_error = e.mean;
     sum.predicted_error_upper = e.upper;

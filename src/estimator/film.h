@@ -2,8 +2,8 @@
 #pragma once
 
 #include "estimator/channels.h"
-#include "estimator/estimator.h"
 #include "estimator/error_model.h"
+#include "estimator/estimator.h"
 #include "util/math.h"
 
 #include <cstddef>
@@ -93,10 +93,10 @@ struct PixelLayout {
   // state's f and 1 / (c pi R^2) is the most one photon adds to a pass sample; the states'
   // BRDF (PPM: each point's f; SPPM: the largest a visible point can have) and kernel mass c.
   double photon_cap = 0.0;
-  StridedColours point_f;                    // PPM
-  vec3 max_f{0.0f};                          // SPPM
-  std::span<const float> glossy_f;           // SPPM: per pixel, glossy points' (empty: none)
-  std::vector<float> mass;                   // per state; empty: 1
+  StridedColours point_f;           // PPM
+  vec3 max_f{0.0f};                 // SPPM
+  std::span<const float> glossy_f;  // SPPM: per pixel, glossy points' (empty: none)
+  std::vector<float> mass;          // per state; empty: 1
   double footprint = 0.0;  // median pixel footprint at the points (the errors' correlation)
 };
 // Combines the states of every pixel. With passes < 2 no bound exists: every pixel with

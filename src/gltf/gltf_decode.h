@@ -1,7 +1,8 @@
 // Decoders for compressed glTF geometry: KHR_draco_mesh_compression (Draco) and
-// EXT_meshopt_compression (meshoptimizer). Only src/gltf/gltf_decode.cpp includes the two libraries;
-// the loader (src/gltf/gltf_geometry.cpp, src/gltf/gltf_accessor.cpp) sees these plain types. Failures
-// throw DecodeError, whose message the loader prefixes with the file and the glTF object.
+// EXT_meshopt_compression (meshoptimizer). Only src/gltf/gltf_decode.cpp includes the two
+// libraries; the loader (src/gltf/gltf_geometry.cpp, src/gltf/gltf_accessor.cpp) sees these plain
+// types. Failures throw DecodeError, whose message the loader prefixes with the file and the glTF
+// object.
 #pragma once
 
 #include <cstddef>

@@ -4,8 +4,8 @@
 #pragma once
 
 #include "scene/environment.h"
-#include "util/rng.h"
 #include "scene/scene.h"
+#include "util/rng.h"
 
 #include <optional>
 #include <span>

@@ -39,7 +39,7 @@ enum class StopRule { MeanError, MeanBound, Pixels };
 inline constexpr double kDefaultFollowRoughness = 0.7;
 
 struct RenderOptions {
-  std::string scene;   // glTF file (the positional argument, not an option)
+  std::string scene;  // glTF file (the positional argument, not an option)
   // Folders besides the scene's own that its buffers and images may be read from (--asset-dir,
   // repeatable; absolute: the state is resumed from anywhere).
   std::vector<std::string> asset_dirs;
@@ -59,8 +59,8 @@ struct RenderOptions {
   double follow_roughness = kDefaultFollowRoughness;
   std::optional<int> width, height;
   std::string camera;  // empty = first perspective camera
-  // The view (camera_choice.h): each replaces the camera's own, or the default view's when the file has
-  // no camera.
+  // The view (camera_choice.h): each replaces the camera's own, or the default view's when the file
+  // has no camera.
   std::optional<std::array<double, 3>> look_from, look_at, up;
   std::optional<double> fov;  // vertical field of view, degrees
   // The environment light (scene_defaults.h): "" for none, or the default sky when the scene has

@@ -3,8 +3,8 @@
 // applied on top (docs/gltf.md "Cameras and the default view").
 #pragma once
 
-#include "scene/camera.h"
 #include "options/options.h"
+#include "scene/camera.h"
 #include "scene/scene.h"
 
 namespace pb {

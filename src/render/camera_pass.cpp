@@ -20,7 +20,7 @@ struct PathVertex {
 
 struct PixelOutput {
   std::vector<VisiblePoint> points;
-  std::vector<float> footprints;    // one per point
+  std::vector<float> footprints;  // one per point
   std::vector<PointBsdf> glossy;  // point = index into points
   dvec3 emission{0.0};
 };

@@ -44,10 +44,10 @@ struct PointBsdf {
 
 struct CameraPassResult {
   int width = 0, height = 0;
-  std::vector<VisiblePoint> points;  // grouped by pixel, in pixel order
-  std::vector<PointBsdf> glossy;       // the non-Lambertian points', sorted by point index
-  std::vector<uint32_t> pixel_begin;     // points of pixel p: [pixel_begin[p], pixel_begin[p+1])
-  std::vector<dvec3> emission;           // Le seen along exact specular chains, per pixel
+  std::vector<VisiblePoint> points;   // grouped by pixel, in pixel order
+  std::vector<PointBsdf> glossy;      // the non-Lambertian points', sorted by point index
+  std::vector<uint32_t> pixel_begin;  // points of pixel p: [pixel_begin[p], pixel_begin[p+1])
+  std::vector<dvec3> emission;        // Le seen along exact specular chains, per pixel
   // Median over the points of the pixel footprint at the point (camera path length x pixel
   // angle): what the default initial radius is made from. 0 without points.
   float median_footprint = 0.0f;

@@ -7,7 +7,6 @@
 
 namespace pb {
 
-
 PpmMethod::PpmMethod(const World& world, const PinholeCamera& camera, int max_depth)
     : pass_(run_camera_pass(world, camera, max_depth)) {
   state_count_ = pass_.points.size();

@@ -1,10 +1,10 @@
 #include "render/renderer.h"
 
-#include "util/parallel.h"
 #include "render/pass_stages.h"
 #include "render/ppm.h"
-#include "render/sppm.h"
 #include "render/scene_defaults.h"
+#include "render/sppm.h"
+#include "util/parallel.h"
 #include "util/timer.h"
 
 #include <algorithm>
@@ -112,8 +112,13 @@ void Renderer::step(std::vector<PointState>* copy) {
 
   t = Clock::now();
   if (copy) copy->resize(n);
-  const PassInputs in{world_,   grid_,         hits_, params_,
-                      boundary_on_ ? &boundary_ : nullptr, options_.seed, pass,
+  const PassInputs in{world_,
+                      grid_,
+                      hits_,
+                      params_,
+                      boundary_on_ ? &boundary_ : nullptr,
+                      options_.seed,
+                      pass,
                       options_.direct == DirectMode::NextEvent};
   method_->step(in, states_, radii_, copy ? copy->data() : nullptr);
   timings_.gather += seconds_since(t);

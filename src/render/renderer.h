@@ -5,16 +5,16 @@
 // When to stop, what to print and when to checkpoint belong to the driver (app/driver.h).
 #pragma once
 
-#include "world/boundary.h"
 #include "estimator/estimator.h"
-#include "render/camera_pass.h"
 #include "estimator/film.h"
-#include "render/hash_grid.h"
-#include "render/method.h"
 #include "io/image_io.h"
 #include "options/options.h"
-#include "render/photon_pass.h"
 #include "render/camera_choice.h"
+#include "render/camera_pass.h"
+#include "render/hash_grid.h"
+#include "render/method.h"
+#include "render/photon_pass.h"
+#include "world/boundary.h"
 #include "world/world.h"
 
 #include <cstdint>

@@ -1,10 +1,10 @@
 #include "render/scene_defaults.h"
 
 #include "estimator/channels.h"
-#include "util/file_io.h"
 #include "lights/lights.h"
-#include "util/rng.h"
 #include "render/camera_choice.h"
+#include "util/file_io.h"
+#include "util/rng.h"
 
 #include <cmath>
 #include <cstdio>

@@ -5,9 +5,7 @@
 
 namespace pb {
 
-
-SppmMethod::SppmMethod(const World& world, const PinholeCamera& camera,
-                       CameraPathSettings settings)
+SppmMethod::SppmMethod(const World& world, const PinholeCamera& camera, CameraPathSettings settings)
     : camera_(camera), settings_(settings) {
   // SPPM keeps no points: the default radius comes from the footprints of a sample of
   // pixel-centre paths (every 4th pixel each way).
@@ -33,8 +31,8 @@ SppmMethod::SppmMethod(const World& world, const PinholeCamera& camera,
 
 void SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
                       PointState* copy) {
-  const CameraPathInputs camera{in.world, camera_,  settings_.max_depth, settings_.follow_roughness,
-                                in.seed,  in.pass,  in.next_event,       in.boundary};
+  const CameraPathInputs camera{in.world, camera_, settings_.max_depth, settings_.follow_roughness,
+                                in.seed,  in.pass, in.next_event,       in.boundary};
   const size_t n = states.size(), block = sums_.size();
   for (size_t first = 0; first < n; first += block) {
     const size_t count = std::min(block, n - first);

@@ -40,8 +40,8 @@ class SppmMethod final : public PhotonMethod {
 
   const PinholeCamera& camera_;
   CameraPathSettings settings_;
-  CameraPassResult pass_;  // the image size and the median footprint of pixel-centre paths
-  vec3 max_f_{0.0f};   // the largest BRDF a Lambertian visible point can have
+  CameraPassResult pass_;          // the image size and the median footprint of pixel-centre paths
+  vec3 max_f_{0.0f};               // the largest BRDF a Lambertian visible point can have
   std::vector<uint32_t> visible_;  // passes with a visible point, per pixel
   std::vector<float> min_mass_;    // smallest kernel mass seen, per pixel
   std::vector<float> glossy_f_;    // largest glossy f seen, per pixel

@@ -24,8 +24,8 @@ constexpr float gamma_bound(int n) {
 // needs. PBR's bound is gamma(7) (|b0 p0| + |b1 p1| + |b2 p2|), projected on |n|. Embree computes
 // a ray's distance to the plane from v0 - origin, whose rounding grows with |p0| whatever the
 // barycentrics, so the sum here is over the vertices' magnitudes unweighted: it bounds PBR's sum
-// and Embree's (tests/world/test_offsets.cpp fires rays from points near every corner of huge, tilted
-// and far-off triangles and finds no self-hit; with the weighted sum it finds some).
+// and Embree's (tests/world/test_offsets.cpp fires rays from points near every corner of huge,
+// tilted and far-off triangles and finds no self-hit; with the weighted sum it finds some).
 inline float surface_error(const vec3& p0, const vec3& p1, const vec3& p2, const vec3& n) {
   const vec3 sum = glm::abs(p0) + glm::abs(p1) + glm::abs(p2);
   return gamma_bound(7) * glm::dot(glm::abs(n), sum);

@@ -1,4 +1,5 @@
-// Ray queries over the scene's triangles. The only file that includes Embree is src/world/accel.cpp.
+// Ray queries over the scene's triangles. The only file that includes Embree is
+// src/world/accel.cpp.
 #pragma once
 
 #include "scene/scene.h"

@@ -2,12 +2,12 @@
 // structure and the light sampler, and the geometric queries every pass needs.
 #pragma once
 
-#include "world/accel.h"
 #include "lights/lights.h"
-#include "util/ray_offset.h"
 #include "scene/scene.h"
-#include "world/surface.h"
 #include "scene/texture.h"
+#include "util/ray_offset.h"
+#include "world/accel.h"
+#include "world/surface.h"
 
 #include <optional>
 #include <string>

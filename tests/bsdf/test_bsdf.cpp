@@ -2,8 +2,8 @@
 // (Fresnel, Snell), Monte Carlo moments of the samplers with 4-standard-error tolerances, and
 // the deterministic specular branches of mirrors and dielectrics.
 #include "bsdf/bsdf.h"
-#include "util/rng.h"
 #include "scene/scene.h"
+#include "util/rng.h"
 #include "world/surface.h"
 
 #include "bsdf_test_util.h"

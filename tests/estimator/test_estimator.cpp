@@ -2,9 +2,9 @@
 // the bias and Laplacian estimates on a quadratic field, and the per-point progressive state
 // (PPM update, streaming moments, retroactive bias correction, Student-t quantiles) against
 // direct recomputation from the recorded per-pass samples.
-#include "pass_sample.h"
 #include "estimator/estimator.h"
 #include "estimator/kernel.h"
+#include "pass_sample.h"
 #include "util/rng.h"
 
 #include <boost/math/distributions/normal.hpp>

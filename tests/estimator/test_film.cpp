@@ -1,8 +1,8 @@
 // The image's mean-error prediction (ESTIMATOR.md section 7) on synthetic fields of known
 // correlation: states fed pass samples directly, developed as SPPM pixels, against the spread
 // of the actual mean |error| over many independent trials.
-#include "pass_sample.h"
 #include "estimator/film.h"
+#include "pass_sample.h"
 
 #include <gtest/gtest.h>
 

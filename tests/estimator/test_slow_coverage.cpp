@@ -3,8 +3,8 @@
 // points over independent trials, and the fraction of (point, trial) whose actual error lies
 // within the reported bound compared with the nominal confidence. Then the same in a render
 // whose visible points are glossy (glTF's BRDF evaluated per photon) against its exact answer.
-#include "pass_sample.h"
 #include "analytic.h"
+#include "pass_sample.h"
 #include "render_fixture.h"
 
 #include "estimator/estimator.h"

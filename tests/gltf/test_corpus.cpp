@@ -1,6 +1,6 @@
 // "Any glTF file renders" (issue 16): a corpus written the way exporters write glTF, made by the
-// project's own generators (python3 -m tools.make_scenes --corpus: no camera and no light, animations,
-// morph targets, unimplemented extensions, directional and spot lights, a huge ground;
+// project's own generators (python3 -m tools.make_scenes --corpus: no camera and no light,
+// animations, morph targets, unimplemented extensions, directional and spot lights, a huge ground;
 // tools/cpp/make_gltf_corpus: Draco, meshopt, quantised and sparse attributes, a skin without
 // inverse bind matrices), renders file by file through the command line with exit code 0, a
 // plausible image (finite radiance, not black, not flat) and exactly the expected notes and
@@ -72,10 +72,11 @@ class Corpus : public pb::test::TempDirTest {};
 TEST_F(Corpus, EveryFileRendersWithOnlyTheExpectedWarnings) {
   const std::string corpus = path("corpus");
   // The tools are the package `tools` of the source root (python3 -m tools.make_scenes).
-  ASSERT_EQ(std::system(("cd " + quote(PHOTONBOUND_SOURCE_DIR) + " && " + quote(PHOTONBOUND_PYTHON) +
-                         " -m tools.make_scenes --corpus " + quote(corpus) + " >/dev/null")
-                            .c_str()),
-            0);
+  ASSERT_EQ(
+      std::system(("cd " + quote(PHOTONBOUND_SOURCE_DIR) + " && " + quote(PHOTONBOUND_PYTHON) +
+                   " -m tools.make_scenes --corpus " + quote(corpus) + " >/dev/null")
+                      .c_str()),
+      0);
   ASSERT_EQ(std::system((quote(PHOTONBOUND_MAKE_CORPUS) + " " + quote(corpus)).c_str()), 0);
   std::vector<fs::path> files;
   for (const auto& e : fs::directory_iterator(corpus))

@@ -6,8 +6,8 @@
 #include "gltf_expect.h"
 
 #include "lights/lights.h"
-#include "render/scene_defaults.h"
 #include "render/camera_choice.h"
+#include "render/scene_defaults.h"
 #include "world/world.h"
 
 #include <algorithm>

@@ -3,8 +3,8 @@
 // map's pixels (every row's solid angle and cosine moment are closed forms).
 #include "scene_builder.h"
 
-#include "scene/environment.h"
 #include "lights/lights.h"
+#include "scene/environment.h"
 #include "util/rng.h"
 
 #include <gtest/gtest.h>

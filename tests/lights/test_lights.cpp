@@ -1,7 +1,7 @@
 // Light sampling: spherical-triangle directions and next-event estimates against exact answers;
 // textured emitters (power, where photons start, next-event estimates) and double-sided ones.
-#include "lights/lights.h"
 #include "bsdf/microfacet.h"
+#include "lights/lights.h"
 #include "util/rng.h"
 
 #include <gtest/gtest.h>

@@ -5,8 +5,8 @@
 // (finite channels or +inf exactly where unknown, bounds that shrink or grow as the method says,
 // coverage, positive radii), not only the absence of a crash. ctest -R Extremes selects the suite;
 // test_slow_extremes.cpp holds the long forms.
-#include "pass_sample.h"
 #include "extremes.h"
+#include "pass_sample.h"
 
 #include <gtest/gtest.h>
 

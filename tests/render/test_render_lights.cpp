@@ -7,8 +7,8 @@
 #include "render_fixture.h"
 #include "scene_builder.h"
 
-#include "util/parallel.h"
 #include "render/scene_defaults.h"
+#include "util/parallel.h"
 
 #include <gtest/gtest.h>
 
@@ -216,7 +216,8 @@ TEST(EnvironmentRender, BackgroundShowsTheMap) {
   for (int y = 0; y < kSize; ++y)
     for (int x = 0; x < kSize; ++x) {
       const size_t p = size_t(y * kSize + x);
-      ASSERT_EQ(r.camera_pass().pixel_begin[p], r.camera_pass().pixel_begin[p + 1]);  // no surface in view
+      ASSERT_EQ(r.camera_pass().pixel_begin[p],
+                r.camera_pass().pixel_begin[p + 1]);  // no surface in view
       EXPECT_EQ(vec3(r.camera_pass().emission[p]), env.radiance(cam.direction(x, y)));
     }
 }

@@ -3,8 +3,8 @@
 // alphaMode MASK cut-outs for camera rays, shadow rays and photons, a base colour texture with
 // KHR_texture_transform, a normal texture, and glTF's default material (a rough metal).
 #include "render/camera_paths.h"
-#include "util/parallel.h"
 #include "render/renderer.h"
+#include "util/parallel.h"
 
 #include <gtest/gtest.h>
 

@@ -114,7 +114,8 @@ TEST(SlowExtremes, AlphaSweepLong) {
     run.passes(64);
     const double b64 = extremes::mean_bound(*run.r, 0.9);
     const double noise64 =
-        develop(run.r->camera_pass(), run.r->states(), 64, run.r->film_settings(), nullptr).mean_noise;
+        develop(run.r->camera_pass(), run.r->states(), 64, run.r->film_settings(), nullptr)
+            .mean_noise;
     run.passes(512);
     extremes::check_states(run);
     EXPECT_EQ(extremes::check_film(*run.r, run.r->film_settings()).unknown, 0u);

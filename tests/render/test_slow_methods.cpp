@@ -25,7 +25,7 @@ std::vector<bool> smooth_interior(const Renderer& ppm) {
   const auto points = [&](int x, int y) {
     const size_t p = size_t(y) * size_t(w) + size_t(x);
     return std::span<const VisiblePoint>(eye.points.data() + eye.pixel_begin[p],
-                                             eye.pixel_begin[p + 1] - eye.pixel_begin[p]);
+                                         eye.pixel_begin[p + 1] - eye.pixel_begin[p]);
   };
   for (int y = 1; y + 1 < h; ++y)
     for (int x = 1; x + 1 < w; ++x) {

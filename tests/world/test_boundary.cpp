@@ -1,7 +1,7 @@
 // The boundary index (boundary.h, ESTIMATOR.md section 11): the kernel's moments over the part of
 // a disc that lies on reachable surface, against brute-force integration over the disc.
-#include "world/boundary.h"
 #include "estimator/kernel.h"
+#include "world/boundary.h"
 #include "world/world.h"
 
 #include <gtest/gtest.h>
