@@ -197,4 +197,36 @@ std::string tinygltf_decoded(const std::string& uri) {
   return out;
 }
 
+namespace {
+
+// The name under the scene's folder that tinygltf joined to it, or none.
+std::optional<std::string> name_under(const AssetFiles& files, const std::string& joined) {
+  const std::string& base = files.base();
+  const std::string prefix = !base.empty() && base.back() == '/' ? base : base + "/";
+  if (joined.rfind(prefix, 0) != 0) return std::nullopt;
+  return joined.substr(prefix.size());
+}
+
+}  // namespace
+
+bool fs_exists(const std::string& joined, void* user) {
+  auto& files = *static_cast<AssetFiles*>(user);
+  const std::optional<std::string> name = name_under(files, joined);
+  return name && files.check(*name) == AssetFiles::Verdict::Readable;
+}
+std::string fs_expand(const std::string& path, void*) { return path; }
+bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& joined,
+             void* user) {
+  auto& files = *static_cast<AssetFiles*>(user);
+  const std::optional<std::string> name = name_under(files, joined);
+  std::string why = "refused";
+  const bool ok = name && files.read(*name, *out, why);
+  if (!ok && err) *err = why;
+  return ok;
+}
+bool fs_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
+  if (err) *err = "the loader writes no files";
+  return false;
+}
+
 }  // namespace pb::gltf

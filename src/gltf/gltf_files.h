@@ -57,4 +57,14 @@ class AssetFiles {
 // unlike RFC 3986, '+' read as a space.
 std::string tinygltf_decoded(const std::string& uri);
 
+// tinygltf's file-system callbacks over an AssetFiles (`user`): tinygltf asks whether
+// `base/NAME` exists, then for its bytes; it would then try `./NAME` (the working directory),
+// which is never there. Nothing is ever written.
+bool fs_exists(const std::string& joined, void* user);
+std::string fs_expand(const std::string& path, void* user);
+bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& joined,
+             void* user);
+bool fs_write(std::string* err, const std::string& path, const std::vector<unsigned char>& bytes,
+              void* user);
+
 }  // namespace pb::gltf

@@ -53,34 +53,6 @@ bool spurious(const std::string& line) {
   return line == "'inverseBindMatrices' property is missing in Skin.";
 }
 
-// tinygltf's file-system callbacks, over AssetFiles: tinygltf asks whether `base/NAME` exists,
-// then for its bytes; it would then try `./NAME` (the working directory), which is never there.
-std::optional<std::string> name_under(const AssetFiles& files, const std::string& joined) {
-  const std::string& base = files.base();
-  const std::string prefix = !base.empty() && base.back() == '/' ? base : base + "/";
-  if (joined.rfind(prefix, 0) != 0) return std::nullopt;
-  return joined.substr(prefix.size());
-}
-bool fs_exists(const std::string& joined, void* user) {
-  auto& files = *static_cast<AssetFiles*>(user);
-  const std::optional<std::string> name = name_under(files, joined);
-  return name && files.check(*name) == AssetFiles::Verdict::Readable;
-}
-std::string fs_expand(const std::string& path, void*) { return path; }
-bool fs_read(std::vector<unsigned char>* out, std::string* err, const std::string& joined,
-             void* user) {
-  auto& files = *static_cast<AssetFiles*>(user);
-  const std::optional<std::string> name = name_under(files, joined);
-  std::string why = "refused";
-  const bool ok = name && files.read(*name, *out, why);
-  if (!ok && err) *err = why;
-  return ok;
-}
-bool fs_write(std::string* err, const std::string&, const std::vector<unsigned char>&, void*) {
-  if (err) *err = "the loader writes no files";
-  return false;
-}
-
 // GLB by its magic, otherwise glTF JSON, rewritten first where tinygltf needs it
 // (gltf_prepass.h). Every error tinygltf reports is fatal, even when it returns true (2.7 drops
 // e.g. a baseColorFactor of the wrong length with only a message), but the spurious ones.
@@ -191,49 +163,6 @@ Scene Loader::run(const std::vector<std::string>& parse_warnings) {
   traverse();
   finish();
   return std::move(scene_);
-}
-
-void Loader::check_extensions() {
-  // What photonbound reads (basisu: its fallback image, or a warning).
-  static const std::set<std::string> known = {
-      "KHR_lights_punctual",        "KHR_materials_transmission",
-      "KHR_materials_ior",          "KHR_materials_emissive_strength",
-      "KHR_materials_specular",     "KHR_materials_volume",
-      "KHR_materials_clearcoat",    "KHR_materials_sheen",
-      "KHR_materials_anisotropy",   "KHR_materials_iridescence",
-      "KHR_materials_dispersion",   "KHR_materials_pbrSpecularGlossiness",
-      "KHR_draco_mesh_compression", "EXT_meshopt_compression",
-      "KHR_mesh_quantization",      "KHR_texture_transform",
-      "KHR_texture_basisu",         "EXT_texture_webp",
-      "EXT_mesh_gpu_instancing",    "KHR_materials_diffuse_transmission"};
-  // What changes nothing photonbound draws, so that leaving it out is exact: metadata, the
-  // material variants' default (what a viewer shows first), and MSFT_lod's base node (the
-  // finest level of detail).
-  static const std::set<std::string> exact_without = {"KHR_xmp", "KHR_xmp_json_ld",
-                                                      "KHR_materials_variants", "MSFT_lod"};
-  // Unknown extensions, even required ones, are rendered without (docs/gltf.md "Compression,
-  // instancing, deformation and extensions"): a material extension then falls back to the core
-  // factors; data an unknown extension holds is missing, and the accessors that lack it are refused
-  // with their own message. What rendering without it means, where that is not only a material
-  // falling back to its core factors:
-  auto without = [](const std::string& e) -> std::string {
-    if (e == "KHR_materials_unlit")
-      return ": its materials are lit (light is simulated, not painted on), by their "
-             "metallic-roughness factors";
-    return "";
-  };
-  for (const std::string& e : m_.extensionsRequired)
-    if (!known.count(e) && !exact_without.count(e))
-      warn("extension '" + e + "' is required but not implemented; rendered without it" +
-           without(e));
-  for (const std::string& e : m_.extensionsUsed)
-    if (!known.count(e) && !exact_without.count(e) &&
-        !std::count(m_.extensionsRequired.begin(), m_.extensionsRequired.end(), e))
-      warn("extension '" + e + "' is ignored" + without(e));
-  if (!m_.animations.empty())
-    warn(std::to_string(m_.animations.size()) +
-         (m_.animations.size() == 1 ? " animation is" : " animations are") +
-         " ignored; the scene is drawn as the nodes place it");
 }
 
 dmat4 Loader::local_matrix(const tinygltf::Node& n, const std::string& nl) const {
