@@ -132,47 +132,42 @@ bool AssetFiles::read(const std::string& name, std::vector<unsigned char>& out, 
     err = "refused";
     return false;
   }
-  // Not blocking in open() (a named pipe put there since the check), not following a symlink
-  // put there since the check, and checked again once open.
+  // Not following a symlink put there since the check, and checked again once open.
+  if (const std::optional<ReadFailure> f = read_regular_file(r.path, false, out)) {
+    err = f->why;
+    if (f->stage == ReadFailure::NotRegular) {
+      refuse(name, f->why);
+      err = "refused";
+    }
+    return false;
+  }
+  read_.push_back(r.path.string());
+  return true;
+}
+
+std::optional<ReadFailure> read_regular_file(const fs::path& path, bool follow_last_link,
+                                             std::vector<unsigned char>& out) {
+  // O_NONBLOCK: a named pipe is refused below, never waited on in open().
   errno = 0;
-  const Fd fd(::open(r.path.c_str(), O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOFOLLOW));
-  if (fd.get() < 0) {
-    err = std::strerror(errno);
-    return false;
-  }
+  const Fd fd(::open(path.c_str(),
+                     O_RDONLY | O_NONBLOCK | O_CLOEXEC | (follow_last_link ? 0 : O_NOFOLLOW)));
+  if (fd.get() < 0) return ReadFailure{ReadFailure::Open, std::strerror(errno)};
   struct stat st;
-  if (::fstat(fd.get(), &st) != 0) {
-    err = std::strerror(errno);
-    return false;
-  }
-  if (!S_ISREG(st.st_mode)) {
-    refuse(name, type_of(st.st_mode));
-    err = "refused";
-    return false;
-  }
-  if (uint64_t(st.st_size) > UINT_MAX) {
-    err = "larger than 4 GiB";
-    return false;
-  }
+  if (::fstat(fd.get(), &st) != 0) return ReadFailure{ReadFailure::Open, std::strerror(errno)};
+  if (!S_ISREG(st.st_mode)) return ReadFailure{ReadFailure::NotRegular, type_of(st.st_mode)};
+  const ReadFailure too_large{ReadFailure::TooLarge, "larger than 4 GiB"};
+  if (uint64_t(st.st_size) > UINT_MAX) return too_large;
   out.clear();
   out.reserve(size_t(st.st_size));
   unsigned char chunk[1 << 16];
   for (;;) {
     const ssize_t n = ::read(fd.get(), chunk, sizeof chunk);
     if (n < 0 && errno == EINTR) continue;
-    if (n < 0) {
-      err = std::strerror(errno);
-      return false;
-    }
-    if (n == 0) break;
+    if (n < 0) return ReadFailure{ReadFailure::Read, std::strerror(errno)};
+    if (n == 0) return std::nullopt;
     out.insert(out.end(), chunk, chunk + n);
-    if (out.size() > UINT_MAX) {
-      err = "larger than 4 GiB";
-      return false;
-    }
+    if (out.size() > UINT_MAX) return too_large;
   }
-  read_.push_back(r.path.string());
-  return true;
 }
 
 std::string tinygltf_decoded(const std::string& uri) {

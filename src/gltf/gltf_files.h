@@ -53,6 +53,20 @@ class AssetFiles {
   std::vector<std::string> read_;
 };
 
+// Why read_regular_file failed: at open() or fstat(), a file that is not a regular one (`why`
+// is then "is a named pipe, not a regular file" and the like), a read(), or a file over 4 GiB.
+struct ReadFailure {
+  enum Stage { Open, NotRegular, Read, TooLarge } stage;
+  std::string why;
+};
+// Reads the regular file at `path` whole: opened without blocking (a named pipe or a device is
+// refused, never waited on) and, unless `follow_last_link`, without following a last symbolic
+// link; its type checked on the open file. The scene file and every file it refers to are read
+// by it.
+std::optional<ReadFailure> read_regular_file(const std::filesystem::path& path,
+                                             bool follow_last_link,
+                                             std::vector<unsigned char>& out);
+
 // A buffer or image URI as tinygltf 2.7 decodes it before it asks for the file: %XX decoded and,
 // unlike RFC 3986, '+' read as a space.
 std::string tinygltf_decoded(const std::string& uri);

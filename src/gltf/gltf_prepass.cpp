@@ -17,35 +17,11 @@ namespace {
 
 using nlohmann::json;
 
-constexpr size_t kMaxNesting = kMaxJsonNesting;  // nlohmann's dump() recurses once per level
-
 bool needs_prepass(std::string_view text) {
   for (const char* key : {"EXT_meshopt_compression", "KHR_draco_mesh_compression", "\"sparse\"",
                           "KHR_animation_pointer"})
     if (text.find(key) != std::string_view::npos) return true;
   return false;
-}
-
-// Deepest [ ] / { } nesting outside strings.
-size_t nesting(std::string_view text) {
-  size_t depth = 0, deepest = 0;
-  bool in_string = false;
-  for (size_t i = 0; i < text.size(); ++i) {
-    const char c = text[i];
-    if (in_string) {
-      if (c == '\\')
-        ++i;
-      else if (c == '"')
-        in_string = false;
-    } else if (c == '"') {
-      in_string = true;
-    } else if (c == '[' || c == '{') {
-      deepest = std::max(deepest, ++depth);
-    } else if ((c == ']' || c == '}') && depth > 0) {
-      --depth;
-    }
-  }
-  return deepest;
 }
 
 // A buffer without uri that cannot be the GLB's BIN chunk becomes a one-byte data URI
@@ -335,7 +311,7 @@ std::string uri_owner(std::string_view text, const std::string& decoded) {
 }
 
 bool prepass(std::string_view text, bool glb, Prepass& out, std::string& rewritten) {
-  if (!needs_prepass(text) || nesting(text) > kMaxNesting) return false;
+  if (!needs_prepass(text)) return false;
   json doc = json::parse(text.begin(), text.end(), nullptr, /*allow_exceptions=*/false);
   if (doc.is_discarded() || !doc.is_object()) return false;
   const bool buffers = rewrite_buffers(doc, glb, out);

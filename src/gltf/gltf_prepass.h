@@ -30,8 +30,9 @@ struct Prepass {
 };
 
 // When anything in `json` (the JSON text, or the GLB's JSON chunk when `glb`) needs changing,
-// writes the changed text to `rewritten`, fills `out` and returns true. Text that is not JSON,
-// or nests deeper than 512 levels, is left to tinygltf to report.
+// writes the changed text to `rewritten`, fills `out` and returns true. Text that is not JSON is
+// left to tinygltf to report. The loader runs json_problem() first, so no text deeper than
+// kMaxJsonNesting reaches the parser here.
 bool prepass(std::string_view json, bool glb, Prepass& out, std::string& rewritten);
 
 // Nesting deeper than this is refused before any recursive parser sees the text.

@@ -1,16 +1,14 @@
 // tinygltf-free helpers of the glTF loader; see gltf_support.h.
 #include "gltf/gltf_support.h"
 
+#include "gltf/gltf_files.h"
 #include "gltf/gltf_loader.h"
 
 #include <algorithm>
-#include <cerrno>
 #include <climits>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <limits>
-#include <memory>
 #include <sstream>
 
 namespace pb::gltf {
@@ -57,15 +55,19 @@ std::vector<unsigned char> read_file(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
     throw SceneError(path + ": cannot open (Is a directory)");
-  errno = 0;
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> f(std::fopen(path.c_str(), "rb"), &std::fclose);
-  if (!f) throw SceneError(path + ": cannot open (" + std::strerror(errno) + ")");
   std::vector<unsigned char> data;
-  unsigned char chunk[1 << 16];
-  for (size_t n; (n = std::fread(chunk, 1, sizeof chunk, f.get())) > 0;)
-    data.insert(data.end(), chunk, chunk + n);
-  if (std::ferror(f.get())) throw SceneError(path + ": cannot read (" + std::strerror(errno) + ")");
-  if (data.size() > UINT_MAX) throw SceneError(path + ": file is larger than 4 GiB");
+  if (const std::optional<ReadFailure> f = read_regular_file(path, true, data)) {
+    switch (f->stage) {
+      case ReadFailure::Open:
+        throw SceneError(path + ": cannot open (" + f->why + ")");
+      case ReadFailure::NotRegular:
+        throw SceneError(path + ": " + f->why);
+      case ReadFailure::Read:
+        throw SceneError(path + ": cannot read (" + f->why + ")");
+      case ReadFailure::TooLarge:
+        throw SceneError(path + ": file is larger than 4 GiB");
+    }
+  }
   return data;
 }
 
