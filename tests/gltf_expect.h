@@ -57,9 +57,10 @@ class DecodeTest : public TempDirTest {
     EXPECT_EQ(s.meshes.size(), 1u);
     return s.meshes.at(0);
   }
-  void expect_error(const std::string& file, const std::string& phrase) {
+  void expect_error(const std::string& file, const std::string& phrase,
+                    const LoadPolicy& policy = {}) {
     try {
-      load_gltf(file);
+      load_gltf(file, policy);
       ADD_FAILURE() << "expected a SceneError containing \"" << phrase << "\"";
     } catch (const SceneError& e) {
       const std::string m = e.what();

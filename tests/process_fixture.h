@@ -4,13 +4,21 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <array>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 #include <string>
+#include <thread>
+#include <vector>
+
+extern char** environ;
 
 namespace pb::test {
 
@@ -38,6 +46,44 @@ inline Outcome run_photonbound(const std::string& args, const std::string& dir =
   const int status = pclose(pipe);
   r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return r;
+}
+
+// Starts photonbound with `args` (args[0] is its name), stderr to /dev/null; its pid, or -1.
+inline pid_t spawn(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
+  pid_t pid = -1;
+  posix_spawn(&pid, PHOTONBOUND_EXE, &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  return pid;
+}
+
+// Waits (at most 60 s) for a file to appear; false if it never does.
+inline bool wait_for(const std::string& file) {
+  for (int k = 0; k < 600; ++k) {
+    if (std::filesystem::exists(file)) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  }
+  return false;
+}
+
+// Waits until process pid catches `sig` (its handler is installed: the SigCgt mask of
+// /proc/PID/status), so that a signal sent then is the program's to handle, however slowly a
+// loaded machine starts it.
+inline bool wait_for_handler(pid_t pid, int sig) {
+  for (int k = 0; k < 600; ++k) {
+    std::ifstream status("/proc/" + std::to_string(pid) + "/status");
+    for (std::string line; std::getline(status, line);)
+      if (line.rfind("SigCgt:", 0) == 0 &&
+          (std::stoull(line.substr(7), nullptr, 16) >> (sig - 1)) & 1u)
+        return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  return false;
 }
 
 // A folder name under the system temporary directory that no other process uses: the process

@@ -136,7 +136,34 @@ def smoke(exe, tmp):
     leftovers = [f for _, _, fs in os.walk(out) for f in fs if f.startswith(".")]
     check(not leftovers, f"temporary files left behind: {leftovers}")
     cornell_reference_margin(exe, tmp)
+    adaptive_study(exe, tmp)
     gltf_reading(tmp)
+
+
+def adaptive_study(exe, tmp):
+    """tools.adaptive_study's table says what the renders it made say: one row per target, each
+    mode's passes as the EXR records them, the actual error as compare measures it."""
+    out = os.path.join(tmp, "adaptive")
+    p = run_tool("adaptive_study", out, "--scenes", "plane", "--targets", "0.03",
+                 "--resolution", "16x16", "--photonbound", exe)
+    if p.returncode != 0:
+        check(False, f"tools.adaptive_study failed ({p.returncode}): {p.stderr.strip()}")
+        return
+    header, rows = table_rows(os.path.join(out, "table.md"))
+    check(len(rows) == 1 and header[0] == "target", f"adaptive table: {header}, {rows}")
+    with open(os.path.join(out, "results.json"), encoding="utf-8") as f:
+        results = json.load(f)
+    check([r["mode"] for r in results] == ["none", "radius"], f"modes {results}")
+    ref = os.path.join(out, "runs", "plane_16x16_exact_area.exr")
+    for r in results:
+        path = os.path.join(out, "runs", f"plane_t0.03_{r['mode']}.exr")
+        meta = exr.read_exr(path).metadata
+        check(meta["photonbound:adaptive"] == r["mode"], f"{path}: adaptive is not {r['mode']}")
+        check(int(meta["photonbound:passes_done"]) == r["passes"], f"{path}: passes differ")
+        actual = cli.compare_json(exe, path, ref)["mean_abs_error"]
+        check(abs(actual - r["actual"]) <= 1e-9 * max(1.0, actual), f"{path}: actual differs")
+        check(rows[0][f"{r['mode']}: passes"] == str(r["passes"]),
+              f"table passes for {r['mode']}")
 
 
 def cornell_reference_margin(exe, tmp):

@@ -7,6 +7,7 @@
   python3 -m tools.study           the speed-accuracy study
   python3 -m tools.views           PNG views of a photonbound EXR
   python3 -m tools.plot_logs       plots of convergence logs and of a sweep of targets
+  python3 -m tools.hostile         the hostile corpus: each class of issue 36, run with limits
 
 Each takes --help. The modules they share, one job each, so that every tool does it the same
 way:

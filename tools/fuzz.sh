@@ -1,28 +1,62 @@
 #!/usr/bin/env bash
-# Fuzzes the glTF loader with libFuzzer (clang) under AddressSanitizer + UBSan.
-#   tools/fuzz.sh [SECONDS] [WORKERS]     default: 900 s on 2 workers = 30 CPU-minutes
-# Builds fuzz/ in build-fuzz/, seeds the corpus with every shipped scene, and runs in fork mode
+# Fuzzes the glTF loader (JSON, GLB, and what they decode) or the image decoders with libFuzzer
+# (clang) under AddressSanitizer + UBSan.
+#   tools/fuzz.sh [SECONDS] [WORKERS] [loader|image]   default: 900 s on 2 workers = 30 CPU-minutes
+# Builds fuzz/ in build-fuzz/, seeds the loader's corpus with every shipped scene and the image
+# decoders' with small images of every format OpenImageIO writes here, and runs in fork mode
 # so that one finding does not end the run. Findings (crash-*, leak-*, timeout-*, oom-*) land in
 # build-fuzz/findings/; each one fixed is kept in tests/data/fuzz/ where test_gltf_loader_files replays it.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds="${1:-900}"
 workers="${2:-2}"
-"$root/tools/install-deps.sh" clang libclang-rt-14-dev nlohmann-json3-dev
+target="${3:-loader}"
+case "$target" in
+  loader | image) ;;
+  *) echo "fuzz.sh: the target is loader or image, not '$target'" >&2; exit 2 ;;
+esac
+"$root/tools/install-deps.sh" clang libclang-rt-14-dev nlohmann-json3-dev python3-openimageio \
+  python3-numpy
 cmake -S "$root/fuzz" -B "$root/build-fuzz" -G Ninja -DCMAKE_CXX_COMPILER=clang++ >/dev/null
 cmake --build "$root/build-fuzz"
-corpus="$root/build-fuzz/corpus"
-findings="$root/build-fuzz/findings"
-mkdir -p "$corpus" "$findings"
-cp "$root"/scenes/*.gltf "$root"/scenes/*.glb "$corpus"/
-cp "$root"/tests/data/fuzz/* "$corpus"/ 2>/dev/null || true
-"$root/build-fuzz/make_gltf_corpus" "$corpus"  # Draco, meshopt, quantised, sparse, skin
+findings="$root/build-fuzz/findings-$target"
+mkdir -p "$findings"
 cd "$root/build-fuzz"
 # Embree and TBB keep allocations alive until exit by design: leaks are not findings here.
 export ASAN_OPTIONS=detect_leaks=0
-./fuzz_gltf_loader -fork="$workers" -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 \
-  -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 -dict="$root/fuzz/gltf.dict" \
-  -artifact_prefix="$findings/" "$corpus"
+if [ "$target" = loader ]; then
+  corpus="$root/build-fuzz/corpus"
+  mkdir -p "$corpus"
+  cp "$root"/scenes/*.gltf "$root"/scenes/*.glb "$corpus"/
+  cp "$root"/tests/data/fuzz/* "$corpus"/ 2>/dev/null || true
+  "$root/build-fuzz/make_gltf_corpus" "$corpus"  # Draco, meshopt, quantised, sparse, skin
+  ./fuzz_gltf_loader -fork="$workers" -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 \
+    -max_total_time="$seconds" -timeout=10 -rss_limit_mb=4096 -dict="$root/fuzz/gltf.dict" \
+    -artifact_prefix="$findings/" "$corpus"
+else
+  corpus="$root/build-fuzz/corpus-image"
+  mkdir -p "$corpus"
+  # Seeds: a 16x12 gradient in every format this OpenImageIO writes (8- and 16-bit, float).
+  /usr/bin/python3 - "$corpus" <<'PY'
+import sys
+import numpy as np
+import OpenImageIO as oiio
+out = sys.argv[1]
+pixels = np.linspace(0.0, 1.0, 16 * 12 * 4, dtype=np.float32).reshape(12, 16, 4)
+for ext, fmt, ch in [("png", "uint8", 4), ("png", "uint16", 3), ("jpg", "uint8", 3),
+                     ("tga", "uint8", 4), ("bmp", "uint8", 3), ("hdr", "float", 3),
+                     ("exr", "half", 4), ("tif", "uint16", 4), ("ppm", "uint8", 3)]:
+    spec = oiio.ImageSpec(16, 12, ch, fmt)
+    path = f"{out}/seed_{fmt}_{ch}.{ext}"
+    o = oiio.ImageOutput.create(path)
+    if o and o.open(path, spec):
+        o.write_image(pixels[:, :, :ch])
+        o.close()
+PY
+  ./fuzz_image_decode -fork="$workers" -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 \
+    -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+    -artifact_prefix="$findings/" "$corpus"
+fi
 echo "fuzz: corpus $(ls "$corpus" | wc -l) inputs; findings: $(ls "$findings" | wc -l)" >&2
 ls -l "$findings" >&2
 # CPU time of this script and its children (the fuzzer processes): user and system.

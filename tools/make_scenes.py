@@ -53,6 +53,13 @@ Scenes (analytic answers are radiances in the renderer's units):
                      0.067 m closer); floor radiance there ~ 0.8/pi * 0.547 = 0.139, plus
                      ~2% from floor <-> slab-underside interreflection.
 
+  caustic.gltf       4 x 4 m floor (rho 0.8), glass ball (radius 0.4, ior 1.5) resting on it,
+                     0.1 m lamp (radiance 400) facing down at y = 2, off to the side: the
+                     caustic of issue 39's convergence figures. No analytic answer.
+  indirect_room.gltf 4 x 3 x 4 m white room with a red wall and a block; a 0.4 m lamp
+                     faces the back wall from 0.4 m and the camera looks the other way, so
+                     all light it sees has bounced at least once. No analytic answer.
+
   unlit.gltf         A model as exporters write one with neither camera nor light: a 4 x 4
                      grey ground (rho 0.8), a red box, a blue sphere and a mirror sphere.
                      Rendered as shipped it gets the default view (framing the bounds) and the
@@ -547,6 +554,38 @@ def build_glass_slab():
     return b
 
 
+def build_caustic():
+    """Issue 39's caustic: a glass ball on a diffuse floor under a small lamp."""
+    b = GltfBuilder()
+    floor = b.lambertian("floor", (0.8, 0.8, 0.8))
+    glass = b.glass("glass", 1.5, thickness=0.8)
+    lamp = b.lambertian("light", (0.0, 0.0, 0.0), radiance=400.0)
+    b.mesh_node("floor", [(horizontal_quad((0.0, 0.0, 0.0), 2.0, 2.0), floor)])
+    b.mesh_node("ball", [(uv_sphere((0.0, 0.0, 0.0), 0.4), glass)], translation=(0.0, 0.4, 0.0))
+    b.mesh_node("light", [(horizontal_quad((0.5, 2.0, -0.3), 0.05, 0.05, facing_up=False),
+                           lamp)])
+    b.camera_node("camera", eye=(0.0, 1.6, 2.4), target=(0.0, 0.25, 0.0), yfov=0.7,
+                  aspect=4.0 / 3.0)
+    return b
+
+
+def build_indirect():
+    """Issue 39's indirectly lit room: a lamp facing the back wall, the camera looking away."""
+    b = GltfBuilder()
+    white = b.lambertian("white", (0.7, 0.7, 0.7))
+    red = b.lambertian("red", (0.6, 0.1, 0.08))
+    lamp = b.lambertian("light", (0.0, 0.0, 0.0), radiance=60.0)
+    walls = box_faces((-2.0, 0.0, -2.0), (2.0, 3.0, 2.0), inward=True)
+    b.mesh_node("room", [(merge([walls["-y"], walls["+y"], walls["-z"], walls["+z"],
+                                 walls["+x"]]), white), (walls["-x"], red)])
+    # Facing -z, toward the back wall 0.4 m away: no surface the camera sees is lit directly.
+    b.mesh_node("light", [(quad((0.0, 1.5, -1.6), (0.2, 0.0, 0.0), (0.0, -0.2, 0.0)), lamp)])
+    b.mesh_node("block", [(box((0.3, 0.0, 0.6), (1.1, 0.8, 1.4)), white)])
+    b.camera_node("camera", eye=(0.0, 1.4, -1.2), target=(0.0, 0.8, 2.0), yfov=0.9,
+                  aspect=4.0 / 3.0)
+    return b
+
+
 def unlit_parts(b):
     """The unlit model: ground, box, sphere, mirror sphere (docs/gltf.md's example)."""
     ground = b.lambertian("ground", (0.8, 0.8, 0.8))
@@ -850,6 +889,8 @@ OUTPUTS = [  # (file name, builder, writer)
     ("unlit.gltf", build_unlit, GltfBuilder.write_gltf),
     ("furnace.gltf", build_furnace, GltfBuilder.write_gltf),
     ("sun.gltf", build_sun, GltfBuilder.write_gltf),
+    ("caustic.gltf", build_caustic, GltfBuilder.write_gltf),
+    ("indirect_room.gltf", build_indirect, GltfBuilder.write_gltf),
 ]
 
 CORPUS = [

@@ -102,9 +102,10 @@ std::vector<std::string> preflight_diagnostics(const RenderOptions& options,
   // of ~1 at R = scene size), so say so rather than report a bound that cannot be trusted.
   if (renderer.boundary().truncated())
     lines.push_back("photonbound: warning: " + options.scene +
-                    ": too many boundary segments within the radius for the boundary correction "
-                    "(ESTIMATOR.md section 11); every disc counts as whole, so bounds along edges "
-                    "may be too small (a higher --resolution or a smaller --radius avoids this)");
+                    ": too many boundary segments, or triangles piled at one place, within the "
+                    "radius for the boundary correction (ESTIMATOR.md section 11); every disc "
+                    "counts as whole, so bounds along edges may be too small (a higher "
+                    "--resolution or a smaller --radius avoids this)");
   if (options.radius && *options.radius > kRadiusWarnFraction * renderer.world().scene_size()) {
     std::ostringstream line;
     line << "photonbound: warning: --radius " << *options.radius << " is " << std::setprecision(3)
@@ -118,8 +119,18 @@ std::vector<std::string> preflight_diagnostics(const RenderOptions& options,
 
 // ESTIMATOR.md sections 11b and 11c: a refuted bias model leaves every photon bound unknown.
 std::vector<std::string> result_diagnostics(const RenderOptions& options, const ExrImage& image,
-                                            const Scene& scene, const FilmSummary& summary) {
+                                            const Scene& scene, const FilmSummary& summary,
+                                            uint64_t passes) {
   std::vector<std::string> lines;
+  // Ctrl-C or the end of --time during the first pass: that pass is discarded (Driver::run),
+  // and an image without passes is black for want of photons, not of light.
+  if (passes == 0) {
+    lines.push_back("photonbound: warning: " + options.scene +
+                    ": the render stopped before its first pass was whole, so the image holds "
+                    "no light and every bound is unknown (a longer --time, or fewer "
+                    "--photons-per-pass, gives it passes)");
+    return lines;
+  }
   if (const auto dark = dark_image_warning(image, scene))
     lines.push_back("photonbound: warning: " + options.scene + ": " + *dark);
   if (summary.model_refuted) {

@@ -7,6 +7,7 @@
 #include "io/image_io.h"
 #include "options/options.h"
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -26,8 +27,9 @@ std::vector<std::string> option_diagnostics(const RenderOptions& options);
 // given up, a radius of the scene's size).
 std::vector<std::string> preflight_diagnostics(const RenderOptions& options,
                                                const Renderer& renderer);
-// After the render: a dark image, a refuted bias model.
+// After the render of `passes` passes: none done, a dark image, a refuted bias model.
 std::vector<std::string> result_diagnostics(const RenderOptions& options, const ExrImage& image,
-                                            const Scene& scene, const FilmSummary& summary);
+                                            const Scene& scene, const FilmSummary& summary,
+                                            uint64_t passes);
 
 }  // namespace pb

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <sstream>
 
 namespace pb {
 
@@ -51,6 +52,29 @@ std::string tested_name(const RenderOptions& o) {
   return "";
 }
 
+// What the stop line reports: the quantity the stop rule tests, then the mean bound.
+std::string stop_figures(const RenderOptions& o, const FilmSummary& s) {
+  std::ostringstream out;
+  const double tested = tested_quantity(o, s);  // what the progress line shows, too
+  if (o.stop_rule != StopRule::MeanBound && std::isfinite(tested))
+    out << tested_name(o) << " <= " << tested << " at " << number_text(100.0 * o.confidence)
+        << "%, ";
+  // The mean is over the known pixels: say how many it leaves out (+inf, not small). Over a
+  // minority of them it is not the image's figure (issue 37: the known pixels may be the
+  // background alone, of bound 0): then the line gives no mean at all.
+  const uint64_t pixels = s.pixels;
+  const uint64_t known = pixels - std::min(pixels, s.unknown_pixels);
+  if (s.unknown_pixels > 0 && std::isfinite(s.mean_bound) && 2 * known <= pixels)
+    out << "mean bound unknown: " << s.unknown_pixels << " of " << pixels
+        << " pixels have no bound yet";
+  else
+    out << "mean bound " << s.mean_bound;
+  if (s.unknown_pixels > 0 && std::isfinite(s.mean_bound) && 2 * known > pixels)
+    out << " over the " << known << " known pixels of " << pixels << ", " << s.unknown_pixels
+        << " unknown";
+  return out.str();
+}
+
 Driver::Driver(Renderer& renderer, DriverState state) : renderer_(renderer), state_(state) {}
 
 RenderReport Driver::run(const std::atomic<bool>* interrupt,
@@ -63,16 +87,32 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
   bool developed = false;
   // A resumed render that already did its passes does not run another one.
   if (o.passes && renderer_.passes() >= *o.passes) report.stop = StopReason::Passes;
+  // Ctrl-C and the end of --time cut the pass in progress (docs/usage.md "Stop rules").
+  std::optional<Clock::time_point> deadline;
+  if (o.time_seconds)
+    deadline = t0 + std::chrono::duration_cast<Clock::duration>(
+                        std::chrono::duration<double>(*o.time_seconds));
+  const Cutoff cutoff = flag_or_deadline(interrupt, deadline);
 
   while (report.stop == StopReason::None) {
     const double before = seconds_since(t0);
     std::vector<PointState>* snapshot = nullptr;
     for (PassObserver* obs : observers)
       if (!snapshot) snapshot = obs->snapshot_buffer(before);
-    renderer_.step(snapshot);
+    const bool whole = renderer_.step(snapshot, &cutoff);
     const uint64_t pass = renderer_.passes();
     const double run_seconds = seconds_since(t0);
     state_.seconds = seconds_before + run_seconds;
+    if (!whole) {
+      // The render is the last whole pass's: its summary, told again with the stop (observers
+      // do not repeat a pass they have written).
+      report.stop = interrupt && interrupt->load() ? StopReason::Interrupted : StopReason::Time;
+      report.summary = renderer_.develop();
+      developed = true;
+      const PassInfo info{renderer_, state_, pass, run_seconds, true, report.summary, report.stop};
+      for (PassObserver* obs : observers) obs->after_pass(info);
+      break;
+    }
 
     const bool check = o.target_error && pass >= state_.next_check;
     bool want = check;
@@ -91,9 +131,12 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
 
     if (o.passes && pass >= *o.passes) report.stop = StopReason::Passes;
     if (o.time_seconds && run_seconds >= *o.time_seconds) report.stop = StopReason::Time;
-    // Success needs every pixel's bound: pixels left out of a mean cannot be within a target
-    // (every tested quantity is +inf while a pixel is unknown).
-    if (check && tested_quantity(o, report.summary) <= *o.target_error)
+    // Success needs every pixel's bound: pixels left out of a mean cannot be within a target.
+    // The means are +inf while a pixel is unknown; the pixel share's quantile is not (it may
+    // leave the unknown pixels above it), so no rule stops on the target with a pixel unknown
+    // (issue 37: every unknown pixel has a visible point, or has had fewer than 2 passes).
+    if (check && report.summary.unknown_pixels == 0 &&
+        tested_quantity(o, report.summary) <= *o.target_error)
       report.stop = StopReason::TargetError;
     // A target below the bias cannot be reached once the radii can no longer shrink (alpha = 1,
     // or every radius at its floor): more passes only shrink the noise.

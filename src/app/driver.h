@@ -77,12 +77,18 @@ double tested_quantity(const RenderOptions& options, const FilmSummary& summary)
 // A short name of it for the progress line ("mean error", "mean bound", "90% of pixels").
 std::string tested_name(const RenderOptions& options);
 
+// The figures of the closing line: the quantity the stop rule tests, then the mean bound; with
+// pixels unknown, how many, and no mean at all when the known pixels are not a majority (their
+// mean is not the image's: issue 37's background of bound 0).
+std::string stop_figures(const RenderOptions& options, const FilmSummary& summary);
+
 class Driver {
  public:
   explicit Driver(Renderer& renderer, DriverState state = {});
 
-  // Runs passes until a stop condition of the renderer's options holds, or `interrupt` is set
-  // (polled after every pass: Ctrl-C finishes the pass).
+  // Runs passes until a stop condition of the renderer's options holds, or `interrupt` is set.
+  // `interrupt` and the end of --time cut the pass in progress (Renderer::step): it is
+  // discarded, and the render ends with the last whole pass.
   RenderReport run(const std::atomic<bool>* interrupt = nullptr,
                    std::span<PassObserver* const> observers = {});
   const DriverState& state() const { return state_; }

@@ -12,9 +12,11 @@
 #include "io/image_io.h"
 #include "options/options.h"
 #include "render/camera_paths.h"
+#include "render/render_memory.h"
 #include "render/renderer.h"
 #include "render/scene_defaults.h"
 #include "util/file_io.h"
+#include "util/memory.h"
 #include "util/parallel.h"
 
 #include <unistd.h>
@@ -26,13 +28,15 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <new>
 #include <sstream>
 
 namespace {
 
 std::atomic<bool> g_stop{false};
 
-// First Ctrl-C (or SIGTERM, SIGHUP): finish the pass and write the image. Second: leave at once,
+// First Ctrl-C (or SIGTERM, SIGHUP): discard the pass in progress (Driver::run) and write the
+// image and state of the last whole one. Second: leave at once,
 // removing the temporary files being written and the lock files first (file_io.h's registry).
 extern "C" void on_signal(int sig) {
   if (g_stop.exchange(true)) {
@@ -88,20 +92,6 @@ void check_scene_files(const std::vector<pb::NamedFile>& outputs, const pb::Scen
   pb::check_distinct(outputs, files);
 }
 
-// What the stop line reports: the quantity the stop rule tests, then the mean bound.
-std::string stop_figures(const pb::RenderOptions& o, const pb::FilmSummary& s) {
-  std::ostringstream out;
-  const double tested = pb::tested_quantity(o, s);  // what the progress line shows, too
-  if (o.stop_rule != pb::StopRule::MeanBound && std::isfinite(tested))
-    out << pb::tested_name(o) << " <= " << tested << " at " << pb::number_text(100.0 * o.confidence)
-        << "%, ";
-  out << "mean bound " << s.mean_bound;
-  // The mean is over the known pixels: say how many it leaves out (+inf, not small).
-  if (s.unknown_pixels > 0 && std::isfinite(s.mean_bound))
-    out << " over the known pixels, " << s.unknown_pixels << " unknown";
-  return out.str();
-}
-
 void print_lines(const std::vector<std::string>& lines) {
   for (const std::string& line : lines) std::cerr << line << "\n";
 }
@@ -109,7 +99,8 @@ void print_lines(const std::vector<std::string>& lines) {
 // The scene, completed for rendering (its warnings and notes printed); with `saved`, checked to
 // be the scene and options that render was made with.
 pb::Scene load_scene(const pb::RenderOptions& options, const pb::SavedRender* saved) {
-  pb::Scene scene = pb::load_gltf(options.scene, pb::LoadPolicy{options.asset_dirs});
+  pb::Scene scene =
+      pb::load_gltf(options.scene, pb::LoadPolicy{options.asset_dirs, pb::memory_budget(options)});
   for (const std::string& w : scene.warnings)
     std::cerr << "photonbound: warning: " << options.scene << ": " << w << "\n";
   for (const std::string& n : pb::complete_scene(scene, options))
@@ -189,13 +180,14 @@ void finish_render(const pb::RenderOptions& options, const pb::Renderer& rendere
   // Ctrl-C keeps the work: the state is written then too.
   const pb::ExrImage image = renderer.image(report.run());
   pb::write_exr(options.output, image);
-  print_lines(pb::result_diagnostics(options, image, renderer.world().scene(), report.summary));
+  print_lines(pb::result_diagnostics(options, image, renderer.world().scene(), report.summary,
+                                     report.work.passes));
   if (keep_state || report.stop == pb::StopReason::Interrupted)
     pb::save_state(state_path, {options, scene_hash, renderer.snapshot(), schedule});
   if (options.progress != pb::ProgressMode::Never)
     std::cerr << "photonbound: stopped (" << pb::stop_text(report.stop) << ") after "
               << report.work.passes << " passes, " << report.seconds << " s; "
-              << stop_figures(options, report.summary) << "; wrote " << options.output << "\n";
+              << pb::stop_figures(options, report.summary) << "; wrote " << options.output << "\n";
 }
 
 // Renders `options`; with `saved`, continues that render (already checked to match).
@@ -211,11 +203,14 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   const pb::OutputLock lock(check_render_outputs(options, outputs));
   pb::remove_stale_temporaries(options.output);
   pb::remove_stale_temporaries(state_path);
+  pb::check_render_memory(options, nullptr);  // an explicit --resolution, before the scene loads
   pb::Scene scene = load_scene(options, saved);
   check_scene_files(outputs, scene);
+  pb::check_render_memory(options, &scene);
   const uint64_t scene_hash = scene.content_hash;
   pb::ExrImage reference;
-  if (!options.reference_path.empty()) reference = pb::read_exr(options.reference_path);
+  if (!options.reference_path.empty())
+    reference = pb::read_exr(options.reference_path, {pb::memory_budget(options)});
   std::ofstream log_file = open_log(options.log_path);
   print_lines(pb::option_diagnostics(options));
   pb::ThreadLimit threads(options.threads);
@@ -245,9 +240,16 @@ int resume(const pb::ResumeOptions& r) {
   return render(pb::resumed_options(saved.options, r), &saved);
 }
 
+// compare and preview read whole images: each within a share of the machine's memory.
+pb::ReadLimit machine_share(int images) {
+  return {pb::default_memory_budget() / uint64_t(images),
+          images == 1 ? "3/4 of the machine's memory" : "half of 3/4 of the machine's memory"};
+}
+
 int compare(const pb::CompareOptions& o) {
   const pb::CompareResult r =
-      pb::compare_images(pb::read_exr(o.render), pb::read_exr(o.reference), o.render, o.reference);
+      pb::compare_images(pb::read_exr(o.render, machine_share(2)),
+                         pb::read_exr(o.reference, machine_share(2)), o.render, o.reference);
   std::cout << (o.json ? pb::to_json(r) : pb::to_text(r));
   return 0;
 }
@@ -256,7 +258,7 @@ int compare(const pb::CompareOptions& o) {
 int preview(const pb::PreviewOptions& o) {
   pb::check_distinct({{"-o", o.output}}, {{"the input image", o.input}});
   pb::check_output_path({"-o", o.output});
-  const pb::ExrImage in = pb::read_exr(o.input);
+  const pb::ExrImage in = pb::read_exr(o.input, machine_share(1));
   const int r = in.channel_index(pb::channel_name(pb::Channel::Radiance, 0));
   const int g = in.channel_index(pb::channel_name(pb::Channel::Radiance, 1));
   const int b = in.channel_index(pb::channel_name(pb::Channel::Radiance, 2));
@@ -304,6 +306,11 @@ int main(int argc, char** argv) {
   } catch (const pb::UsageError& e) {
     std::cerr << "photonbound: " << e.what() << "\n";
     return 2;
+  } catch (const std::bad_alloc&) {
+    // What the up-front estimates (render_memory.h) did not foresee.
+    std::cerr << "photonbound: error: out of memory (an allocation failed); lower --resolution "
+                 "or --photons-per-pass, or use smaller textures\n";
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "photonbound: error: " << e.what() << "\n";
     return 1;

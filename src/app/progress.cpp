@@ -32,9 +32,11 @@ bool ProgressPrinter::wants_summary(uint64_t, double run_seconds) {
 }
 
 void ProgressPrinter::after_pass(const PassInfo& info) {
+  if (info.pass == printed_) return;
   if (info.stop == StopReason::None && !(info.run_seconds - last_print_ >= 0.5 && info.developed))
     return;
   last_print_ = info.run_seconds;
+  printed_ = info.pass;
   out_ << line(info) << std::endl;
 }
 
@@ -92,7 +94,8 @@ bool PassLogger::wants_summary(uint64_t, double run_seconds) {
 }
 
 void PassLogger::after_pass(const PassInfo& info) {
-  if (!want_ && info.stop == StopReason::None) return;
+  if (info.pass == logged_ || (!want_ && info.stop == StopReason::None)) return;
+  logged_ = info.pass;
   const auto t0 = Clock::now();
   const FilmSummary& s = info.summary;
   JsonObject line;

@@ -9,7 +9,8 @@
 namespace pb {
 
 // A progress line at most every 0.5 s and after the last pass: pass, photons, mean bound,
-// share of pixels below the target, unknown pixels, elapsed time and time left.
+// share of pixels below the target, unknown pixels, elapsed time and time left. A pass is told
+// again when the next one was cut short (Driver::run): not printed twice, and pass 0 never.
 class ProgressPrinter : public PassObserver {
  public:
   explicit ProgressPrinter(std::ostream& out) : out_(out) {}
@@ -20,12 +21,13 @@ class ProgressPrinter : public PassObserver {
  private:
   std::ostream& out_;
   double last_print_ = -1.0;
+  uint64_t printed_ = 0;  // the last pass printed
 };
 
 // --log: one JSON object per logged pass (docs/usage.md "Logging"). Passes are logged while
 // the time spent logging stays within `max_overhead` of the run's time, so the log never slows
-// the pass loop by more than that; the last pass is always logged. With a reference image each
-// line also carries the actual error and coverage.
+// the pass loop by more than that; the last pass is always logged (once, and pass 0 never: see
+// ProgressPrinter). With a reference image each line also carries the actual error and coverage.
 class PassLogger : public PassObserver {
  public:
   PassLogger(std::ostream& out, const ExrImage* reference, double max_overhead = 0.03)
@@ -39,6 +41,7 @@ class PassLogger : public PassObserver {
   double max_overhead_;
   double log_seconds_ = 0.0;
   bool want_ = false;
+  uint64_t logged_ = 0;  // the last pass logged
 };
 
 }  // namespace pb

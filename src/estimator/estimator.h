@@ -74,7 +74,25 @@ struct EstimatorParams {
   double alpha = 0.7;             // PPM radius reduction, in (0, 1]
   double photons_per_pass = 1.0;  // M_e
   double min_r2 = 0.0;            // floor on R^2 (ESTIMATOR.md section 8)
+  // --adaptive radius: after the PPM update, each point's radius moves down to the one its own
+  // error model prefers (ESTIMATOR.md section 13), never above the PPM schedule's.
+  bool adaptive_radius = false;
 };
+
+// Section 13's safeguards: no radius choice before this many passes (the slope and variance
+// estimates need a few samples), and R^2 shrinks by at most this factor in one pass beyond the
+// PPM update, so that one noisy Laplacian cannot collapse a radius (and its photon count).
+inline constexpr uint64_t kAdaptiveMinPasses = 4;
+inline constexpr double kAdaptiveMaxShrink = 0.5;
+// A bias slope moves a radius only where it exceeds this many of its own sds (section 13).
+inline constexpr double kAdaptiveSlopeZ = 3.0;
+
+// The squared radius that minimises the predicted mean squared error of a point's estimate
+// over the next passes (ESTIMATOR.md section 13): R^2 = (v / (2 A^2 (i + 1)))^(1/3), with
+// A^2 the bias slopes' squares net of their own noise and v the per-pass variance times R^2,
+// both summed over the channels. +inf where the model has nothing to say (too few passes or
+// photons, no significant slope): the PPM schedule then decides alone.
+double preferred_r2(const PointState& state, uint64_t passes, double photons_per_pass);
 
 // The PPM radius update (HOJ08; ESTIMATOR.md section 3) for m photons that could contribute:
 // R^2 *= (N + alpha m) / (N + m), N += alpha m, R^2 floored at min_r2. Returns the factor R^2

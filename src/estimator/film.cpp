@@ -269,6 +269,7 @@ void bound_pixel(const PixelResult& r, const dvec3& tau2, const BoundRule& rule,
 // The image's means over its known pixels and the settings' quantile of the pixels' bounds.
 void summarise(Tally& tally, const FilmSettings& s, FilmSummary& sum) {
   const size_t pixels = tally.pixel_bounds.size();
+  sum.pixels = pixels;
   if (tally.known > 0) {
     const double known = double(tally.known);
     sum.mean_bound = tally.bound_sum / (3.0 * known);

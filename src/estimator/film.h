@@ -39,6 +39,7 @@ struct FilmSummary {
       0.0;  // mean |B| in the chosen metric: the part of the bound the noise cannot shrink
   double below_target = 0.0;    // fraction of pixels whose every channel's bound meets the target
   uint64_t unknown_pixels = 0;  // pixels with a state whose bound is unknown (section 7)
+  uint64_t pixels = 0;          // the image's pixels
   double relative_floor = 0.0;  // denominator floor of the relative metric
   // The image's mean absolute error over pixels and channels (what `compare` reports), in the
   // chosen metric, as the error model predicts it, and its upper confidence limit at the

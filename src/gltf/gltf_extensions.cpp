@@ -17,7 +17,8 @@ void Loader::check_extensions() {
       "KHR_draco_mesh_compression", "EXT_meshopt_compression",
       "KHR_mesh_quantization",      "KHR_texture_transform",
       "KHR_texture_basisu",         "EXT_texture_webp",
-      "EXT_mesh_gpu_instancing",    "KHR_materials_diffuse_transmission"};
+      "EXT_mesh_gpu_instancing",    "KHR_materials_diffuse_transmission",
+      "KHR_materials_unlit"};
   // What changes nothing photonbound draws, so that leaving it out is exact: metadata, the
   // material variants' default (what a viewer shows first), and MSFT_lod's base node (the
   // finest level of detail).
@@ -27,13 +28,8 @@ void Loader::check_extensions() {
   // instancing, deformation and extensions"): a material extension then falls back to the core
   // factors; data an unknown extension holds is missing, and the accessors that lack it are refused
   // with their own message. What rendering without it means, where that is not only a material
-  // falling back to its core factors:
-  auto without = [](const std::string& e) -> std::string {
-    if (e == "KHR_materials_unlit")
-      return ": its materials are lit (light is simulated, not painted on), by their "
-             "metallic-roughness factors";
-    return "";
-  };
+  // falling back to its core factors (none today):
+  auto without = [](const std::string&) -> std::string { return ""; };
   for (const std::string& e : m_.extensionsRequired)
     if (!known.count(e) && !exact_without.count(e))
       warn("extension '" + e + "' is required but not implemented; rendered without it" +

@@ -2,12 +2,14 @@
 #include "gltf/gltf_files.h"
 
 #include "scene/scene.h"
+#include "util/memory.h"
 #include "util/message_text.h"
 
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cctype>
 #include <cerrno>
 #include <climits>
@@ -63,7 +65,9 @@ class Fd {
 
 }  // namespace
 
-AssetFiles::AssetFiles(const std::string& scene_path, const std::vector<std::string>& asset_dirs) {
+AssetFiles::AssetFiles(const std::string& scene_path, const std::vector<std::string>& asset_dirs,
+                       uint64_t max_bytes, uint64_t scene_bytes)
+    : max_bytes_(max_bytes), read_bytes_(std::min(scene_bytes, max_bytes)) {
   std::error_code ec;
   fs::path dir = fs::path(scene_path).parent_path();
   if (dir.empty()) dir = ".";
@@ -133,20 +137,26 @@ bool AssetFiles::read(const std::string& name, std::vector<unsigned char>& out, 
     return false;
   }
   // Not following a symlink put there since the check, and checked again once open.
-  if (const std::optional<ReadFailure> f = read_regular_file(r.path, false, out)) {
+  const uint64_t left = max_bytes_ - read_bytes_;
+  if (const std::optional<ReadFailure> f = read_regular_file(r.path, false, out, left)) {
     err = f->why;
     if (f->stage == ReadFailure::NotRegular) {
       refuse(name, f->why);
       err = "refused";
+    } else if (f->stage == ReadFailure::TooLarge && left < UINT32_MAX) {
+      refuse(name, "is " + f->why + ", more than the " + bytes_text(left) +
+                       " --max-memory leaves for the scene's files");
+      err = "refused";
     }
     return false;
   }
+  read_bytes_ += out.size();
   read_.push_back(r.path.string());
   return true;
 }
 
 std::optional<ReadFailure> read_regular_file(const fs::path& path, bool follow_last_link,
-                                             std::vector<unsigned char>& out) {
+                                             std::vector<unsigned char>& out, uint64_t max_size) {
   // O_NONBLOCK: a named pipe is refused below, never waited on in open().
   errno = 0;
   const Fd fd(::open(path.c_str(),
@@ -155,8 +165,9 @@ std::optional<ReadFailure> read_regular_file(const fs::path& path, bool follow_l
   struct stat st;
   if (::fstat(fd.get(), &st) != 0) return ReadFailure{ReadFailure::Open, std::strerror(errno)};
   if (!S_ISREG(st.st_mode)) return ReadFailure{ReadFailure::NotRegular, type_of(st.st_mode)};
-  const ReadFailure too_large{ReadFailure::TooLarge, "larger than 4 GiB"};
-  if (uint64_t(st.st_size) > UINT_MAX) return too_large;
+  max_size = std::min<uint64_t>(max_size, UINT32_MAX);
+  const ReadFailure too_large{ReadFailure::TooLarge, "larger than " + bytes_text(max_size)};
+  if (uint64_t(st.st_size) > max_size) return too_large;
   out.clear();
   out.reserve(size_t(st.st_size));
   unsigned char chunk[1 << 16];
@@ -166,7 +177,7 @@ std::optional<ReadFailure> read_regular_file(const fs::path& path, bool follow_l
     if (n < 0) return ReadFailure{ReadFailure::Read, std::strerror(errno)};
     if (n == 0) return std::nullopt;
     out.insert(out.end(), chunk, chunk + n);
-    if (out.size() > UINT_MAX) return too_large;
+    if (out.size() > max_size) return too_large;
   }
 }
 

@@ -4,6 +4,7 @@
 // its file-system callbacks, so that tinygltf opens nothing itself.
 #pragma once
 
+#include <cstdint>
 #include <filesystem>
 #include <optional>
 #include <string>
@@ -16,7 +17,10 @@ class AssetFiles {
  public:
   // The scene file's folder and the --asset-dir folders, made canonical. Throws SceneError
   // "<dir>: --asset-dir ..." when one is not a folder.
-  AssetFiles(const std::string& scene_path, const std::vector<std::string>& asset_dirs);
+  // The files read together may take at most `max_bytes` (--max-memory; the scene file's own
+  // bytes, `scene_bytes`, count).
+  AssetFiles(const std::string& scene_path, const std::vector<std::string>& asset_dirs,
+             uint64_t max_bytes = UINT64_MAX, uint64_t scene_bytes = 0);
 
   // The scene's folder, absolute and canonical: the folder relative URIs resolve against.
   const std::string& base() const { return base_; }
@@ -29,7 +33,8 @@ class AssetFiles {
   Verdict check(const std::string& name);
   // Reads a file check() found Readable (opened without following a last symlink, without
   // blocking, and checked again to be a regular file once open). False with `err` set when it
-  // cannot; a file that stopped being a regular file is refused.
+  // cannot; a file that stopped being a regular file, or one larger than what is left of
+  // `max_bytes`, is refused.
   bool read(const std::string& name, std::vector<unsigned char>& out, std::string& err);
 
   // The files read so far, canonical, in reading order (the outputs may not be any of them).
@@ -51,10 +56,12 @@ class AssetFiles {
   std::vector<std::filesystem::path> roots_;  // base_ first
   std::optional<std::pair<std::string, std::string>> refusal_;
   std::vector<std::string> read_;
+  uint64_t max_bytes_, read_bytes_;
 };
 
 // Why read_regular_file failed: at open() or fstat(), a file that is not a regular one (`why`
-// is then "is a named pipe, not a regular file" and the like), a read(), or a file over 4 GiB.
+// is then "is a named pipe, not a regular file" and the like), a read(), or a file over
+// `max_size` (4 GiB unless less is asked).
 struct ReadFailure {
   enum Stage { Open, NotRegular, Read, TooLarge } stage;
   std::string why;
@@ -64,8 +71,8 @@ struct ReadFailure {
 // link; its type checked on the open file. The scene file and every file it refers to are read
 // by it.
 std::optional<ReadFailure> read_regular_file(const std::filesystem::path& path,
-                                             bool follow_last_link,
-                                             std::vector<unsigned char>& out);
+                                             bool follow_last_link, std::vector<unsigned char>& out,
+                                             uint64_t max_size = UINT32_MAX);
 
 // A buffer or image URI as tinygltf 2.7 decodes it before it asks for the file: %XX decoded and,
 // unlike RFC 3986, '+' read as a space.

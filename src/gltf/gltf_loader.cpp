@@ -17,10 +17,10 @@
 // metallic-roughness, normal, emissive, transmission, specular, specular colour, the clear
 // coat's three, the sheen's two) with
 // KHR_texture_transform, alphaMode
-// MASK cut-outs and doubleSided emitters. Factors must be in their documented ranges (a
-// reflectance above 1 creates energy) or the file is rejected; what is rendered approximately
-// (BLEND, rough transmission) is warned about. Primitives without a material share one
-// Lambertian material named "default" with base_color 0.8 (one warning).
+// MASK cut-outs, BLEND coverage and doubleSided emitters. Factors must be in their documented
+// ranges (a reflectance above 1 creates energy) or the file is rejected; what is rendered
+// approximately (rough transmission in PPM) is warned about. Primitives without a material share
+// one Lambertian material named "default" with base_color 0.8 (one warning).
 #include "gltf/gltf_loader_impl.h"
 
 #include "gltf/gltf_files.h"
@@ -179,6 +179,13 @@ dmat4 Loader::local_matrix(const tinygltf::Node& n, const std::string& nl) const
   if (!n.matrix.empty()) {  // column-major
     for (int c = 0; c < 4; ++c)
       for (int r = 0; r < 4; ++r) m[c][r] = n.matrix[size_t(c * 4 + r)];
+    // glTF 2.0 "Transformations": a matrix must be decomposable to TRS, so its last row is
+    // (0, 0, 0, 1). Any other is projective: no triangle stays a triangle, and reading it as
+    // affine would move every vertex without a word.
+    if (m[0][3] != 0.0 || m[1][3] != 0.0 || m[2][3] != 0.0 || m[3][3] != 1.0)
+      fail(nl + " has a matrix whose last row is (" + num(m[0][3]) + ", " + num(m[1][3]) + ", " +
+           num(m[2][3]) + ", " + num(m[3][3]) +
+           "), not (0, 0, 0, 1): glTF node matrices are affine (translation, rotation, scale)");
     return m;
   }
   if (!n.translation.empty())
@@ -214,6 +221,11 @@ void Loader::walk(int root, const std::string& root_from) {
     visited_[size_t(item.index)] = 1;
     const Xform xf(item.parent * local_matrix(n, nl));
     if (!xf.finite()) fail(nl + " has a non-finite transform");
+    if (!n.matrix.empty() && sheared(dmat3(local_matrix(n, nl))))
+      warn(nl +
+           "'s matrix shears (its columns are not orthogonal), which glTF does not allow (a "
+           "node's matrix is a translation, rotation and scale); it is rendered as the "
+           "affine transform it is");
     visit(n, nl, xf);
     for (auto c = n.children.rbegin(); c != n.children.rend(); ++c)
       stack.push_back({*c, item.depth + 1, xf.m, nl});
@@ -335,7 +347,7 @@ void Loader::finish() {
 }  // namespace gltf
 
 Scene load_gltf(const std::string& path, const LoadPolicy& policy) {
-  Scene scene = load_gltf_bytes(path, gltf::read_file(path), policy);
+  Scene scene = load_gltf_bytes(path, gltf::read_file(path, policy.max_memory), policy);
   scene.files.insert(scene.files.begin(), path);
   return scene;
 }
@@ -344,15 +356,16 @@ Scene load_gltf_bytes(const std::string& path, const std::vector<unsigned char>&
                       const LoadPolicy& policy) {
   std::vector<std::string> warnings;
   gltf::Prepass pre;
-  gltf::AssetFiles files(path, policy.asset_dirs);
+  gltf::AssetFiles files(path, policy.asset_dirs, policy.max_memory, bytes.size());
   const tinygltf::Model model = gltf::parse(path, bytes, warnings, pre, files);
-  Scene scene = gltf::Loader(path, model, pre).run(warnings);
-  scene.files = files.read_paths();
-  // External images are part of the identity too (embedded ones already are: their bytes are in
-  // the file or a buffer).
   uint64_t total = bytes.size();
   for (const tinygltf::Buffer& b : model.buffers) total += b.data.size();
   for (const tinygltf::Image& im : model.images) total += im.image.size();
+  // The decoded texels may take what the file and its buffers and images leave of the budget.
+  Scene scene = gltf::Loader(path, model, pre, policy.max_memory, total).run(warnings);
+  scene.files = files.read_paths();
+  // External images are part of the identity too (embedded ones already are: their bytes are in
+  // the file or a buffer).
   Checksum hash(total);
   hash.add(bytes.data(), bytes.size());
   for (const tinygltf::Buffer& b : model.buffers) hash.add(b.data.data(), b.data.size());

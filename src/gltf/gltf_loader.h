@@ -4,6 +4,7 @@
 
 #include "scene/scene.h"
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -14,8 +15,12 @@ namespace pb {
 // read"): a buffer or image URI must resolve, after percent-decoding and following symlinks,
 // to a regular file inside the scene file's own folder or inside one of `asset_dirs` (--asset-dir).
 // Anything else is refused before it is opened, with a message that says nothing about it.
+// What a load may hold (docs/usage.md "Memory"): the scene file, the files it names and the
+// decoded texels of all its images together, each file checked from its size before it is read
+// and each image from its header before it is decoded (the same bytes are decoded once).
 struct LoadPolicy {
   std::vector<std::string> asset_dirs;  // further folders files may be read from
+  uint64_t max_memory = UINT64_MAX;     // --max-memory
 };
 
 // Reads a .gltf (embedded or external buffers) or .glb file. Throws SceneError for anything

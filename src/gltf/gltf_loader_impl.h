@@ -85,8 +85,11 @@ struct DracoPrimitive {
 
 class Loader {
  public:
-  Loader(const std::string& file, const tinygltf::Model& model, const Prepass& pre)
-      : file_(file), m_(model), pre_(pre) {}
+  // `held`: the bytes of the file and of the buffers and images it names, which count against
+  // `max_memory` with the decoded texels.
+  Loader(const std::string& file, const tinygltf::Model& model, const Prepass& pre,
+         uint64_t max_memory = UINT64_MAX, uint64_t held = 0)
+      : file_(file), m_(model), pre_(pre), max_memory_(max_memory), held_bytes_(held) {}
   Scene run(const std::vector<std::string>& parse_warnings);
 
  private:
@@ -178,6 +181,13 @@ class Loader {
   std::vector<int64_t> material_slot_;         // glTF material -> Scene::materials index, -1 unused
   std::vector<int64_t> image_slot_;            // glTF image -> Scene::images index, -1 not decoded
   static constexpr int64_t kUndecodable = -2;  // a KTX2 image, warned about once
+  // What the files and all decoded texels may take (LoadPolicy::max_memory), and what they take
+  // so far. Images with the same bytes are decoded once: image_by_bytes_ maps their checksum to
+  // the Scene::images index (the bytes compared before sharing).
+  uint64_t max_memory_;
+  uint64_t held_bytes_;
+  std::multimap<uint64_t, int64_t> image_by_bytes_;
+  std::vector<Bytes> image_source_;  // Scene::images index -> the encoded bytes
   int64_t default_material_ = -1;
   // Recentring (Loader::choose_origin): the world bounds of the POSITION accessors' min/max.
   dvec3 measured_lo_{INFINITY}, measured_hi_{-INFINITY};

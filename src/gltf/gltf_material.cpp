@@ -229,14 +229,19 @@ Material Loader::convert_material(size_t index) {  // the rules are in the comme
     out.emission[c] = float(e);
   }
   out.double_sided = gm.doubleSided;
+  // KHR_materials_unlit: the base colour is painted (docs/materials.md "Unlit"); the other
+  // properties, emission included, do not apply ("all other properties ... ignored").
+  if (ext.count("KHR_materials_unlit")) {
+    out.unlit = true;
+    out.emission = vec3(0.0f);
+  }
   if (gm.alphaMode == "MASK") {
     out.alpha_mode = AlphaMode::Mask;
     if (!(gm.alphaCutoff >= 0.0 && fits_float(gm.alphaCutoff)))
       fail(ml + ": alphaCutoff " + num(gm.alphaCutoff) + " must be finite and >= 0");
     out.alpha_cutoff = float(gm.alphaCutoff);
   } else if (gm.alphaMode == "BLEND") {
-    out.alpha_mode = AlphaMode::Blend;
-    warn(ml + ": alphaMode BLEND is rendered opaque (MASK cut-outs are exact)");
+    out.alpha_mode = AlphaMode::Blend;  // alpha as coverage (docs/materials.md "Alpha")
   } else if (!gm.alphaMode.empty() && gm.alphaMode != "OPAQUE") {
     fail(ml + ": unknown alphaMode '" + one_line(gm.alphaMode) + "'");
   }

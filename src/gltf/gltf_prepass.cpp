@@ -2,6 +2,7 @@
 #include "gltf/gltf_prepass.h"
 
 #include "gltf/gltf_files.h"
+#include "util/memory.h"
 #include "util/message_text.h"
 
 #include <nlohmann/json.hpp>
@@ -261,6 +262,11 @@ std::string json_problem(std::string_view text) {
       const size_t start = ++i;
       while (i < n && text[i] != '"') i += text[i] == '\\' ? 2 : 1;
       const std::string_view s = text.substr(start, std::min(i, n) - start);
+      if (s.size() > kMaxJsonString)
+        return path_text(stack) + " is " +
+               (s.rfind("data:", 0) == 0 ? "a data: URI" : std::string("a string")) + " of " +
+               bytes_text(s.size()) + ", over the " + bytes_text(kMaxJsonString) +
+               " photonbound reads (put its bytes in a .bin file beside the scene, or in a .glb)";
       if (!stack.empty() && !stack.back().array && stack.back().expect_key) {
         stack.back().key = s;
         stack.back().expect_key = false;

@@ -37,10 +37,15 @@ bool prepass(std::string_view json, bool glb, Prepass& out, std::string& rewritt
 
 // Nesting deeper than this is refused before any recursive parser sees the text.
 inline constexpr size_t kMaxJsonNesting = 512;
+// A longer string is refused before any parser sees the text: nlohmann's parser and tinygltf's
+// base64 decoding copy a data: URI about six times over (a 1 GiB URI peaked at 7.5 GB); bytes
+// that large belong in a .bin file or a GLB's binary chunk, which are read once.
+inline constexpr size_t kMaxJsonString = size_t(256) << 20;
 
 // What is wrong with the JSON text that tinygltf 2.7 would not say, found in one pass over the
 // bytes before any parser runs: "JSON nested deeper than 512 levels" (nlohmann's parser and
-// dump() recurse once per level: 100,000 nested arrays overflow the stack), or a string or
+// dump() recurse once per level: 100,000 nested arrays overflow the stack), a string longer
+// than kMaxJsonString (a data: URI), or a string or
 // boolean where glTF requires a number or an array of numbers (tinygltf takes the default
 // without a word: "intensity": "NaN" is intensity 1), named by its JSON path. Empty when
 // nothing is. Members under "extras" are the author's own and are not checked.

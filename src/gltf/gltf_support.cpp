@@ -51,12 +51,12 @@ std::string component_name(int c) {
   return c >= 5120 && c <= 5126 ? names[c - 5120] : c == 5130 ? "DOUBLE" : std::to_string(c);
 }
 
-std::vector<unsigned char> read_file(const std::string& path) {
+std::vector<unsigned char> read_file(const std::string& path, uint64_t max_size) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec))
     throw SceneError(path + ": cannot open (Is a directory)");
   std::vector<unsigned char> data;
-  if (const std::optional<ReadFailure> f = read_regular_file(path, true, data)) {
+  if (const std::optional<ReadFailure> f = read_regular_file(path, true, data, max_size)) {
     switch (f->stage) {
       case ReadFailure::Open:
         throw SceneError(path + ": cannot open (" + f->why + ")");
@@ -65,7 +65,8 @@ std::vector<unsigned char> read_file(const std::string& path) {
       case ReadFailure::Read:
         throw SceneError(path + ": cannot read (" + f->why + ")");
       case ReadFailure::TooLarge:
-        throw SceneError(path + ": file is larger than 4 GiB");
+        throw SceneError(path + ": file is " + f->why +
+                         (max_size < UINT32_MAX ? " (--max-memory)" : ""));
     }
   }
   return data;
@@ -154,6 +155,14 @@ bool Xform::finite() const {
 bool Xform::singular() const {  // relative, so that a uniformly tiny scale is not "singular"
   const double scale = glm::length(linear[0]) * glm::length(linear[1]) * glm::length(linear[2]);
   return !(std::abs(det) > 1e-12 * scale);
+}
+
+bool sheared(const glm::dmat3& a) {
+  for (int i = 0; i < 3; ++i)
+    for (int j = i + 1; j < 3; ++j)
+      if (std::abs(glm::dot(a[i], a[j])) > 1e-4 * glm::length(a[i]) * glm::length(a[j]))
+        return true;
+  return false;
 }
 
 bool rotation_matrix(const std::vector<double>& xyzw, glm::dmat3& out) {

@@ -61,8 +61,9 @@ struct View {
   dvec3 vec3(size_t i) const { return dvec3(scalar(i, 0), scalar(i, 1), scalar(i, 2)); }
 };
 
-// The whole file; throws SceneError "<path>: cannot open (<strerror>)" when it cannot.
-std::vector<unsigned char> read_file(const std::string& path);
+// The whole file; throws SceneError "<path>: cannot open (<strerror>)" when it cannot, and
+// "<path>: file is larger than ..." past `max_size` (--max-memory) or 4 GiB.
+std::vector<unsigned char> read_file(const std::string& path, uint64_t max_size = UINT32_MAX);
 
 // Checks the GLB header and chunk bounds (tinygltf 2.7 lets the BIN chunk run up to 8 bytes
 // past the declared length) and returns the declared length. Throws SceneError.
@@ -92,6 +93,10 @@ struct Xform {
   bool finite() const;
   bool singular() const;  // |det| tiny relative to the column lengths
 };
+
+// Whether a linear map is not rotation x scale (glTF 2.0 "Transformations": TRS): two of its
+// columns are not orthogonal, beyond float rounding (1e-4 of their lengths' product).
+bool sheared(const glm::dmat3& linear);
 
 // The column-major matrix of a glTF quaternion [x, y, z, w] (normalised here); false when the
 // quaternion is zero or not finite.

@@ -6,8 +6,11 @@
 #include "io/image_io.h"
 #include "scene/tangents.h"
 #include "scene/texture.h"
+#include "util/file_io.h"
+#include "util/memory.h"
 
 #include <cmath>
+#include <cstring>
 
 namespace pb::gltf {
 
@@ -67,17 +70,34 @@ int32_t Loader::image(int index, const std::string& where) {
     slot = kUndecodable;
     return -1;
   }
+  // The same bytes under another image index (four images naming one file) are decoded once.
+  Checksum sum(bytes.size);
+  sum.add(bytes.data, bytes.size);
+  const uint64_t key = sum.finish();
+  for (auto [at, end] = image_by_bytes_.equal_range(key); at != end; ++at) {
+    const Bytes& seen = image_source_[size_t(at->second)];
+    if (seen.size == bytes.size && std::memcmp(seen.data, bytes.data, bytes.size) == 0)
+      return int32_t(slot = at->second);
+  }
   // The uri's extension tells OpenImageIO the format where the signature does not.
   const std::string name = gi.uri.empty() ? il : one_line(gi.uri);
   try {
-    Image decoded = decode_image(bytes.data, bytes.size, name);
+    const uint64_t left = max_memory_ - std::min(held_bytes_, max_memory_);
+    Image decoded = decode_image(bytes.data, bytes.size, name, left);
+    held_bytes_ += image_bytes(decoded);
     decoded.name = il;
     slot = int64_t(scene_.images.size());
     scene_.images.push_back(std::move(decoded));
+    image_by_bytes_.emplace(key, slot);
+    image_source_.push_back(bytes);
   } catch (const ImageError& e) {
     // decode_image names the image itself; il is said once.
     std::string what = e.what();
     if (what.rfind(name + ": ", 0) == 0) what.erase(0, name.size() + 2);
+    if (const auto* big = dynamic_cast<const ImageTooLarge*>(&e))
+      what += ": the scene's files and textures would take " +
+              bytes_text(saturating_add(held_bytes_, big->bytes)) + ", over the " +
+              bytes_text(max_memory_) + " of --max-memory";
     fail(il + ": " + what);
   }
   return int32_t(slot);

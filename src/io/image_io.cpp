@@ -13,11 +13,16 @@
 #include <filesystem>
 
 #include "util/file_io.h"
+#include "util/memory.h"
 #include "util/message_text.h"
 
 namespace pb {
 
 namespace {
+
+// deflate's largest expansion: a 258-byte match costs at least 2 bits, about 1032:1 (zlib's
+// "Maximum compression factor", zlib.net/zlib_tech.html).
+constexpr uint64_t kDeflateMaxRatio = 1032;
 
 // OpenImageIO writes the temporary file write_atomically names (it picks the format by the
 // extension, which the name keeps); its errors become one ImageError naming `path`.
@@ -65,17 +70,71 @@ void write_png(const std::string& path, int width, int height,
   write_image(path, spec, rgb.data(), OIIO::TypeDesc::UINT8);
 }
 
-ExrImage read_exr(const std::string& path) {
+namespace {
+
+// The most an EXR's compression can shrink its pixels: none stores them as they are, ZIP is
+// deflate (1032:1, see kDeflateMaxRatio), RLE a run of at most 128 bytes in 2 (OpenEXR's
+// ImfRle.cpp); 0 for the others (PIZ, PXR24, B44, DWA), which have no bound used here.
+uint64_t exr_max_ratio(const std::string& compression) {
+  if (compression == "none") return 1;
+  if (compression == "zip" || compression == "zips") return kDeflateMaxRatio;
+  if (compression == "rle") return 64;
+  return 0;
+}
+
+// A file about to be read whole as floats: refused when deep, past `limit`, or (an EXR whose
+// compression bounds its ratio) when its pixels cannot fit in the file, all from its header.
+void check_whole_read(const std::string& path, const OIIO::ImageInput& in, const ReadLimit& limit) {
+  const OIIO::ImageSpec& spec = in.spec();
+  if (spec.deep)
+    throw ImageError(path +
+                     ": is a deep image (several samples per pixel), which photonbound does "
+                     "not read; flatten it first");
+  const uint64_t values = saturating_mul(
+      saturating_mul(uint64_t(std::max(spec.width, 0)), uint64_t(std::max(spec.height, 0))),
+      uint64_t(std::max(spec.nchannels, 0)));
+  const uint64_t bytes = saturating_mul(values, sizeof(float));
+  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 || bytes > limit.max_bytes)
+    throw ImageError(path + ": the header claims " + std::to_string(spec.width) + "x" +
+                     std::to_string(spec.height) + " pixels of " + std::to_string(spec.nchannels) +
+                     " channels" +
+                     (spec.width < 1 || spec.height < 1 || spec.nchannels < 1
+                          ? ""
+                          : ", " + bytes_text(bytes) + " as floats, over the " +
+                                bytes_text(limit.max_bytes) + " of " + limit.source));
+  if (std::string(in.format_name()) != "openexr") return;
+  const uint64_t ratio = exr_max_ratio(spec.get_string_attribute("compression", "none"));
+  std::error_code ec;
+  const uint64_t size = std::filesystem::file_size(path, ec);
+  const uint64_t stored = spec.image_bytes(/*native=*/true);  // each channel in its own type
+  if (ratio > 0 && !ec && stored / ratio > size)
+    throw ImageError(path + ": the header claims " + std::to_string(spec.width) + "x" +
+                     std::to_string(spec.height) + " pixels of " + std::to_string(spec.nchannels) +
+                     " channels (" + bytes_text(stored) + " stored), more than its " +
+                     std::to_string(size) + " bytes can hold: a corrupt or hostile file");
+}
+
+// read_image returned `ok`; a reader may also have recorded an error and returned true.
+void check_read(const std::string& path, OIIO::ImageInput& in, bool ok) {
+  if (!ok || in.has_error())
+    throw ImageError(path + ": cannot read pixels: " +
+                     (in.has_error() ? one_line(in.geterror()) : "the reader failed"));
+}
+
+}  // namespace
+
+ExrImage read_exr(const std::string& path, const ReadLimit& limit) {
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw ImageError(path + ": cannot read image: " + one_line(OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
+  check_whole_read(path, *in, limit);
   ExrImage image;
   image.width = spec.width;
   image.height = spec.height;
   image.channels = spec.channelnames;
   image.pixels.resize(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
-  if (!in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()))
-    throw ImageError(path + ": cannot read pixels: " + one_line(in->geterror()));
+  check_read(path, *in,
+             in->read_image(0, 0, 0, spec.nchannels, OIIO::TypeDesc::FLOAT, image.pixels.data()));
   for (const OIIO::ParamValue& p : spec.extra_attribs) {
     const std::string name = p.name().string();
     if (name.rfind("photonbound:", 0) == 0)
@@ -140,7 +199,38 @@ class QuietStderr {
 
 }  // namespace
 
-Image decode_image(const unsigned char* data, size_t size, const std::string& name) {
+namespace {
+
+// A header that claims more texels than the file's bytes can hold is refused before anything
+// is allocated for them (a 69-byte PNG can claim 16384x16384). PNG only: its filtered rows
+// (one filter byte each) are one deflate stream, so they are at most 1032 times the file. JPEG
+// and the others have no such bound worth the name (a progressive JPEG's end-of-band runs
+// cover any number of blocks); their size is checked against the budget alone.
+void check_plausible(const OIIO::ImageInput& in, const unsigned char* data, size_t size,
+                     const std::string& name, const std::string& claim) {
+  // IHDR as stored (PNG specification 11.2.2), not as the reader expands it: a palette image's
+  // rows hold one index of `depth` bits per pixel, though it is read as RGB.
+  if (std::string(in.format_name()) != "png" || size < 26 || std::memcmp(data + 12, "IHDR", 4) != 0)
+    return;
+  auto be32 = [&](size_t at) {
+    return uint64_t(data[at]) << 24 | uint64_t(data[at + 1]) << 16 | uint64_t(data[at + 2]) << 8 |
+           uint64_t(data[at + 3]);
+  };
+  const uint64_t width = be32(16), height = be32(20), depth = data[24];
+  const int colour = data[25];
+  const uint64_t samples = colour == 2 ? 3 : colour == 4 ? 2 : colour == 6 ? 4 : 1;
+  const uint64_t raw = height * (1 + (width * samples * depth + 7) / 8);
+  if (raw / kDeflateMaxRatio > uint64_t(size))
+    throw ImageError(name + ": the PNG header claims " + claim + " (" + bytes_text(raw) +
+                     " of rows), more than its " + std::to_string(size) +
+                     " bytes can hold (deflate expands at most 1032:1): a corrupt or "
+                     "hostile file");
+}
+
+}  // namespace
+
+Image decode_image(const unsigned char* data, size_t size, const std::string& name,
+                   uint64_t max_bytes) {
   // KTX2 (KHR_texture_basisu's container) has no OpenImageIO reader; without this, OpenImageIO
   // falls back to opening `name` as a path relative to the working directory and reports a
   // missing file.
@@ -208,32 +298,51 @@ Image decode_image(const unsigned char* data, size_t size, const std::string& na
   im.width = spec.width;
   im.height = spec.height;
   im.channels = std::min(spec.nchannels, 4);
+  const std::string claim = std::to_string(spec.width) + "x" + std::to_string(spec.height) +
+                            " with " + std::to_string(spec.nchannels) + " channels";
   const uint64_t texels = uint64_t(std::max(spec.width, 0)) * uint64_t(std::max(spec.height, 0));
   if (spec.width <= 0 || spec.height <= 0 || im.channels <= 0 || texels > (uint64_t(1) << 28))
-    throw ImageError(name + ": the image is " + std::to_string(spec.width) + "x" +
-                     std::to_string(spec.height) + " with " + std::to_string(spec.nchannels) +
-                     " channels; photonbound reads 1 to 4 channels and up to 2^28 texels");
+    throw ImageError(name + ": the image is " + claim +
+                     "; photonbound reads 1 to 4 channels and up to 2^28 texels");
+  check_plausible(*in, data, size, name, claim);
+  const bool u8 = spec.format == OIIO::TypeDesc::UINT8;
   const size_t values = size_t(texels) * size_t(im.channels);
+  const uint64_t bytes = uint64_t(values) * (u8 ? 1 : sizeof(float));
+  if (bytes > max_bytes)
+    throw ImageTooLarge(name + ": the image is " + claim + ", " + bytes_text(bytes) + " decoded",
+                        bytes);
   bool ok;
-  if (spec.format == OIIO::TypeDesc::UINT8) {
+  if (u8) {
     im.u8.resize(values);
     ok = in->read_image(0, 0, 0, im.channels, OIIO::TypeDesc::UINT8, im.u8.data());
   } else {
     im.f32.resize(values);
     ok = in->read_image(0, 0, 0, im.channels, OIIO::TypeDesc::FLOAT, im.f32.data());
   }
-  if (!ok) throw ImageError(name + ": cannot decode the image: " + one_line(in->geterror()));
+  // A decoder may return true and only record the problem: OpenImageIO's JPEG reader does for
+  // libjpeg's "Premature end of JPEG file", after filling the missing rows with grey.
+  if (!ok || in->has_error()) {
+    // OpenImageIO's readers quote the name they were opened with, here the made-up `file`.
+    std::string why = in->has_error() ? one_line(in->geterror()) : "the decoder failed";
+    for (const std::string quoted : {" (\"" + file + "\")", " \"" + file + "\""})
+      for (size_t at; (at = why.find(quoted)) != std::string::npos;) why.erase(at, quoted.size());
+    throw ImageError(name + ": cannot decode the image: " + why);
+  }
   in->close();
   return im;
 }
 
-RgbImage read_rgb_image(const std::string& path) {
+uint64_t image_bytes(const Image& image) {
+  return uint64_t(image.u8.size()) + uint64_t(image.f32.size()) * sizeof(float);
+}
+
+RgbImage read_rgb_image(const std::string& path, const ReadLimit& limit) {
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw ImageError(path + ": cannot read image: " + one_line(OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
+  check_whole_read(path, *in, limit);
   const size_t pixels = size_t(spec.width) * size_t(spec.height);
-  if (spec.width < 1 || spec.height < 1 || spec.nchannels < 1 ||
-      pixels * size_t(std::max(spec.nchannels, 1)) > (size_t(1) << 29))
+  if (pixels * size_t(spec.nchannels) > (size_t(1) << 29))
     throw ImageError(path + ": " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
                      " pixels of " + std::to_string(spec.nchannels) +
                      " channels is not an environment map (at most 2^29 values)");
@@ -244,8 +353,7 @@ RgbImage read_rgb_image(const std::string& path) {
     for (int c = 0; c < 3; ++c) source[c] = std::min(c, spec.nchannels - 1);
   const int channels = spec.nchannels;
   std::vector<float> data(pixels * size_t(channels));
-  if (!in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, data.data()))
-    throw ImageError(path + ": cannot read pixels: " + one_line(in->geterror()));
+  check_read(path, *in, in->read_image(0, 0, 0, channels, OIIO::TypeDesc::FLOAT, data.data()));
   in->close();
   RgbImage out;
   out.width = spec.width;

@@ -4,6 +4,7 @@
 
 #include "scene/scene.h"
 
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -35,15 +36,26 @@ enum class ExrCompression { Zip, None };
 void write_exr(const std::string& path, const ExrImage& image,
                ExrCompression compression = ExrCompression::Zip);
 
-ExrImage read_exr(const std::string& path);
+// How much a file read whole may take (its header's width x height x channels as floats), and
+// what sets it, for the message: "--max-memory", "3/4 of the machine's memory".
+struct ReadLimit {
+  uint64_t max_bytes = UINT64_MAX;
+  std::string source = "--max-memory";
+};
+
+// Reads an EXR whole, as floats. Throws ImageError naming the file when it cannot, when it is
+// a deep image (several samples per pixel), when the decoder reports any error (a short file),
+// or, from the header and before any pixel is allocated, when it passes `limit`.
+ExrImage read_exr(const std::string& path, const ReadLimit& limit = {});
 
 // An image's colour as linear RGB floats, for environment maps: any format OpenImageIO reads
-// (.exr, .hdr), its first three channels (one channel: grey). Throws ImageError naming the file.
+// (.exr, .hdr), its first three channels (one channel: grey). Throws ImageError naming the file,
+// as read_exr does.
 struct RgbImage {
   int width = 0, height = 0;
   std::vector<float> rgb;  // 3 floats per pixel, row-major, row 0 at the top
 };
-RgbImage read_rgb_image(const std::string& path);
+RgbImage read_rgb_image(const std::string& path, const ReadLimit& limit = {});
 
 // Writes an 8-bit RGB PNG (rgb: 3 bytes per pixel, row-major), atomically like write_exr.
 void write_png(const std::string& path, int width, int height,
@@ -53,8 +65,19 @@ void write_png(const std::string& path, int width, int height,
 // format is recognised from the bytes, else from `name`'s extension) into texels as stored:
 // 8-bit images as 8-bit values, others as floats in [0, 1], colour not premultiplied by alpha
 // (glTF's images are unassociated). At most 4 channels are kept. Throws ImageError naming
-// `name` when the bytes are not an image it can read, or the image is beyond 2^28 texels.
-Image decode_image(const unsigned char* data, size_t size, const std::string& name);
+// `name` when the bytes are not an image it can read, the decoder reports any error (a
+// truncated or corrupt file), the image is beyond 2^28 texels, or its header claims more texels
+// than its bytes can hold (PNG: deflate expands at most 1032:1); ImageTooLarge, from the header
+// and before any texel is decoded, when the texels would take more than `max_bytes`.
+class ImageTooLarge : public ImageError {
+ public:
+  ImageTooLarge(const std::string& what, uint64_t bytes) : ImageError(what), bytes(bytes) {}
+  uint64_t bytes;  // what the decoded texels would take
+};
+Image decode_image(const unsigned char* data, size_t size, const std::string& name,
+                   uint64_t max_bytes = UINT64_MAX);
+// What decode_image's image takes: 1 byte per value for 8-bit images, 4 (a float) otherwise.
+uint64_t image_bytes(const Image& image);
 // The bytes begin with KTX2's identifier (KHR_texture_basisu's container), which no reader here
 // decodes.
 bool is_ktx2(const unsigned char* data, size_t size);

@@ -51,7 +51,8 @@ Lights::Lights(const Scene& scene, double piece_budget)
   double pieces = 0.0;  // what the textured triangles ask for
   for (const Mesh& mesh : scene.meshes) {
     const Material& mat = scene.materials[mesh.material];
-    if (!mat.emits() || !(mat.emissive_texture.present() || mat.masked())) continue;
+    if (!mat.emits() || !(mat.emissive_texture.present() || mat.masked() || mat.blended()))
+      continue;
     for (size_t t = 0; t + 2 < mesh.indices.size(); t += 3) {
       const double n = textured_split(mesh, mat, uint32_t(t / 3), nullptr);
       pieces += n * n;
@@ -75,7 +76,7 @@ Lights::Lights(const Scene& scene, double piece_budget)
       tri.select = average(tri.radiance);
       tri.two_sided = mat.double_sided;
       tri.coat = mat.clearcoat;
-      if (mat.emissive_texture.present() || mat.masked())
+      if (mat.emissive_texture.present() || mat.masked() || mat.blended())
         add_textured(mesh, mat, uint32_t(t / 3), tri);
       else
         triangles_.push_back(tri);

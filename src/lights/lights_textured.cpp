@@ -1,7 +1,7 @@
 // The light sampler's textured emitters (lights.h): an emissive triangle whose radiance follows
-// an emissive texture (or a MASK cut-out) is cut into pieces chosen by their power, and the
-// radiance of a sampled point is looked up, so emission and next-event estimation stay
-// unbiased while their choice follows the texture.
+// an emissive texture (or a MASK cut-out, or BLEND coverage) is cut into pieces chosen by their
+// power, and the radiance of a sampled point is looked up, so emission and next-event estimation
+// stay unbiased while their choice follows the texture.
 #include "lights/lights.h"
 
 #include "scene/texture.h"
@@ -23,7 +23,8 @@ vec2 texture_st(const Mesh& mesh, uint32_t tri, const TextureRef& ref, vec2 b) {
   return texture_coords(ref, uv);
 }
 
-// What a textured emitter follows: its emissive texture, else the base colour's alpha (MASK).
+// What a textured emitter follows: its emissive texture, else the base colour's alpha (MASK,
+// BLEND).
 const TextureRef& emitter_texture(const Material& mat) {
   return mat.emissive_texture.present() ? mat.emissive_texture : mat.base_color_texture;
 }

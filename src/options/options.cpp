@@ -2,6 +2,8 @@
 // (option_table.cpp).
 #include "options/options.h"
 
+#include "util/memory.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -192,6 +194,10 @@ std::string state_path_for(const RenderOptions& o) {
   const size_t dot = o.output.find_last_of('.');
   const bool has_ext = dot != std::string::npos && (slash == std::string::npos || dot > slash);
   return (has_ext ? o.output.substr(0, dot) : o.output) + ".pbstate";
+}
+
+uint64_t memory_budget(const RenderOptions& o) {
+  return o.max_memory ? *o.max_memory : default_memory_budget();
 }
 
 Command parse_command_line(int argc, const char* const* argv) {

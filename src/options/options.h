@@ -51,6 +51,9 @@ struct RenderOptions {
   Method method = Method::SPPM;
   uint64_t photons_per_pass = 100000;  // M_e
   double alpha = 0.7;
+  // --adaptive: which parts of the render follow each pixel's own error estimates
+  // (ESTIMATOR.md section 13); none = every point on the PPM schedule.
+  bool adaptive_radius = false;
   std::optional<double> radius;  // world units; default from the pixel footprint
   int max_depth = 8;
   double mirror_roughness = kDefaultMirrorRoughness;
@@ -68,6 +71,8 @@ struct RenderOptions {
   std::string environment;
   double environment_scale = 1.0;
   int threads = 0;
+  // --max-memory in bytes; unset: default_memory_budget() (util/memory.h).
+  std::optional<uint64_t> max_memory;
   uint64_t seed = 1;
   DirectMode direct = DirectMode::NextEvent;
   double confidence = 0.9;  // 1 - beta
@@ -130,6 +135,9 @@ std::array<double, 3> environment_colour(const std::string& text);
 // The state file a render writes: --state, or the output path with its extension replaced by
 // ".pbstate".
 std::string state_path_for(const RenderOptions& options);
+
+// --max-memory, or its default (3/4 of the machine's memory).
+uint64_t memory_budget(const RenderOptions& options);
 
 // photonbound preview IN.exr -o OUT.png [--exposure STOPS]
 struct PreviewOptions {

@@ -16,7 +16,12 @@ struct PathVertex {
   float origin_error;  // its position error bound (Surface::error)
   float length;        // path length so far, for the footprint
   int depth;           // specular bounces so far
+  int layers;          // BLEND surfaces passed through so far
 };
+
+// BLEND surfaces a pixel's ray may pass through (kept apart from the specular depth: a tree's
+// crown of foliage cards is many layers deep).
+constexpr int kMaxBlendLayers = 256;
 
 struct PixelOutput {
   std::vector<VisiblePoint> points;
@@ -31,7 +36,8 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
                  PixelOutput& out) {
   PathVertex stack[64];
   int top = 0;
-  stack[top++] = {camera.origin(), camera.direction(x, y), vec3(1.0f), vec3(0.0f), 0.0f, 0.0f, 0};
+  stack[top++] = {
+      camera.origin(), camera.direction(x, y), vec3(1.0f), vec3(0.0f), 0.0f, 0.0f, 0, 0};
   while (top > 0) {
     const PathVertex v = stack[--top];
     Hit hit;
@@ -45,10 +51,26 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
     const Surface s = world.surface(hit);
     const vec3 wo = -v.dir;
     // Inside an absorbing volume the segment's transmittance weighs what it reaches.
-    const vec3 weight = v.weight * world.transmittance(s, wo, v.origin);
-    // Emission seen along the chain is exact for this ray (front side unless double-sided).
-    if (s.material->emits()) out.emission += dvec3(weight * world.emitted(s, wo));
+    vec3 weight = v.weight * world.transmittance(s, wo, v.origin);
     const float length = v.length + hit.t;
+    // A BLEND surface of coverage a splits the ray deterministically, as a dielectric does
+    // (ESTIMATOR.md section 5: PPM's points are fixed, a random choice would be frozen): the
+    // surface with weight a, and the ray going on through it with 1 - a (docs/materials.md
+    // "Alpha"). The key-less trace met it (Accel::intersect).
+    if (s.material->blended()) {
+      const float a = world.coverage(hit, s);
+      const vec3 through = weight * (1.0f - a);
+      // At depth 0 the ray goes on as the camera's (World::camera_hit, from beyond the card).
+      const vec3 from = v.depth == 0 ? World::spawn(s, v.dir) : s.position;
+      if (max_component(through) > 0.0f && v.layers < kMaxBlendLayers && top < 64)
+        stack[top++] = {from, v.dir, through, s.ng, s.error, length, v.depth, v.layers + 1};
+      weight *= a;
+      if (!(max_component(weight) > 0.0f)) continue;
+    }
+    // Emission seen along the chain is exact for this ray (front side unless double-sided), and
+    // so is an unlit surface's painted colour (either side; it holds no visible point).
+    if (s.material->emits()) out.emission += dvec3(weight * world.emitted(s, wo));
+    if (s.material->unlit) out.emission += dvec3(weight * s.painted);
     if (!s.bsdf.is_delta()) {
       const bool front = glm::dot(wo, s.ng) > 0.0f;
       VisiblePoint p;
@@ -71,7 +93,7 @@ void trace_pixel(const World& world, const PinholeCamera& camera, int max_depth,
     for (int k = 0; k < n; ++k) {
       const vec3 w = weight * branches[k].weight;
       if (max_component(w) <= 0.0f || top >= 64) continue;
-      stack[top++] = {s.position, branches[k].dir, w, s.ng, s.error, length, v.depth + 1};
+      stack[top++] = {s.position, branches[k].dir, w, s.ng, s.error, length, v.depth + 1, v.layers};
     }
   }
 }

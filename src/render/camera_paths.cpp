@@ -43,6 +43,9 @@ struct CameraPath {
   // roulette through delta branches too, up to kPassOverDepth beyond, instead of being cut
   // where the limit would cut a path that reached it.
   bool past_limit = false;
+  // The path left the camera's chain of delta branches (a followed lobe or a pass-over): it
+  // estimates a surface's reflected light now, to which unlit surfaces give nothing.
+  bool left_chain = false;
   int depth = 0;
 
   CameraPath(const CameraPathInputs& in, size_t pixel)
@@ -111,6 +114,7 @@ LobeChoice follow_lobe(CameraPath& path, const CameraPathInputs& in, const Surfa
     // The light this path finds directly was counted by the next-event sample, unless it left
     // through sharp rough glass, which that sample left out.
     path.after_lobe = in.next_event && !(sharp_glass && b.glass);
+    path.left_chain = true;
     return LobeChoice::Followed;
   }
   w /= 1.0f - p_lobe;
@@ -142,6 +146,7 @@ Step pass_over(CameraPath& path, const CameraPathInputs& in, const Surface& s, c
   if (!(max_component(path.weight) > 0.0f)) return Step::End;
   path.leave(s, b.wi);
   path.after_lobe = in.next_event;  // the next-event sample counted what it finds directly
+  path.left_chain = true;
   return Step::Continue;
 }
 
@@ -195,6 +200,9 @@ Step at_vertex(CameraPath& path, const CameraPathInputs& in, const Hit& hit, flo
   path.weight *= in.world.transmittance(s, wo, path.origin);  // inside an absorbing volume
   if (s.material->emits() && !path.after_lobe)
     path.emission += dvec3(path.weight * in.world.emitted(s, wo));
+  // An unlit surface's painted colour, seen along the camera's delta chain (docs/materials.md
+  // "Unlit"); its Bsdf is black, so the path ends there without a visible point.
+  if (s.material->unlit && !path.left_chain) path.emission += dvec3(path.weight * s.painted);
   path.after_lobe = false;
   const float p_delta = s.bsdf.delta_probability(wo);
   bool stop = p_delta < 1.0f;
@@ -228,9 +236,12 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
     std::optional<PointBsdf> g;
     for (;; ++path.depth) {
       Hit hit;
-      const bool found = path.depth == 0 ? in.world.camera_hit(path.origin, path.dir, hit)
-                                         : in.world.trace(path.origin, path.origin_normal,
-                                                          path.origin_error, path.dir, hit);
+      // BLEND surfaces are met by chance, by a key of the path's stream (World::ray_key).
+      const uint64_t key = in.world.ray_key(path.rng);
+      const bool found = path.depth == 0
+                             ? in.world.camera_hit(path.origin, path.dir, hit, nullptr, key)
+                             : in.world.trace(path.origin, path.origin_normal, path.origin_error,
+                                              path.dir, hit, key);
       if (!found) {  // the environment (black without one), seen along the path
         if (!path.after_lobe)
           path.emission += dvec3(path.weight * in.world.lights().environment_radiance(path.dir));

@@ -55,8 +55,9 @@ class PhotonMethod {
 
   // Stages 0 and 3-5 of pass in.pass (pass_stages.h) over every state, block by block; the
   // renderer has traced the photons and built the grid (stages 1-2). `copy` (sized to the
-  // states) receives the new states.
-  virtual void step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
+  // states) receives the new states. False when in.cutoff was reached during the first block's
+  // gather: nothing was changed (no state, no side state), and the pass is to be discarded.
+  virtual bool step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
                     PointState* copy) = 0;
 
   // The method's side state into a snapshot, and back (StateError when it does not fit).

@@ -10,7 +10,8 @@ dvec3 direct_light(const World& world, const VisiblePoint& point, const PointBsd
   if (cos_s <= 0.0f || glm::dot(s.wi, point.normal) <= 0.0f) return dvec3(0.0);
   const vec3 f = glossy ? point.f * glossy->bsdf.eval(glossy->wo, s.wi) : point.f;
   if (glossy && !(max_component(f) > 0.0f)) return dvec3(0.0);  // no shadow ray for nothing
-  if (world.occluded(point.position, s.wi, s.distance, s.margin)) return dvec3(0.0);
+  if (world.occluded(point.position, s.wi, s.distance, s.margin, world.ray_key(rng)))
+    return dvec3(0.0);
   return dvec3(f * s.li * cos_s);
 }
 
@@ -25,7 +26,7 @@ dvec3 direct_light_through(const World& world, const Surface& s, const vec3& wo,
   if (cos_s <= 0.0f || glm::dot(d.wi, n) <= 0.0f) return dvec3(0.0);
   const vec3 f = weight * s.bsdf.eval_transmission(wo, d.wi, glass);
   if (!(max_component(f) > 0.0f)) return dvec3(0.0);  // no shadow ray for nothing
-  if (world.occluded(origin, d.wi, d.distance, d.margin)) return dvec3(0.0);
+  if (world.occluded(origin, d.wi, d.distance, d.margin, world.ray_key(rng))) return dvec3(0.0);
   return dvec3(f * d.li * cos_s);
 }
 

@@ -101,7 +101,8 @@ void fold_block(size_t first, std::span<PointState> states, std::span<const Pass
 inline constexpr size_t kFoldBlock = 16384;
 
 // What every stage of a pass reads: the world, the pass's photons and grid, the estimator's
-// parameters and the random stream's key.
+// parameters and the random stream's key; and what may cut the pass short (polled by the first
+// fold block's chunks, before anything of the pass is folded; null: never).
 struct PassInputs {
   const World& world;
   const HashGrid& grid;
@@ -110,6 +111,10 @@ struct PassInputs {
   const BoundaryIndex* boundary = nullptr;
   uint64_t seed = 0, pass = 0;
   bool next_event = true;
+  const Cutoff* cutoff = nullptr;
+  // Whether a chunk of the fold block starting at `first` should give up: only the first block
+  // can (the later ones come after a fold).
+  bool cut(size_t first) const { return first == 0 && cutoff && cutoff->reached(); }
 };
 
 // Points per parallel task inside a fold block. The methods cut a block into chunks of this

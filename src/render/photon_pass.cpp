@@ -13,8 +13,6 @@
 namespace pb {
 
 namespace {
-// Photons per work chunk: large enough to amortise scheduling, small enough to balance 2 cores.
-constexpr size_t kChunk = 2048;
 
 // Spatial order of the hits: a Morton code on a 2^10 lattice per axis (30 bits), sorted by an
 // LSD radix sort of three 10-bit digits (counting_sort.h: the order does not depend on the
@@ -54,9 +52,10 @@ void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, std::vect
   for (int bounce = 0; bounce < kMaxBounces; ++bounce) {
     Hit hit;
     ++rays;
+    const uint64_t key = world_.ray_key(rng);  // BLEND surfaces are met by chance
     const bool found = glm::dot(origin_normal, origin_normal) > 0.0f
-                           ? world_.trace(origin, origin_normal, origin_error, dir, hit)
-                           : world_.accel().intersect(origin, dir, 0.0f, INFINITY, hit);
+                           ? world_.trace(origin, origin_normal, origin_error, dir, hit, key)
+                           : world_.accel().intersect(origin, dir, 0.0f, INFINITY, hit, key);
     if (!found) return;
     const Surface s = world_.surface(hit);
     const vec3 wo = -dir;
@@ -65,8 +64,14 @@ void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, std::vect
     const vec3 ns = front ? s.ns : -s.ns;
     flux *= world_.transmittance(s, wo, origin);  // Beer-Lambert inside an absorbing volume
     // Every surface with a non-delta part keeps the photon (glossy points evaluate f per photon).
-    if (!s.bsdf.is_delta() && (bounce >= 1 || deposit_first_hit_))
-      out.push_back({s.position, wo, ng, flux});
+    // A BLEND surface of coverage a was met with probability a: the photon stored there carries
+    // flux / a, so that the density estimate is the irradiance of the surface where it is (a
+    // camera path meets it with probability a too; the estimate counts a once). The photon goes
+    // on with its flux: what the surface scatters is a times what reaches it, on average.
+    if (!s.bsdf.is_delta() && !s.material->unlit && (bounce >= 1 || deposit_first_hit_)) {
+      const float a = s.material->blended() ? world_.coverage(hit, s) : 1.0f;
+      out.push_back({s.position, wo, ng, a > 0.0f && a < 1.0f ? flux / a : flux});
+    }
     BsdfSample b;
     if (!s.bsdf.sample(wo, rng, Transport::Importance, b, flux)) return;
     const vec3 next = b.wi;
@@ -84,14 +89,19 @@ void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, std::vect
 }
 
 PhotonPassStats PhotonTracer::run(uint64_t seed, uint64_t pass, uint64_t first, uint64_t last,
-                                  std::vector<PhotonHit>& hits) {
+                                  std::vector<PhotonHit>& hits, const Cutoff* cutoff) {
   const uint64_t count = last > first ? last - first : 0;
   const size_t chunks = size_t((count + kChunk - 1) / kChunk);
   if (chunk_hits_.size() < chunks) chunk_hits_.resize(chunks);
   chunk_bounds_.resize(chunks);
   chunk_max_.resize(chunks);
   std::atomic<uint64_t> rays{0};
+  std::atomic<bool> cut{false};
   parallel_chunks(size_t(count), kChunk, [&](size_t k, size_t begin, size_t end) {
+    if (cut.load(std::memory_order_relaxed) || (cutoff && cutoff->reached())) {
+      cut.store(true, std::memory_order_relaxed);
+      return;
+    }
     std::vector<PhotonHit>& out = chunk_hits_[k];
     out.clear();
     uint64_t local_rays = 0;
@@ -106,11 +116,15 @@ PhotonPassStats PhotonTracer::run(uint64_t seed, uint64_t pass, uint64_t first, 
     chunk_max_[k] = max_flux;
     rays += local_rays;
   });
+  PhotonPassStats stats;
+  if (cut.load()) {
+    stats.cut = true;
+    return stats;
+  }
   chunk_offset_.assign(chunks + 1, 0);
   for (size_t k = 0; k < chunks; ++k)
     chunk_offset_[k + 1] = chunk_offset_[k] + chunk_hits_[k].size();
 
-  PhotonPassStats stats;
   const auto t0 = std::chrono::steady_clock::now();
   order_hits(hits);
   stats.order_seconds =

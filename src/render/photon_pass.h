@@ -4,6 +4,7 @@
 // recorded.
 #pragma once
 
+#include "util/timer.h"
 #include "world/world.h"
 
 #include <cstdint>
@@ -23,6 +24,7 @@ struct PhotonPassStats {
   uint64_t paths = 0;        // photons emitted
   double order_seconds = 0;  // wall clock spent ordering the hits (part of run())
   float max_flux = 0.0f;     // largest channel of any stored hit's power (ESTIMATOR.md section 12)
+  bool cut = false;          // the cutoff was reached: `hits` and the rest are not the range's
 };
 
 class PhotonTracer {
@@ -39,8 +41,13 @@ class PhotonTracer {
   // near its point; in photon order each is a cache miss, in Morton order a point's photons are
   // a few contiguous runs that the neighbouring points read again (bench/README.md: a 2.1-2.4x
   // faster gather at 1 M photons per pass, and a faster grid build).
+  // With a cutoff, each batch of kChunk photons first polls it; once it is reached the run
+  // stops early and returns with `cut` set (the caller discards the pass).
   PhotonPassStats run(uint64_t seed, uint64_t pass, uint64_t first, uint64_t last,
-                      std::vector<PhotonHit>& hits);
+                      std::vector<PhotonHit>& hits, const Cutoff* cutoff = nullptr);
+
+  // Photons per batch: large enough to amortise scheduling, small enough to balance 2 cores.
+  static constexpr size_t kChunk = 2048;
 
   // A photon path never takes more bounces than this; Russian roulette ends almost all first.
   static constexpr int kMaxBounces = 256;

@@ -3,6 +3,7 @@
 #include "util/parallel.h"
 
 #include <algorithm>
+#include <atomic>
 #include <string>
 
 namespace pb {
@@ -30,14 +31,19 @@ void PpmMethod::prepare(const BoundaryIndex& boundary, double initial_radius) {
   });
 }
 
-void ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
+bool ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
               std::span<const PointBsdf> glossy, std::span<const float> clearance,
               std::span<PointState> states, std::span<float> radii, std::span<PassSums> sums,
               std::span<OwnerValues> owner, PointState* copy) {
   const size_t n = states.size(), block = sums.size();
   for (size_t first = 0; first < n; first += block) {
     const size_t count = std::min(block, n - first);
+    std::atomic<bool> cut{false};
     for_each_chunk(count, [&](size_t b, size_t m) {
+      if (cut.load(std::memory_order_relaxed) || in.cut(first)) {
+        cut.store(true, std::memory_order_relaxed);
+        return;
+      }
       const size_t at = first + b;
       const std::span<const VisiblePoint> pts = points.subspan(at, m);
       const std::span<const PointState> st = std::span<const PointState>(states).subspan(at, m);
@@ -49,15 +55,17 @@ void ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
                 own);
       if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, at, own);
     });
+    if (cut.load()) return false;  // the first block: nothing folded yet
     // A distributed render reduces sums[0, count) across machines here.
     fold_block(first, states, std::span<const PassSums>(sums).first(count),
                std::span<const OwnerValues>(owner).first(count), in.params, in.pass, radii, copy);
   }
+  return true;
 }
 
-void PpmMethod::step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
+bool PpmMethod::step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
                      PointState* copy) {
-  ppm_pass(in, pass_.points, pass_.glossy, clearance_, states, radii, sums_, owner_, copy);
+  return ppm_pass(in, pass_.points, pass_.glossy, clearance_, states, radii, sums_, owner_, copy);
 }
 
 void PpmMethod::restore(const RenderState& s) {

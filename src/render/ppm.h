@@ -13,8 +13,8 @@ namespace pb {
 // `sums`, the disc moments (with `clearance`, per point; empty: ask the boundary index for every
 // disc) and next-event samples into `owner`, then fold into `states` and `radii`. `glossy` is
 // the points' glossy side table (CameraPassResult::glossy); `copy` (sized to the points) receives
-// the new states.
-void ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
+// the new states. False when in.cutoff was reached before the first fold (nothing changed).
+bool ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
               std::span<const PointBsdf> glossy, std::span<const float> clearance,
               std::span<PointState> states, std::span<float> radii, std::span<PassSums> sums,
               std::span<OwnerValues> owner, PointState* copy);
@@ -25,7 +25,7 @@ class PpmMethod final : public PhotonMethod {
 
   const CameraPassResult& camera_pass() const override { return pass_; }
   void prepare(const BoundaryIndex& boundary, double initial_radius) override;
-  void step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
+  bool step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
             PointState* copy) override;
   void save(RenderState&) const override {}
   void restore(const RenderState& s) override;

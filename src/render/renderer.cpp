@@ -60,6 +60,7 @@ Renderer::Renderer(Scene scene, const RenderOptions& options)
   timings_.camera = seconds_since(t0);
   params_.alpha = options_.alpha;
   params_.photons_per_pass = double(options_.photons_per_pass);
+  params_.adaptive_radius = options_.adaptive_radius;
   const double r_min = radius_floor(world_);
   params_.min_r2 = r_min * r_min;
   initial_radius_ = options_.radius ? std::max(*options_.radius, r_min)
@@ -94,34 +95,42 @@ FilmSettings Renderer::film_settings() const {
   return s;
 }
 
-void Renderer::step(std::vector<PointState>* copy) {
-  const uint64_t pass = ++work_.passes;
+bool Renderer::step(std::vector<PointState>* copy, const Cutoff* cutoff) {
+  const uint64_t pass = work_.passes + 1;
   auto t = Clock::now();
   const PhotonPassStats stats =
-      tracer_.run(options_.seed, pass, 0, options_.photons_per_pass, hits_);
+      tracer_.run(options_.seed, pass, 0, options_.photons_per_pass, hits_, cutoff);
+  timings_.trace += seconds_since(t);
+  if (stats.cut) return false;
+
+  const size_t n = states_.size();
+  if (n > 0) {
+    if (cutoff && cutoff->reached()) return false;
+    t = Clock::now();
+    build_photon_grid(hits_, radii_, hit_positions_, grid_);  // radii_ from the previous fold
+    timings_.grid += seconds_since(t);
+
+    t = Clock::now();
+    if (copy) copy->resize(n);
+    const PassInputs in{world_,
+                        grid_,
+                        hits_,
+                        params_,
+                        boundary_on_ ? &boundary_ : nullptr,
+                        options_.seed,
+                        pass,
+                        options_.direct == DirectMode::NextEvent,
+                        cutoff};
+    const bool whole = method_->step(in, states_, radii_, copy ? copy->data() : nullptr);
+    timings_.gather += seconds_since(t);
+    if (!whole) return false;
+  }
+  // Only a whole pass counts: a pass cut short has changed none of what follows.
+  work_.passes = pass;
   work_.rays += stats.rays;
   work_.photons += stats.paths;
   max_photon_power_ = std::max(max_photon_power_, double(stats.max_flux));
-  timings_.trace += seconds_since(t);
-
-  const size_t n = states_.size();
-  if (n == 0) return;
-  t = Clock::now();
-  build_photon_grid(hits_, radii_, hit_positions_, grid_);  // radii_ from the previous fold
-  timings_.grid += seconds_since(t);
-
-  t = Clock::now();
-  if (copy) copy->resize(n);
-  const PassInputs in{world_,
-                      grid_,
-                      hits_,
-                      params_,
-                      boundary_on_ ? &boundary_ : nullptr,
-                      options_.seed,
-                      pass,
-                      options_.direct == DirectMode::NextEvent};
-  method_->step(in, states_, radii_, copy ? copy->data() : nullptr);
-  timings_.gather += seconds_since(t);
+  return true;
 }
 
 RenderState Renderer::snapshot(std::vector<PointState> states) const {

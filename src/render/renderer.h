@@ -54,8 +54,12 @@ class Renderer {
   ~Renderer();
 
   // Runs one more pass (pass number passes() + 1). With `copy`, also copies every point's
-  // state into it as the pass leaves it (resized to the point count first).
-  void step(std::vector<PointState>* copy = nullptr);
+  // state into it as the pass leaves it (resized to the point count first). With `cutoff`, the
+  // pass polls it between batches of photons, before the grid build and while the first fold
+  // block gathers; once reached, the pass is discarded whole and step() returns false: states,
+  // side state and counters are those of the last whole pass, and `copy` is not that pass's.
+  // Past the first fold the pass runs to its end.
+  bool step(std::vector<PointState>* copy = nullptr, const Cutoff* cutoff = nullptr);
   uint64_t passes() const { return work_.passes; }
   const WorkCounters& work() const { return work_; }
 

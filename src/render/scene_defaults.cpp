@@ -26,7 +26,7 @@ Environment read_environment(const RenderOptions& o, uint64_t& hash) {
   const float scale = float(o.environment_scale);
   const std::string& text = o.environment;
   if (environment_is_map(text)) {
-    const RgbImage img = read_rgb_image(text);
+    const RgbImage img = read_rgb_image(text, ReadLimit{memory_budget(o)});
     env.source = text;
     env.width = img.width;
     env.height = img.height;

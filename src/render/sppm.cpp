@@ -1,6 +1,7 @@
 #include "render/sppm.h"
 
 #include <algorithm>
+#include <atomic>
 #include <string>
 
 namespace pb {
@@ -27,9 +28,10 @@ SppmMethod::SppmMethod(const World& world, const PinholeCamera& camera, CameraPa
   glossy_.resize(block);
   sums_.resize(block);
   owner_.resize(block);
+  glossy_count_.resize((block + kStageChunk - 1) / kStageChunk);
 }
 
-void SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
+bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
                       PointState* copy) {
   const CameraPathInputs camera{in.world, camera_, settings_.max_depth, settings_.follow_roughness,
                                 in.seed,  in.pass, in.next_event,       in.boundary};
@@ -37,7 +39,12 @@ void SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
   for (size_t first = 0; first < n; first += block) {
     const size_t count = std::min(block, n - first);
     // Stages 0, 3 and 4 chunk by chunk, so that a chunk's visible points are still in cache.
+    std::atomic<bool> cut{false};
     for_each_chunk(count, [&](size_t b, size_t m) {
+      if (cut.load(std::memory_order_relaxed) || in.cut(first)) {
+        cut.store(true, std::memory_order_relaxed);
+        return;
+      }
       const size_t at = first + b;
       const std::span<VisiblePoint> pts = std::span(points_).subspan(b, m);
       const std::span<OwnerValues> own = std::span(owner_).subspan(b, m);
@@ -48,12 +55,20 @@ void SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
       const PointBsdfTable table{scratch.first(n_glossy), 0};  // indices into pts
       gather_pass(pts, st, in.grid, in.hits, table, std::span(sums_).subspan(b, m));
       if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, at, own);
-      record_visible(at, pts, own, table.entries, st);
+      glossy_count_[b / kStageChunk] = uint32_t(n_glossy);
+    });
+    if (cut.load()) return false;  // the first block: nothing recorded or folded yet
+    // The pixels' side state, once the pass is known to go on (a chunk writes its own pixels).
+    for_each_chunk(count, [&](size_t b, size_t m) {
+      record_visible(first + b, std::span(points_).subspan(b, m), std::span(owner_).subspan(b, m),
+                     std::span(glossy_).subspan(b, glossy_count_[b / kStageChunk]),
+                     std::span<const PointState>(states).subspan(first + b, m));
     });
     // A distributed render reduces sums_[0, count) across machines here.
     fold_block(first, states, std::span<const PassSums>(sums_).first(count),
                std::span<const OwnerValues>(owner_).first(count), in.params, in.pass, radii, copy);
   }
+  return true;
 }
 
 void SppmMethod::record_visible(size_t first, std::span<const VisiblePoint> points,

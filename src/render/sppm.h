@@ -23,7 +23,7 @@ class SppmMethod final : public PhotonMethod {
 
   const CameraPassResult& camera_pass() const override { return pass_; }
   void prepare(const BoundaryIndex&, double) override {}
-  void step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
+  bool step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
             PointState* copy) override;
   void save(RenderState& s) const override;
   void restore(const RenderState& s) override;
@@ -51,6 +51,7 @@ class SppmMethod final : public PhotonMethod {
   std::vector<PointBsdf> glossy_;
   std::vector<PassSums> sums_;
   std::vector<OwnerValues> owner_;
+  std::vector<uint32_t> glossy_count_;  // per chunk of the block: its glossy entries
 };
 
 }  // namespace pb

@@ -76,6 +76,9 @@ struct Material {
   bool double_sided = false;  // doubleSided: an emitter emits from both sides
   AlphaMode alpha_mode = AlphaMode::Opaque;
   float alpha_cutoff = 0.5f;
+  // KHR_materials_unlit: the camera sees the base colour as the surface's radiance; to light it
+  // is black (it reflects and emits nothing; docs/materials.md "Unlit").
+  bool unlit = false;
   float normal_scale = 1.0f;                 // normalTexture.scale
   TextureRef base_color_texture;             // sRGB; alpha in A
   TextureRef metallic_roughness_texture;     // B metal, G rough (linear)
@@ -105,6 +108,9 @@ struct Material {
   bool emits() const { return emission.x > 0.0f || emission.y > 0.0f || emission.z > 0.0f; }
   // Rays pass through where the base colour's alpha is below the cutoff (alphaMode MASK).
   bool masked() const { return alpha_mode == AlphaMode::Mask; }
+  // The base colour's alpha is the share of rays the surface stops (alphaMode BLEND as
+  // stochastic coverage; docs/materials.md "Alpha").
+  bool blended() const { return alpha_mode == AlphaMode::Blend; }
 
   // Plain materials for tests and defaults: a Lambertian (metallic 0 and KHR_materials_specular
   // specularFactor 0: glTF's way to say "no specular layer"), a smooth metal, smooth glass.

@@ -159,10 +159,45 @@ bool cut_out(std::span<const Image> images, const Material& m, const vec2 uv[2],
   return a < m.alpha_cutoff;
 }
 
+float coverage(std::span<const Image> images, const Material& m, const vec2 uv[2],
+               float vertex_alpha) {
+  if (m.masked()) return cut_out(images, m, uv, vertex_alpha) ? 0.0f : 1.0f;
+  if (!m.blended()) return 1.0f;
+  const float a = m.alpha * lookup(images, m.base_color_texture, uv, false).w * vertex_alpha;
+  return std::clamp(a, 0.0f, 1.0f);
+}
+
+void settle_blend(Scene& scene) {
+  for (size_t k = 0; k < scene.materials.size(); ++k) {
+    Material& m = scene.materials[k];
+    if (!m.blended() || !(m.alpha >= 1.0f)) continue;
+    bool opaque = true;
+    if (m.base_color_texture.present()) {
+      const Image& im = scene.images[size_t(m.base_color_texture.image)];
+      const size_t texels = size_t(im.width) * size_t(im.height);
+      const int a = im.channels == 2 ? 1 : im.channels >= 4 ? 3 : -1;  // as texel() reads it
+      for (size_t t = 0; a >= 0 && t < texels && opaque; ++t) {
+        const size_t i = t * size_t(im.channels) + size_t(a);
+        opaque = im.u8.empty() ? im.f32[i] >= 1.0f : im.u8[i] == 255;
+      }
+    }
+    for (const Mesh& mesh : scene.meshes)
+      if (mesh.material == k)
+        for (const glm::vec4& c : mesh.colors) opaque = opaque && c.w >= 1.0f;
+    if (opaque) m.alpha_mode = AlphaMode::Opaque;
+  }
+}
+
+vec3 surface_emission(std::span<const Image> images, const Material& m, const vec2 uv[2]) {
+  if (!m.emits()) return vec3(0.0f);
+  return m.emission * vec3(lookup(images, m.emissive_texture, uv, true));
+}
+
 vec3 emission_at(std::span<const Image> images, const Material& m, const vec2 uv[2],
                  float vertex_alpha) {
-  if (!m.emits() || cut_out(images, m, uv, vertex_alpha)) return vec3(0.0f);
-  return m.emission * vec3(lookup(images, m.emissive_texture, uv, true));
+  if (!m.emits()) return vec3(0.0f);
+  const float c = coverage(images, m, uv, vertex_alpha);
+  return c > 0.0f ? c * surface_emission(images, m, uv) : vec3(0.0f);
 }
 
 }  // namespace pb

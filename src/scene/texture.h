@@ -51,8 +51,23 @@ float mesh_alpha(const Mesh& mesh, size_t tri, float b1, float b2);
 bool cut_out(std::span<const Image> images, const Material& m, const vec2 uv[2],
              float vertex_alpha = 1.0f);
 
-// A material's emitted radiance at a point (emissiveFactor x strength x the emissive texture),
-// 0 where a MASK material is cut out. Either side; one-sidedness is the caller's.
+// The share of rays a material's surface stops at a point: 1 for OPAQUE, 0 or 1 for MASK
+// (cut_out), and for BLEND the alpha (baseColorFactor.a x the base colour texture's alpha x
+// COLOR_0's) clamped to [0, 1] (docs/materials.md "Alpha").
+float coverage(std::span<const Image> images, const Material& m, const vec2 uv[2],
+               float vertex_alpha = 1.0f);
+
+// A BLEND material whose coverage is 1 everywhere (alpha factor 1, a base colour texture without
+// an alpha below 1, and no COLOR_0 alpha below 1 on its meshes) becomes OPAQUE: the same
+// surface, without the per-ray coverage choice (exporters write BLEND for opaque materials).
+void settle_blend(Scene& scene);
+
+// A material's emitted radiance at a point of its surface, where a ray met it (emissiveFactor x
+// strength x the emissive texture). Either side; one-sidedness is the caller's.
+vec3 surface_emission(std::span<const Image> images, const Material& m, const vec2 uv[2]);
+
+// The mean radiance emitted at a point, as the light sampler sees it: surface_emission times
+// the coverage there (0 where a MASK material is cut out, alpha x Le under BLEND).
 vec3 emission_at(std::span<const Image> images, const Material& m, const vec2 uv[2],
                  float vertex_alpha = 1.0f);
 

@@ -27,25 +27,38 @@ void check(RTCDevice device, const char* what) {
   if (err != RTC_ERROR_NONE) throw std::runtime_error(std::string("embree failed in ") + what);
 }
 
-// What the cut-out filter of one alphaMode MASK mesh reads.
-struct MaskedMesh {
+// What the filter of one alphaMode MASK or BLEND mesh reads.
+struct CoveredMesh {
   const Mesh* mesh;
   const Material* material;
   std::span<const Image> images;
 };
 
-// Embree's filter function for MASK meshes, on closest-hit and occlusion rays alike: a hit where
-// the alpha is below the cutoff is rejected, so camera rays, photons and shadow rays all pass
-// through the cut-out (Embree 3 "rtcSetGeometryIntersectFilterFunction"; u, v are the hit's
-// barycentrics of vertices 1 and 2).
-void cut_out_filter(const RTCFilterFunctionNArguments* args) {
-  const auto* m = static_cast<const MaskedMesh*>(args->geometryUserPtr);
+// Embree's context, extended by the ray's coverage key (Embree 3 "rtcInitIntersectContext": an
+// application may append its own data and read it back in its filter functions).
+struct KeyedContext {
+  RTCIntersectContext context;
+  uint64_t key;
+};
+
+// Embree's filter function for MASK and BLEND meshes, on closest-hit and occlusion rays alike:
+// a hit where the alpha is below the cutoff (MASK), or that the ray's key passes (BLEND,
+// stops_ray), is rejected, so camera rays, photons and shadow rays all pass the surface the
+// same way (Embree 3 "rtcSetGeometryIntersectFilterFunction"; u, v are the hit's barycentrics
+// of vertices 1 and 2).
+void coverage_filter(const RTCFilterFunctionNArguments* args) {
+  const auto* m = static_cast<const CoveredMesh*>(args->geometryUserPtr);
+  const uint64_t key = reinterpret_cast<const KeyedContext*>(args->context)->key;
+  if (m->material->blended() && key == 0) return;  // met: the caller weighs it
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
     const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
     const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
     const vec2 uv[2] = {mesh_uv(*m->mesh, prim, 0, u, v), mesh_uv(*m->mesh, prim, 1, u, v)};
-    if (cut_out(m->images, *m->material, uv, mesh_alpha(*m->mesh, prim, u, v))) args->valid[i] = 0;
+    const float a = coverage(m->images, *m->material, uv, mesh_alpha(*m->mesh, prim, u, v));
+    const unsigned geom = RTCHitN_geomID(args->hit, args->N, i);
+    const bool met = m->material->blended() ? stops_ray(key, geom, prim, a) : a > 0.0f;
+    if (!met) args->valid[i] = 0;
   }
 }
 
@@ -54,7 +67,7 @@ void cut_out_filter(const RTCFilterFunctionNArguments* args) {
 struct Accel::Impl {
   RTCDevice device = nullptr;
   RTCScene scene = nullptr;
-  std::vector<MaskedMesh> masked;  // sized up front: Embree keeps pointers into it
+  std::vector<CoveredMesh> covered;  // sized up front: Embree keeps pointers into it
 };
 
 Accel::Accel(const Scene& scene) : impl_(std::make_unique<Impl>()) {
@@ -66,7 +79,7 @@ Accel::Accel(const Scene& scene) : impl_(std::make_unique<Impl>()) {
   rtcSetDeviceErrorFunction(impl_->device, on_embree_error, nullptr);
   impl_->scene = rtcNewScene(impl_->device);
   rtcSetSceneBuildQuality(impl_->scene, RTC_BUILD_QUALITY_HIGH);
-  impl_->masked.reserve(scene.meshes.size());
+  impl_->covered.reserve(scene.meshes.size());
 
   for (size_t m = 0; m < scene.meshes.size(); ++m) {
     const Mesh& mesh = scene.meshes[m];
@@ -86,11 +99,11 @@ Accel::Accel(const Scene& scene) : impl_(std::make_unique<Impl>()) {
     }
     std::copy(mesh.indices.begin(), mesh.indices.end(), idx);
     const Material& mat = scene.materials[mesh.material];
-    if (mat.masked()) {
-      impl_->masked.push_back({&mesh, &mat, scene.images});
-      rtcSetGeometryUserData(geom, &impl_->masked.back());
-      rtcSetGeometryIntersectFilterFunction(geom, cut_out_filter);
-      rtcSetGeometryOccludedFilterFunction(geom, cut_out_filter);
+    if (mat.masked() || mat.blended()) {
+      impl_->covered.push_back({&mesh, &mat, scene.images});
+      rtcSetGeometryUserData(geom, &impl_->covered.back());
+      rtcSetGeometryIntersectFilterFunction(geom, coverage_filter);
+      rtcSetGeometryOccludedFilterFunction(geom, coverage_filter);
     }
     rtcCommitGeometry(geom);
     rtcAttachGeometryByID(impl_->scene, geom, unsigned(m));
@@ -105,9 +118,11 @@ Accel::~Accel() {
   if (impl_->device) rtcReleaseDevice(impl_->device);
 }
 
-bool Accel::intersect(const vec3& o, const vec3& d, float tnear, float tfar, Hit& hit) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+bool Accel::intersect(const vec3& o, const vec3& d, float tnear, float tfar, Hit& hit,
+                      uint64_t key) const {
+  KeyedContext context;
+  rtcInitIntersectContext(&context.context);
+  context.key = key;
   RTCRayHit rh;
   rh.ray.org_x = o.x;
   rh.ray.org_y = o.y;
@@ -123,7 +138,7 @@ bool Accel::intersect(const vec3& o, const vec3& d, float tnear, float tfar, Hit
   rh.ray.flags = 0;
   rh.hit.geomID = RTC_INVALID_GEOMETRY_ID;
   rh.hit.instID[0] = RTC_INVALID_GEOMETRY_ID;
-  rtcIntersect1(impl_->scene, &context, &rh);
+  rtcIntersect1(impl_->scene, &context.context, &rh);
   if (rh.hit.geomID == RTC_INVALID_GEOMETRY_ID) return false;
   hit.t = rh.ray.tfar;
   hit.mesh = rh.hit.geomID;
@@ -133,9 +148,10 @@ bool Accel::intersect(const vec3& o, const vec3& d, float tnear, float tfar, Hit
   return true;
 }
 
-bool Accel::occluded(const vec3& o, const vec3& d, float tnear, float tfar) const {
-  RTCIntersectContext context;
-  rtcInitIntersectContext(&context);
+bool Accel::occluded(const vec3& o, const vec3& d, float tnear, float tfar, uint64_t key) const {
+  KeyedContext context;
+  rtcInitIntersectContext(&context.context);
+  context.key = key;
   RTCRay ray;
   ray.org_x = o.x;
   ray.org_y = o.y;
@@ -149,7 +165,7 @@ bool Accel::occluded(const vec3& o, const vec3& d, float tnear, float tfar) cons
   ray.mask = 0xffffffffu;
   ray.id = 0;
   ray.flags = 0;
-  rtcOccluded1(impl_->scene, &context, &ray);
+  rtcOccluded1(impl_->scene, &context.context, &ray);
   // Embree sets tfar to -inf when the ray is occluded.
   return ray.tfar < 0.0f;
 }

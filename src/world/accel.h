@@ -3,6 +3,7 @@
 #pragma once
 
 #include "scene/scene.h"
+#include "util/rng.h"
 
 #include <cstdint>
 #include <memory>
@@ -17,6 +18,16 @@ struct Hit {
   float v = 0.0f;
 };
 
+// Whether the ray of key `key` stops at triangle `prim` of mesh `mesh`, a BLEND surface of
+// coverage a there: a uniform number u in [0, 1) hashed from the three, the surface met when
+// u < a (probability a, so 1 - a of the rays pass). One number per ray and triangle: Embree may
+// report a triangle twice (spatial splits), and both reports get the same answer; two rays of a
+// path (a reflection back through the same card) have independent keys.
+inline bool stops_ray(uint64_t key, uint32_t mesh, uint32_t prim, float a) {
+  const uint64_t h = mix64(key ^ mix64((uint64_t(mesh) << 32) | prim));
+  return float(h >> 40) * 0x1p-24f < a;
+}
+
 class Accel {
  public:
   // Builds a static Embree scene with one triangle geometry per mesh (geometry id = mesh index).
@@ -25,10 +36,15 @@ class Accel {
   Accel(const Accel&) = delete;
   Accel& operator=(const Accel&) = delete;
 
-  // Closest hit along origin + t dir for t in (tnear, tfar).
-  bool intersect(const vec3& origin, const vec3& dir, float tnear, float tfar, Hit& hit) const;
-  // True when anything lies along the segment (tnear, tfar).
-  bool occluded(const vec3& origin, const vec3& dir, float tnear, float tfar) const;
+  // Closest hit along origin + t dir for t in (tnear, tfar). MASK cut-outs are passed through.
+  // A BLEND surface (Material::blended) is met with its coverage a as probability: the ray's
+  // `key` (a random number of the work item's stream, World::ray_key) and the triangle decide,
+  // stops_ray below. Key 0 meets every BLEND surface, whose caller weighs it by a itself.
+  bool intersect(const vec3& origin, const vec3& dir, float tnear, float tfar, Hit& hit,
+                 uint64_t key = 0) const;
+  // True when anything lies along the segment (tnear, tfar); BLEND surfaces as above.
+  bool occluded(const vec3& origin, const vec3& dir, float tnear, float tfar,
+                uint64_t key = 0) const;
 
   // Calls visit(mesh, prim) for every triangle whose bounding box meets the sphere (a superset
   // of the triangles within `radius` of `center`; the caller tests the geometry itself).

@@ -47,10 +47,13 @@ void edge_key(const vec3& a, const vec3& b, uint32_t key[6]) {
   std::memcpy(key + 3, swap ? ka : kb, 12);
 }
 
-// Whether point q lies on a triangle of `world` facing like n, within `tol` of its plane.
-bool covered(const World& world, const vec3& q, const vec3& n, float tol, uint32_t self) {
+// Whether point q lies on a triangle of `world` facing like n, within `tol` of its plane; adds
+// the candidates examined to `work`.
+bool covered(const World& world, const vec3& q, const vec3& n, float tol, uint32_t self,
+             size_t& work) {
   bool found = false;
   world.accel().query_sphere(q, tol, [&](uint32_t mesh, uint32_t prim) {
+    ++work;
     const uint32_t t = world.triangle_index(mesh, prim);
     if (found || t == self) return;
     const vec3& m = world.face_normal(t);
@@ -70,8 +73,9 @@ bool covered(const World& world, const vec3& q, const vec3& n, float tol, uint32
 }
 
 // Sorted by their corners, so that the triangles sharing an edge are neighbours (ESTIMATOR.md
-// section 11, "Geometry").
-std::vector<EdgeRecord> sorted_edges(const World& world) {
+// section 11, "Geometry"). A later copy of a triangle (first_copy) has no edges of its own: it
+// would share every edge of the first and hide its borders.
+std::vector<EdgeRecord> sorted_edges(const World& world, const std::vector<uint32_t>& first_copy) {
   const uint32_t n = world.triangle_count();
   std::vector<EdgeRecord> edges(size_t(n) * 3);
   parallel_for(n, 4096, [&](size_t b, size_t e) {
@@ -86,6 +90,11 @@ std::vector<EdgeRecord> sorted_edges(const World& world) {
       }
     }
   });
+  if (!first_copy.empty())
+    edges.erase(
+        std::remove_if(edges.begin(), edges.end(),
+                       [&](const EdgeRecord& r) { return first_copy[r.triangle] != r.triangle; }),
+        edges.end());
   std::sort(edges.begin(), edges.end(), [](const EdgeRecord& x, const EdgeRecord& y) {
     if (key_less(x, y)) return true;
     if (key_less(y, x)) return false;
@@ -97,7 +106,8 @@ std::vector<EdgeRecord> sorted_edges(const World& world) {
 // Whether a coplanar triangle that does not share its corners continues triangle t across its
 // unshared edge (a, b), c being t's third corner (ESTIMATOR.md section 11, "Geometry"): probed
 // outward in t's plane, a thousandth of the edge's length away.
-bool continued_beyond(const World& world, uint32_t t, const vec3& a, const vec3& b, const vec3& c) {
+bool continued_beyond(const World& world, uint32_t t, const vec3& a, const vec3& b, const vec3& c,
+                      size_t& work) {
   const vec3& nt = world.face_normal(t);
   const vec3 along = b - a;
   vec3 out = glm::cross(along, nt);
@@ -106,9 +116,9 @@ bool continued_beyond(const World& world, uint32_t t, const vec3& a, const vec3&
   const float tol = 1e-3f * len + 1e-6f * max_component(glm::abs(a));
   if (!(len > 0.0f)) return false;
   out *= tol / glm::length(out);
-  return covered(world, a + 0.25f * along + out, nt, 2.0f * tol, t) &&
-         covered(world, a + 0.5f * along + out, nt, 2.0f * tol, t) &&
-         covered(world, a + 0.75f * along + out, nt, 2.0f * tol, t);
+  return covered(world, a + 0.25f * along + out, nt, 2.0f * tol, t, work) &&
+         covered(world, a + 0.5f * along + out, nt, 2.0f * tol, t, work) &&
+         covered(world, a + 0.75f * along + out, nt, 2.0f * tol, t, work);
 }
 
 // Where triangle w (centre and size: its bounding sphere) crosses the plane of host triangle t
@@ -154,21 +164,35 @@ struct BoundaryIndex::Cut {
   Segment s;
 };
 
+// Every phase counts the candidates its queries return (and the edges it compares) and stops
+// once the total passes the budget; the index is then given up. Triangles piled at one place
+// that are not exact copies (find_copies) would otherwise make each query return all of them.
+struct BoundaryIndex::Work {
+  std::atomic<size_t> done{0};
+  size_t budget = 0;
+  bool over() const { return done.load(std::memory_order_relaxed) > budget; }
+  void add(size_t k) { done.fetch_add(k, std::memory_order_relaxed); }
+};
+
 // ESTIMATOR.md section 11, "Geometry": the four phases below, then the lists' runs and centres.
-BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
+BoundaryIndex::BoundaryIndex(const World& world, float max_radius, size_t work_budget) {
   const uint32_t n = world.triangle_count();
+  Work work;
+  work.budget = work_budget + 256 * size_t(n);
   // Points (and so discs) exist only on surfaces that are not mirrors or glass.
-  std::vector<uint8_t> host(n);
-  for (uint32_t t = 0; t < n; ++t) host[t] = world.may_hold_points(world.material_of(t));
-  std::vector<Cut> cuts = boundary_edges(world, host);
+  const std::vector<uint8_t> host = find_copies(world);
+  std::vector<Cut> cuts = boundary_edges(world, host, first_copy_, work);
   // Every segment is listed at least for its own triangle (list_near), so more segments than the
   // pair budget there means the index is given up: counted by add_blockers, that is known before
   // a tightly packed assembly (a CAD engine of interpenetrating parts: 4.8M cuts at a preview's
   // radius, 0.9 GB) has listed them all.
   const size_t budget = kPairBudget + 16 * size_t(n);
-  truncated_ = add_blockers(world, host, max_radius, budget, cuts);
+  truncated_ = add_blockers(world, host, first_copy_, max_radius, budget, work, cuts);
   std::vector<std::pair<uint32_t, uint32_t>> pairs =
-      list_near(world, cuts, host, max_radius, budget);
+      list_near(world, cuts, host, max_radius, budget, work);
+  work_ = work.done.load();
+  if (debug_boundary())
+    std::fprintf(stderr, "boundary: %zu candidates examined, %zu copies\n", work_, coincident_);
   index_pairs(pairs, n);
   bound_runs(n);
   find_centres(world);
@@ -177,26 +201,31 @@ BoundaryIndex::BoundaryIndex(const World& world, float max_radius) {
 // Phases 1 and 2 (ESTIMATOR.md section 11, "Geometry"): edges with no neighbour on them whose
 // photons the gather would accept. An edge nobody shares may still continue into a coplanar
 // triangle that does not share its corners (a T-junction, or two meshes side by side).
-std::vector<BoundaryIndex::Cut> BoundaryIndex::boundary_edges(const World& world,
-                                                              const std::vector<uint8_t>& host) {
-  const std::vector<EdgeRecord> edges = sorted_edges(world);
+std::vector<BoundaryIndex::Cut> BoundaryIndex::boundary_edges(
+    const World& world, const std::vector<uint8_t>& host, const std::vector<uint32_t>& first_copy,
+    Work& work) {
+  const std::vector<EdgeRecord> edges = sorted_edges(world, first_copy);
   std::vector<Cut> found;
-  for (size_t i = 0; i < edges.size();) {
+  size_t examined = 0;
+  for (size_t i = 0; i < edges.size() && !work.over();) {
     size_t j = i + 1;
     while (j < edges.size() && !key_less(edges[i], edges[j])) ++j;
-    for (size_t k = i; k < j; ++k) {
+    for (size_t k = i; k < j && !work.over(); ++k) {
       const uint32_t t = edges[k].triangle;
       if (!host[t]) continue;
       const vec3& nt = world.face_normal(t);
       bool shared = false;
-      for (size_t q = i; q < j && !shared; ++q)
+      for (size_t q = i; q < j && !shared; ++q, ++examined)
         shared = edges[q].triangle != t && compatible(nt, world.face_normal(edges[q].triangle));
       vec3 v[3];
       world.triangle(t, v[0], v[1], v[2]);
       const int e = edges[k].edge;
       const vec3 a = v[e], b = v[(e + 1) % 3];
-      if (!shared && j - i == 1) shared = continued_beyond(world, t, a, b, v[(e + 2) % 3]);
+      if (!shared && j - i == 1)
+        shared = continued_beyond(world, t, a, b, v[(e + 2) % 3], examined);
       if (!shared) found.push_back({t, {a, b}});
+      work.add(examined);
+      examined = 0;
     }
     i = j;
   }
@@ -209,20 +238,24 @@ std::vector<BoundaryIndex::Cut> BoundaryIndex::boundary_edges(const World& world
 // t's reachable surface where it crosses. True when the cuts pass `budget` (the index is given
 // up, and `found` emptied).
 bool BoundaryIndex::add_blockers(const World& world, const std::vector<uint8_t>& host,
-                                 float max_radius, size_t budget, std::vector<Cut>& found) {
+                                 const std::vector<uint32_t>& first_copy, float max_radius,
+                                 size_t budget, Work& work, std::vector<Cut>& found) {
   const uint32_t n = world.triangle_count();
   std::atomic<size_t> cuts{found.size()};
   std::vector<std::vector<Cut>> blockers(n);
   parallel_for(n, 256, [&](size_t b, size_t e) {
     for (size_t uu = b; uu < e; ++uu) {
-      if (cuts.load(std::memory_order_relaxed) > budget) return;
+      if (cuts.load(std::memory_order_relaxed) > budget || work.over()) return;
       const uint32_t u = uint32_t(uu);
+      if (!first_copy.empty() && first_copy[u] != u) continue;  // its first copy's cuts are its
+      size_t examined = 0;
       vec3 w[3];
       world.triangle(u, w[0], w[1], w[2]);
       const vec3 centre = triangle_centre(w);
       const float reach = triangle_reach(w);
       const uint32_t mesh_of_u = world.mesh_of(u);
       world.accel().query_sphere(centre, reach, [&](uint32_t mesh, uint32_t prim) {
+        ++examined;
         const uint32_t t = world.triangle_index(mesh, prim);
         if (t == u || !host[t]) return;
         // Only other objects block: a surface folding through its own tangent planes (the
@@ -236,9 +269,10 @@ bool BoundaryIndex::add_blockers(const World& world, const std::vector<uint8_t>&
           blockers[uu].push_back({t, s});
       });
       cuts.fetch_add(blockers[uu].size(), std::memory_order_relaxed);
+      work.add(examined);
     }
   });
-  const bool truncated = cuts.load() > budget;
+  const bool truncated = cuts.load() > budget || work.over();
   if (truncated) {
     found.clear();
     blockers.clear();
@@ -262,7 +296,7 @@ bool BoundaryIndex::add_blockers(const World& world, const std::vector<uint8_t>&
 // (truncated()).
 std::vector<std::pair<uint32_t, uint32_t>> BoundaryIndex::list_near(
     const World& world, const std::vector<Cut>& found, const std::vector<uint8_t>& host,
-    float max_radius, size_t budget) {
+    float max_radius, size_t budget, Work& work) {
   segments_.resize(found.size());
   // The pairs of each run of kChunk segments (sorted below, so the runs' order does not matter):
   // one vector per run, not per segment, whose headers alone took 0.3 GB for 4.8M segments.
@@ -272,7 +306,7 @@ std::vector<std::pair<uint32_t, uint32_t>> BoundaryIndex::list_near(
   std::atomic<size_t> listed{0};
   parallel_for(chunks, 1, [&](size_t cb, size_t ce) {
     for (size_t i = cb * kChunk; i < std::min(ce * kChunk, found.size()); ++i) {
-      if (listed.load(std::memory_order_relaxed) > budget) return;
+      if (listed.load(std::memory_order_relaxed) > budget || work.over()) return;
       std::vector<std::pair<uint32_t, uint32_t>>& out = near[i / kChunk];
       const size_t before = out.size();
       const Cut& f = found[i];
@@ -281,7 +315,9 @@ std::vector<std::pair<uint32_t, uint32_t>> BoundaryIndex::list_near(
       s.mid = 0.5f * (s.a + s.b);
       s.half = 0.5f * glm::length(s.b - s.a);
       const vec3& nh = world.face_normal(f.triangle);
+      size_t examined = 0;
       world.accel().query_sphere(s.mid, s.half + max_radius, [&](uint32_t mesh, uint32_t prim) {
+        ++examined;
         const uint32_t t = world.triangle_index(mesh, prim);
         if (!host[t] || !compatible(world.face_normal(t), nh)) return;
         vec3 v[3];
@@ -291,9 +327,10 @@ std::vector<std::pair<uint32_t, uint32_t>> BoundaryIndex::list_near(
           out.emplace_back(t, uint32_t(i));
       });
       listed.fetch_add(out.size() - before, std::memory_order_relaxed);
+      work.add(examined);
     }
   });
-  truncated_ = truncated_ || listed.load() > budget;
+  truncated_ = truncated_ || listed.load() > budget || work.over();
   std::vector<std::pair<uint32_t, uint32_t>> pairs;
   for (auto& v : near) {
     if (!truncated_) pairs.insert(pairs.end(), v.begin(), v.end());
@@ -305,82 +342,6 @@ std::vector<std::pair<uint32_t, uint32_t>> BoundaryIndex::list_near(
   }
   if (debug_boundary()) std::fprintf(stderr, "boundary: %zu pairs\n", pairs.size());
   return pairs;
-}
-
-// The pairs as per-triangle lists, start_ and list_ (ESTIMATOR.md section 11, "Geometry").
-void BoundaryIndex::index_pairs(std::vector<std::pair<uint32_t, uint32_t>>& pairs, uint32_t n) {
-  // Sorted by (triangle, segment): the runs were concatenated in segment order, so a stable
-  // counting sort by triangle gives std::sort's order in O(pairs + triangles) (at a 4x4 preview,
-  // whose radius spans the scene, scenes/unlit.gltf lists 10.7M pairs: 1 s of std::sort).
-  {
-    std::vector<uint32_t> at(size_t(n) + 1, 0u);
-    for (const auto& pr : pairs) ++at[size_t(pr.first) + 1];
-    for (uint32_t t = 0; t < n; ++t) at[t + 1] += at[t];
-    std::vector<std::pair<uint32_t, uint32_t>> sorted(pairs.size());
-    for (const auto& pr : pairs) sorted[at[pr.first]++] = pr;
-    pairs.swap(sorted);
-  }
-  pairs.erase(std::unique(pairs.begin(), pairs.end()), pairs.end());
-  start_.assign(size_t(n) + 1, 0);
-  for (const auto& [t, s] : pairs) ++start_[t + 1];
-  for (uint32_t t = 0; t < n; ++t) start_[t + 1] += start_[t];
-  list_.resize(pairs.size());
-  for (size_t k = 0; k < pairs.size(); ++k) list_[k] = pairs[k].second;
-}
-
-// The lists' runs of kGroup and kGroup^2 entries with their bounding spheres (ESTIMATOR.md
-// section 11: a far point skips a run with one test).
-void BoundaryIndex::bound_runs(uint32_t n) {
-  for (int level = 0; level < 2; ++level) {
-    const uint32_t span = level == 0 ? kGroup : kGroup * kGroup;  // list entries per run
-    std::vector<uint32_t>& gs = group_start_[level];
-    gs.assign(size_t(n) + 1, 0);
-    for (uint32_t t = 0; t < n; ++t)
-      gs[t + 1] = gs[t] + (start_[t + 1] - start_[t] + span - 1) / span;
-    groups_[level].resize(gs[n]);
-    parallel_for(n, 4096, [&](size_t b, size_t e) {
-      for (size_t t = b; t < e; ++t) {
-        for (uint32_t g = gs[t]; g < gs[t + 1]; ++g) {
-          const uint32_t first = start_[t] + (g - gs[t]) * span;
-          const uint32_t last = std::min(first + span, start_[t + 1]);
-          Bounds box;
-          for (uint32_t k = first; k < last; ++k) {
-            box.extend(segments_[list_[k]].a);
-            box.extend(segments_[list_[k]].b);
-          }
-          const vec3 c = 0.5f * (box.lo + box.hi);
-          float radius = 0.0f;
-          for (uint32_t k = first; k < last; ++k) {
-            const Segment& sg = segments_[list_[k]];
-            radius = std::max(radius, glm::length(sg.mid - c) + sg.half);
-          }
-          groups_[level][g] = {c, radius};
-        }
-      }
-    });
-  }
-}
-
-// Centres of the triangles with segments, to tell which side of a segment through a point is
-// its surface (moments(); ESTIMATOR.md section 11).
-void BoundaryIndex::find_centres(const World& world) {
-  const uint32_t n = world.triangle_count();
-  centre_.assign(n, vec3(0.0f));
-  parallel_for(n, 4096, [&](size_t b, size_t e) {
-    for (size_t t = b; t < e; ++t) {
-      if (start_[t + 1] == start_[t]) continue;
-      vec3 v[3];
-      world.triangle(uint32_t(t), v[0], v[1], v[2]);
-      centre_[t] = triangle_centre(v);
-    }
-  });
-}
-
-size_t BoundaryIndex::memory_bytes() const {
-  return segments_.capacity() * sizeof(Segment) + start_.capacity() * sizeof(uint32_t) +
-         (group_start_[0].capacity() + group_start_[1].capacity()) * sizeof(uint32_t) +
-         (groups_[0].capacity() + groups_[1].capacity()) * sizeof(Group) +
-         list_.capacity() * sizeof(uint32_t) + centre_.capacity() * sizeof(vec3);
 }
 
 }  // namespace pb

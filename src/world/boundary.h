@@ -28,8 +28,9 @@ class World;
 class BoundaryIndex {
  public:
   BoundaryIndex() = default;
-  // Segments of `world` and, per triangle, those within max_radius of it.
-  BoundaryIndex(const World& world, float max_radius);
+  // Segments of `world` and, per triangle, those within max_radius of it. work_budget: see
+  // work() (a test gives a small one).
+  BoundaryIndex(const World& world, float max_radius, size_t work_budget = kWorkBudget);
 
   // The disc of radius r about p, a point of triangle `triangle` whose normal on the side it is
   // seen from is n. r must not exceed the index's max_radius.
@@ -42,9 +43,21 @@ class BoundaryIndex {
 
   size_t segment_count() const { return segments_.size(); }
   // The index was given up (more than kPairBudget + 16 per triangle segment-triangle pairs
-  // within the radius): every disc counts as whole.
+  // within the radius, or more than kWorkBudget + 256 per triangle candidates examined): every
+  // disc counts as whole.
   bool truncated() const { return truncated_; }
   static constexpr size_t kPairBudget = size_t(1) << 24;
+  static constexpr size_t kWorkBudget = size_t(1) << 26;
+  // The construction's work: candidate triangles the geometric queries returned and edges
+  // compared, what grows with the triangles piled at one place (ESTIMATOR.md section 11). Past
+  // the budget plus 256 per triangle the construction stops (each thread finishing the queries
+  // it is in: at most three, of at most a candidate per triangle each) and the index is given up.
+  // Measured: the shipped scenes and corpora examine at most 54 per triangle (cornell_heavy.glb at
+  // 512x512).
+  size_t work() const { return work_; }
+  // Triangles that repeat another's corners (bit for bit, same winding) are indexed once: how
+  // many triangles the index treats as copies of an earlier one.
+  size_t coincident_count() const { return coincident_; }
   size_t memory_bytes() const;
 
   // Directions of the polar quadrature.
@@ -78,17 +91,28 @@ class BoundaryIndex {
   template <class Skip, class Visit>
   void scan(uint32_t triangle, Skip&& skip, Visit&& visit) const;
   std::vector<vec3> centre_;  // of triangles with segments (zero elsewhere)
+  // Per triangle, the first triangle with the same corners (itself when none); empty when no
+  // triangle repeats another. Only those first ones are indexed; the queries look them up.
+  std::vector<uint32_t> first_copy_;
   bool truncated_ = false;
+  size_t work_ = 0;
+  size_t coincident_ = 0;
 
   // The constructor's phases (boundary.cpp), in order. A segment found for a host triangle:
   struct Cut;
-  static std::vector<Cut> boundary_edges(const World& world, const std::vector<uint8_t>& host);
-  static bool add_blockers(const World& world, const std::vector<uint8_t>& host, float max_radius,
-                           size_t budget, std::vector<Cut>& cuts);
+  struct Work;  // the work counted against kWorkBudget
+  // Which triangles may hold points (first copies only: 0 for a later copy) and first_copy_
+  // (boundary_copies.cpp).
+  std::vector<uint8_t> find_copies(const World& world);
+  static std::vector<Cut> boundary_edges(const World& world, const std::vector<uint8_t>& host,
+                                         const std::vector<uint32_t>& first_copy, Work& work);
+  static bool add_blockers(const World& world, const std::vector<uint8_t>& host,
+                           const std::vector<uint32_t>& first_copy, float max_radius, size_t budget,
+                           Work& work, std::vector<Cut>& cuts);
   std::vector<std::pair<uint32_t, uint32_t>> list_near(const World& world,
                                                        const std::vector<Cut>& cuts,
                                                        const std::vector<uint8_t>& host,
-                                                       float max_radius, size_t budget);
+                                                       float max_radius, size_t budget, Work& work);
   void index_pairs(std::vector<std::pair<uint32_t, uint32_t>>& pairs, uint32_t n);
   void bound_runs(uint32_t n);
   void find_centres(const World& world);

@@ -114,6 +114,7 @@ void BoundaryIndex::scan(uint32_t triangle, Skip&& skip, Visit&& visit) const {
 
 float BoundaryIndex::clearance(uint32_t triangle, const vec3& p, float r) const {
   if (start_.empty()) return r;
+  if (!first_copy_.empty()) triangle = first_copy_[triangle];  // copies share its list
   double nearest = double(r) * double(r);
   // A run whose bounding sphere is farther than the nearest segment so far holds none nearer
   // (with a 1e-4 relative margin for float rounding).
@@ -136,6 +137,7 @@ float BoundaryIndex::clearance(uint32_t triangle, const vec3& p, float r) const 
 DiscMoments BoundaryIndex::moments(uint32_t triangle, const vec3& p, const vec3& n, float r) const {
   DiscMoments m;
   if (start_.empty()) return m;
+  if (!first_copy_.empty()) triangle = first_copy_[triangle];
   // The segments within r of p, projected into p's tangent plane.
   Projected near;
   const double r2 = double(r) * double(r);

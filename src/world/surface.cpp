@@ -164,6 +164,14 @@ Surface World::surface(const Hit& hit) const {
   Surface s = geometry(mesh.positions, mesh.normals, mesh.face_normals[hit.prim], c);
   const Material& m = *mesh.material;
   s.material = &m;
+  if (m.unlit) {  // painted, black to light (docs/materials.md "Unlit")
+    for (int set = 0; set < 2; ++set)
+      if (mesh.texcoords[set]) s.uv[set] = c.at(mesh.texcoords[set]);
+    s.painted = m.base_color * vec3(lookup(scene_.images, m.base_color_texture, s.uv, true));
+    if (mesh.colors) s.painted *= vec3(c.at(mesh.colors));
+    s.bsdf = Bsdf(BsdfParams::of(Material::lambertian(vec3(0.0f))), s.ng, s.ns, mirror_roughness_);
+    return s;
+  }
   if (!mesh.textured) {
     BsdfParams p = BsdfParams::of(m);
     p.follows_transmission = follows_transmission_;

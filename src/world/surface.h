@@ -14,6 +14,9 @@ struct Surface {
   vec2 uv[2] = {vec2(0.0f), vec2(0.0f)};  // TEXCOORD_0/1 (0 without them or without textures)
   const Material* material = nullptr;
   Bsdf bsdf;  // the material's scattering here (textures and normal texture applied)
+  // KHR_materials_unlit: the radiance the camera sees here (base colour factor x texture x
+  // COLOR_0), the Bsdf then black; 0 on other materials.
+  vec3 painted{0.0f};
 };
 
 }  // namespace pb

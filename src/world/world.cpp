@@ -6,8 +6,15 @@
 
 namespace pb {
 
+namespace {
+Scene with_settled_blend(Scene scene) {
+  settle_blend(scene);
+  return scene;
+}
+}  // namespace
+
 World::World(Scene scene, float mirror_roughness, bool follows_transmission)
-    : scene_(std::move(scene)),
+    : scene_(with_settled_blend(std::move(scene))),
       accel_(scene_),
       lights_(scene_),
       scene_size_(std::max(scene_.bounds.diagonal(), 1e-30f)),
@@ -26,6 +33,7 @@ World::World(Scene scene, float mirror_roughness, bool follows_transmission)
       face_normals_[first + t] = glm::normalize(glm::cross(p1 - p0, p2 - p0));
     }
     const Material& mat = scene_.materials[m.material];
+    has_blend_ = has_blend_ || mat.blended();
     const bool textured =
         mat.base_color_texture.present() || mat.metallic_roughness_texture.present() ||
         mat.normal_texture.present() || mat.emissive_texture.present() ||
@@ -67,9 +75,12 @@ void World::triangle(uint32_t t, vec3& a, vec3& b, vec3& c) const {
   c = mv.positions[tri[2]];
 }
 
-bool World::camera_hit(const vec3& origin, const vec3& dir, Hit& hit, int* culled) const {
+bool World::camera_hit(const vec3& origin, const vec3& dir, Hit& hit, int* culled,
+                       uint64_t key) const {
   if (culled) *culled = 0;
-  if (!accel_.intersect(origin, dir, 0.0f, INFINITY, hit)) return false;
+  // One key for the whole line: a BLEND surface beyond a culled face gets the same choice when
+  // the ray goes on from that face.
+  if (!accel_.intersect(origin, dir, 0.0f, INFINITY, hit, key)) return false;
   for (int k = 0; k < kMaxCulledFaces; ++k) {
     const Material& m = *meshes_[hit.mesh].material;
     const uint32_t t = triangle_index(hit);
@@ -78,7 +89,7 @@ bool World::camera_hit(const vec3& origin, const vec3& dir, Hit& hit, int* culle
     // The back of a single-sided face: go on from just beyond it.
     const Surface s = surface(hit);
     if (culled) *culled = k + 1;
-    if (!trace(s.position, s.ng, s.error, dir, hit)) return false;
+    if (!trace(s.position, s.ng, s.error, dir, hit, key)) return false;
   }
   return true;
 }

@@ -6,6 +6,7 @@
 #include "scene/scene.h"
 #include "scene/texture.h"
 #include "util/ray_offset.h"
+#include "util/rng.h"
 #include "world/accel.h"
 #include "world/surface.h"
 
@@ -43,8 +44,9 @@ class World {
     // KHR_materials_clearcoat darkens the emission: 1 - k at the geometric normal, with
     // clearcoatFactor alone (Lights does the same for next-event samples and photons).
     const float coat = 1.0f - clearcoat_fresnel(m.clearcoat, glm::dot(wo, s.ng));
-    if (!m.emissive_texture.present() && !m.masked()) return coat * m.emission;
-    return coat * emission_at(scene_.images, m, s.uv);
+    // Where a ray met the surface it is there (MASK and BLEND: the coverage chose it).
+    if (!m.emissive_texture.present()) return coat * m.emission;
+    return coat * surface_emission(scene_.images, m, s.uv);
   }
 
   // Beer-Lambert transmittance exp(-sigma d) of the segment from `from` (the surface point it
@@ -81,9 +83,30 @@ class World {
     return offset_ray_origin(s.position, s.ng, s.error, dir);
   }
 
-  // Closest hit from surface point p (normal ng, error bound `error`) in direction dir.
-  bool trace(const vec3& p, const vec3& ng, float error, const vec3& dir, Hit& hit) const {
-    return accel_.intersect(spawn(p, ng, error, dir), dir, 0.0f, INFINITY, hit);
+  // Closest hit from surface point p (normal ng, error bound `error`) in direction dir; BLEND
+  // surfaces are met by the ray's key (Accel::intersect, ray_key).
+  bool trace(const vec3& p, const vec3& ng, float error, const vec3& dir, Hit& hit,
+             uint64_t key = 0) const {
+    return accel_.intersect(spawn(p, ng, error, dir), dir, 0.0f, INFINITY, hit, key);
+  }
+
+  // The coverage key of a ray that meets BLEND surfaces by chance (Accel::intersect): 64 bits of
+  // the work item's stream (pass, pixel or photon, and the bounce by the stream's position), so
+  // the choice depends on the work item, never on the thread. 0 (every BLEND surface met) in a
+  // scene without BLEND surfaces, which then draws no number: its images are unchanged.
+  uint64_t ray_key(Rng& rng) const {
+    if (!has_blend_) return 0;
+    const uint64_t hi = rng.next_u32(), lo = rng.next_u32();
+    return (hi << 32 | lo) | 1u;
+  }
+  // Whether some surface is BLEND (after settle_blend: its coverage is below 1 somewhere).
+  bool has_blend() const { return has_blend_; }
+  // The coverage of surface s at hit (texture.h coverage): 1 but on MASK and BLEND surfaces.
+  float coverage(const Hit& hit, const Surface& s) const {
+    const Material& m = *s.material;
+    if (!m.blended() && !m.masked()) return 1.0f;
+    return pb::coverage(scene_.images, m, s.uv,
+                        mesh_alpha(scene_.meshes[hit.mesh], hit.prim, hit.u, hit.v));
   }
   // The first surface a camera ray from `origin` sees. glTF culls the back faces of a material
   // that is not doubleSided ("back-face culling is enabled", glTF 2.0 section 3.9.5), so the
@@ -93,7 +116,8 @@ class World {
   // shadows and the surfaces seen through mirrors and glass meet both sides of every surface.
   // Returns the number of faces passed through in `culled` (at most kMaxCulledFaces; beyond,
   // the last one is what the ray sees).
-  bool camera_hit(const vec3& origin, const vec3& dir, Hit& hit, int* culled = nullptr) const;
+  bool camera_hit(const vec3& origin, const vec3& dir, Hit& hit, int* culled = nullptr,
+                  uint64_t key = 0) const;
   static constexpr int kMaxCulledFaces = 64;
 
   // Whether the camera at p is enclosed: in none of 256 directions spread over the sphere does
@@ -112,9 +136,11 @@ class World {
   // before the point at `dist`, less `margin`: the distance within which that point's own
   // surface may be found by rounding (DirectSample::margin; 0 for a point light, and dist is
   // infinite for directional and environment light).
-  bool occluded(const vec3& origin, const vec3& dir, float dist, float margin) const {
+  // A BLEND surface blocks it by the ray's key (ray_key; key 0: always).
+  bool occluded(const vec3& origin, const vec3& dir, float dist, float margin,
+                uint64_t key = 0) const {
     const float tfar = (dist - margin) * kShadowLengthFactor;
-    return tfar > 0.0f && accel_.occluded(origin, dir, 0.0f, tfar);
+    return tfar > 0.0f && accel_.occluded(origin, dir, 0.0f, tfar, key);
   }
 
   // Triangles by one global index (mesh after mesh, in Scene order), for the boundary index.
@@ -155,6 +181,7 @@ class World {
   float scene_size_;
   float mirror_roughness_;
   bool follows_transmission_;
+  bool has_blend_ = false;
 };
 
 }  // namespace pb

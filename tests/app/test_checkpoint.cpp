@@ -22,8 +22,6 @@
 #include <thread>
 #include <vector>
 
-extern char** environ;
-
 namespace pb {
 namespace {
 
@@ -225,42 +223,9 @@ TEST_F(Checkpoints, MismatchedSceneAndOptionsAreNamed) {
 
 // ---- The executable under signals -------------------------------------------------------
 
-pid_t spawn(const std::vector<std::string>& args) {
-  std::vector<char*> argv;
-  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
-  argv.push_back(nullptr);
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, 2, "/dev/null", O_WRONLY, 0);
-  pid_t pid = -1;
-  posix_spawn(&pid, PHOTONBOUND_EXE, &actions, nullptr, argv.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  return pid;
-}
-
-// Waits (at most 60 s) for a file to appear; false if it never does.
-bool wait_for(const std::string& file) {
-  for (int k = 0; k < 600; ++k) {
-    if (fs::exists(file)) return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(100));
-  }
-  return false;
-}
-
-// Waits until process pid catches `sig` (its handler is installed: the SigCgt mask of
-// /proc/PID/status), so that a signal sent then is the program's to handle, however slowly a
-// loaded machine starts it.
-bool wait_for_handler(pid_t pid, int sig) {
-  for (int k = 0; k < 600; ++k) {
-    std::ifstream status("/proc/" + std::to_string(pid) + "/status");
-    for (std::string line; std::getline(status, line);)
-      if (line.rfind("SigCgt:", 0) == 0 &&
-          (std::stoull(line.substr(7), nullptr, 16) >> (sig - 1)) & 1u)
-        return true;
-    std::this_thread::sleep_for(std::chrono::milliseconds(20));
-  }
-  return false;
-}
+using test::spawn;
+using test::wait_for;
+using test::wait_for_handler;
 
 std::string meta(const ExrImage& img, const std::string& key) {
   for (const auto& [k, v] : img.metadata)
@@ -327,6 +292,52 @@ TEST_F(Checkpoints, CtrlCWritesImageAndStateAndExitsZero) {
   EXPECT_EQ(meta(img, "stop_reason"), "interrupted");
   const SavedRender s = load_state(state);
   EXPECT_EQ(std::to_string(s.render.work.passes), meta(img, "passes_done"));
+}
+
+// Ctrl-C in the middle of a pass (passes of 400,000 photons, polled every 2,048): the pass is
+// discarded, and the image and state are those of the render stopped after its last whole pass,
+// bit for bit, as the state's own options render that many passes in this process. Where the
+// signal lands does not matter: every pass is either whole or absent.
+TEST_F(Checkpoints, CtrlCMidPassKeepsTheLastWholePass) {
+  const std::string out = path("m.exr"), state = path("m.pbstate");
+  const pid_t pid =
+      spawn({"photonbound", "render", test::scene_path("cornell.gltf"), "-o", out, "--passes",
+             "1000000", "--resolution", "24x24", "--photons-per-pass", "400000", "--quiet"});
+  ASSERT_GT(pid, 0);
+  ASSERT_TRUE(wait_for_handler(pid, SIGINT));
+  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
+  kill(pid, SIGINT);
+  int status = 0;
+  waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0);
+  const ExrImage img = read_exr(out);
+  EXPECT_EQ(meta(img, "stop_reason"), "interrupted");
+  const SavedRender s = load_state(state);
+  EXPECT_EQ(std::to_string(s.render.work.passes), meta(img, "passes_done"));
+  Renderer whole(load_gltf(s.options.scene), s.options);
+  for (uint64_t k = 0; k < s.render.work.passes; ++k) whole.step();
+  const RenderState w = whole.snapshot();
+  EXPECT_EQ(w.work.photons, s.render.work.photons);
+  EXPECT_EQ(w.work.rays, s.render.work.rays);
+  EXPECT_EQ(w.max_photon_power, s.render.max_photon_power);
+  EXPECT_EQ(w.visible, s.render.visible);
+  ASSERT_EQ(w.states.size(), s.render.states.size());
+  EXPECT_EQ(
+      std::memcmp(w.states.data(), s.render.states.data(), w.states.size() * sizeof(PointState)),
+      0);
+  // Channel by channel (the file keeps them in its own order), bit for bit.
+  const ExrImage mine = whole.image(RunInfo{});
+  ASSERT_EQ(mine.pixels.size(), img.pixels.size());
+  const size_t pixels = size_t(img.width) * size_t(img.height), nc = img.channels.size();
+  for (size_t c = 0; c < mine.channels.size(); ++c) {
+    const int at = img.channel_index(mine.channels[c]);
+    ASSERT_GE(at, 0) << mine.channels[c];
+    size_t differ = 0;
+    for (size_t p = 0; p < pixels; ++p)
+      differ += std::memcmp(&mine.pixels[p * nc + c], &img.pixels[p * nc + size_t(at)], 4) != 0;
+    EXPECT_EQ(differ, 0u) << mine.channels[c];
+  }
 }
 
 TEST_F(Checkpoints, SecondSignalLeavesAtOnceAndKeepsTheLastFiles) {

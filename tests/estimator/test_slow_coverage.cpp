@@ -64,7 +64,10 @@ struct PassPhotons {
   }
 };
 
-TEST(SlowCoverage, SyntheticDensityBoundsCoverNominalConfidence) {
+// Mean |error| after 16, 64 and 256 passes of one synthetic run.
+using CheckErrors = std::array<double, 3>;
+
+CheckErrors synthetic_coverage(bool adaptive_radius) {
   const int kTrials = 40;
   const int kSide = 16;  // 16 x 16 query points in [0.15, 0.85]^2 (kernels never reach the edge)
   const int kPasses = 256;
@@ -73,6 +76,7 @@ TEST(SlowCoverage, SyntheticDensityBoundsCoverNominalConfidence) {
   EstimatorParams params;
   params.alpha = 0.7;
   params.photons_per_pass = kMe;
+  params.adaptive_radius = adaptive_radius;
 
   std::vector<std::array<double, 2>> points;
   for (int a = 0; a < kSide; ++a)
@@ -193,6 +197,26 @@ TEST(SlowCoverage, SyntheticDensityBoundsCoverNominalConfidence) {
       EXPECT_GE(cov, confidences[ci] - 0.05)
           << "coverage after " << checks[k] << " passes at confidence " << confidences[ci];
     }
+  }
+  CheckErrors errors{};
+  for (int k = 0; k < 3; ++k) errors[k] = sum_err[k] / double(std::max(1L, total[k] - unknown[k]));
+  return errors;
+}
+
+// ESTIMATOR.md section 13: with each point's radius chosen by its own error model the bound
+// still covers (a radius fixed before each pass's photons keeps sections 3 and 4 whole). This
+// density is noise-dominated everywhere (bound / error 2.5 at 90%, as for pure noise), where the
+// schedule's radius is already at or below the optimum and the adaptive rule must leave it
+// alone: its error may not exceed the schedule's by more than issue 39's 5%. Both runs draw the
+// same photons (the Rng is keyed by pass and trial), so the comparison is paired. Measured with
+// the 3-sd slope threshold: ratios printed below; with no threshold (1 sd) they were 1.05-1.11.
+TEST(SlowCoverage, SyntheticDensityBoundsCoverWithAndWithoutAdaptiveRadius) {
+  const CheckErrors fixed = synthetic_coverage(false);
+  const CheckErrors adaptive = synthetic_coverage(true);
+  for (int k = 0; k < 3; ++k) {
+    std::printf("check %d: mean |error| PPM schedule %.5g, adaptive %.5g (ratio %.3f)\n", k,
+                fixed[k], adaptive[k], adaptive[k] / fixed[k]);
+    EXPECT_LT(adaptive[k], 1.05 * fixed[k]);
   }
 }
 

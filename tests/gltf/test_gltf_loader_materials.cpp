@@ -117,10 +117,23 @@ const std::vector<LoaderCase> kRows = {
                "extensions": {"KHR_materials_transmission": {"transmissionFactor": 1},
                               "KHR_materials_volume": {}}})"),
              [](const Scene&, const Material& m) { EXPECT_TRUE(m.thin); }),
-    material("BlendIsRenderedOpaque", {{"name", "blend"}, {"alphaMode", "BLEND"}},
+    // KHR_materials_unlit: painted (tests/render/test_render_unlit.cpp); its emission is one of
+    // the properties the extension says to ignore.
+    material("UnlitIsPaintedAndEmitsNothing",
+             json::parse(R"({"name": "baked", "emissiveFactor": [1, 1, 1],
+               "extensions": {"KHR_materials_unlit": {}}})"),
+             [](const Scene& s, const Material& m) {
+               EXPECT_TRUE(m.unlit);
+               EXPECT_FALSE(m.emits());
+               EXPECT_FALSE(has_warning(s, "baked"));
+             }),
+    material("WithoutTheExtensionAMaterialIsLit", {{"name", "lit"}},
+             [](const Scene&, const Material& m) { EXPECT_FALSE(m.unlit); }),
+    // BLEND is coverage (tests/render/test_render_blend.cpp), drawn without a word.
+    material("BlendIsReadWithoutAWarning", {{"name", "blend"}, {"alphaMode", "BLEND"}},
              [](const Scene& s, const Material& m) {
                EXPECT_EQ(m.alpha_mode, AlphaMode::Blend);
-               EXPECT_TRUE(has_warning(s, "material 'blend': alphaMode BLEND is rendered opaque"));
+               EXPECT_FALSE(has_warning(s, "material 'blend'"));
              }),
     {.name = "APrimitiveWithoutMaterialGetsTheDefault",
      .edit = [](Doc& d) { d.j["meshes"][0]["primitives"][0].erase("material"); },

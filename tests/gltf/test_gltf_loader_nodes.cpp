@@ -98,6 +98,76 @@ const std::vector<LoaderCase> kRows = {
            d.j["nodes"][0] = json{{"name", "flat"}, {"mesh", 0}, {"scale", {1, 1, 0}}};
          },
      .error = {"node 'flat' has a singular transform"}},
+    // Node matrices that are not TRS (glTF 2.0 "Transformations"; issue 36). A mirror given as a
+    // matrix (x and y swapped, determinant -1) maps the triangle onto itself with the opposite
+    // winding: the corners are swapped back, the front still faces +z.
+    {.name = "MatrixMirrorFlipsWinding",
+     .edit =
+         [](Doc& d) {
+           d.j["nodes"][0] =
+               json{{"mesh", 0}, {"matrix", {0, 1, 0, 0, 1, 0, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}};
+         },
+     .check =
+         [](const Scene& s) {
+           const Mesh& m = s.meshes[0];
+           EXPECT_EQ(m.indices, (std::vector<uint32_t>{0, 2, 1}));
+           expect_vec(m.positions[1], vec3(0, 1, 0));
+           expect_vec(face_normal(m, 0), vec3(0, 0, 1));
+           expect_vec(m.normals[0], vec3(0, 0, 1));
+           EXPECT_TRUE(s.warnings.empty());
+         }},
+    // Shear z' = z + x: (1,0,0) rises to (1,0,1), and the normal is the inverse transpose's,
+    // (-1,0,1)/sqrt2, the new plane's. Rendered as given, with a warning (glTF wants TRS).
+    {.name = "MatrixShearIsRenderedAsItsAffineMapWithAWarning",
+     .edit =
+         [](Doc& d) {
+           d.j["nodes"][0] = json{{"name", "skew"},
+                                  {"mesh", 0},
+                                  {"matrix", {1, 0, 1, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}};
+         },
+     .check =
+         [](const Scene& s) {
+           const Mesh& m = s.meshes[0];
+           expect_vec(m.positions[1], vec3(1, 0, 1));
+           expect_vec(m.normals[0], glm::normalize(vec3(-1, 0, 1)));
+           expect_vec(face_normal(m, 0), glm::normalize(vec3(-1, 0, 1)));
+           ASSERT_EQ(s.warnings.size(), 1u);
+           EXPECT_NE(s.warnings[0].find("node 'skew''s matrix shears"), std::string::npos)
+               << s.warnings[0];
+         }},
+    {.name = "MatrixSingular",
+     .edit =
+         [](Doc& d) {
+           d.j["nodes"][0] = json{{"name", "flat"},
+                                  {"mesh", 0},
+                                  {"matrix", {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 1}}};
+         },
+     .error = {"node 'flat' has a singular transform (determinant 0)"}},
+    {.name = "MatrixAllZero",
+     .edit =
+         [](Doc& d) {
+           d.j["nodes"][0] =
+               json{{"name", "gone"}, {"mesh", 0}, {"matrix", std::vector<int>(16, 0)}};
+         },
+     .error = {"node 'gone' has a matrix whose last row is (0, 0, 0, 0), not (0, 0, 0, 1)"}},
+    {.name = "MatrixProjective",
+     .edit =
+         [](Doc& d) {
+           d.j["nodes"][0] = json{{"name", "persp"},
+                                  {"mesh", 0},
+                                  {"matrix", {1, 0, 0, 0.5, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1}}};
+         },
+     .error = {"node 'persp' has a matrix whose last row is (0.5, 0, 0, 1), not (0, 0, 0, 1)"}},
+    // Finite matrices whose product is not: 1e150 x 1e150 overflows (the check squares each
+    // column: 1e150 alone passes).
+    {.name = "MatrixProductNotFinite",
+     .edit =
+         [](Doc& d) {
+           const json huge = {1e150, 0, 0, 0, 0, 1e150, 0, 0, 0, 0, 1e150, 0, 0, 0, 0, 1};
+           d.j["nodes"][0] = json{{"name", "outer"}, {"matrix", huge}, {"children", {3}}};
+           d.add("nodes", json{{"name", "inner"}, {"mesh", 0}, {"matrix", huge}});
+         },
+     .error = {"node 'inner' has a non-finite transform"}},
     {.name = "NodeCycle",
      .edit =
          [](Doc& d) {

@@ -1,5 +1,6 @@
 // The boundary index (boundary.h, ESTIMATOR.md section 11): the kernel's moments over the part of
 // a disc that lies on reachable surface, against brute-force integration over the disc.
+#include "boundary_scene.h"
 #include "estimator/kernel.h"
 #include "world/boundary.h"
 #include "world/world.h"
@@ -22,20 +23,8 @@ double lap_kappa(double t) { return 105.0 / kPi * (-3 * t + 8 * t * t - 5 * t * 
 
 // A floor [-1, 1]^2 at z = 0 facing +z, and a wall on its edge x = 1 facing back over it (-x):
 // the floor's other three edges are borders, x = 1 a 90-degree crease.
-// A scene of `meshes` with one material and a point light (World needs one; the moments ignore
-// it), its bounds those of the meshes.
 Scene scene_of(const char* source, std::vector<Mesh> meshes) {
-  Scene s;
-  s.source = source;
-  s.materials.emplace_back();
-  s.meshes = std::move(meshes);
-  PunctualLight light;
-  light.position = vec3(0, 0, 1);
-  light.intensity = vec3(1);
-  s.lights.push_back(light);
-  for (const Mesh& m : s.meshes)
-    for (const vec3& p : m.positions) s.bounds.extend(p);
-  return s;
+  return test::boundary_scene(source, std::move(meshes));
 }
 
 Scene floor_and_wall() {

@@ -24,6 +24,9 @@ double normal_cdf_one() { return 0.8413447460685429; }  // `bounds_study TABLE s
 RenderOptions study_options(const std::string& scene, int size, uint64_t passes) {
   RenderOptions o = test::quick_options(scene, size, passes);
   o.method = g_method;
+  // PB_STUDY_ADAPTIVE=radius: the tables with ESTIMATOR.md section 13's radius.
+  if (const char* a = std::getenv("PB_STUDY_ADAPTIVE"))
+    o.adaptive_radius = std::string(a) == "radius";
   return o;
 }
 

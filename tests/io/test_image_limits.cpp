@@ -1,0 +1,249 @@
+// Hostile and broken image files (issue 36): each is made here, at test time, a few bytes long,
+// and must be refused from what its header claims, before anything is allocated for its
+// texels, or from the decoder's own report, with one line naming the file.
+#include "io/image_io.h"
+
+#include <OpenImageIO/deepdata.h>
+#include <OpenImageIO/imageio.h>
+#include <gtest/gtest.h>
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+
+namespace pb {
+namespace {
+
+std::vector<unsigned char> file_bytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), {}};
+}
+
+// An 8-bit RGB PNG of w x h texels, as write_png writes it.
+std::vector<unsigned char> png(int w, int h) {
+  const std::filesystem::path p =
+      std::filesystem::temp_directory_path() / ("pb_limits_" + std::to_string(getpid()) + ".png");
+  std::vector<unsigned char> rgb(size_t(3 * w * h));
+  for (size_t k = 0; k < rgb.size(); ++k) rgb[k] = uint8_t(k * 37);
+  write_png(p.string(), w, h, rgb);
+  std::vector<unsigned char> bytes = file_bytes(p.string());
+  std::filesystem::remove(p);
+  return bytes;
+}
+
+// PNG's chunk CRC (ISO 3309, as the PNG specification's annex D computes it).
+uint32_t crc32(const unsigned char* d, size_t n) {
+  uint32_t c = 0xffffffffu;
+  for (size_t i = 0; i < n; ++i) {
+    c ^= d[i];
+    for (int k = 0; k < 8; ++k) c = (c >> 1) ^ (0xedb88320u & (0u - (c & 1u)));
+  }
+  return c ^ 0xffffffffu;
+}
+
+void put32(unsigned char* at, uint32_t v) {
+  for (int k = 0; k < 4; ++k) at[k] = uint8_t(v >> (24 - 8 * k));
+}
+
+// `bytes` (a PNG) with its IHDR rewritten to claim w x h texels of `depth` bits and `colour`
+// type (6: RGBA), its CRC made right: the image data stays that of the small image.
+std::vector<unsigned char> claiming(std::vector<unsigned char> bytes, uint32_t w, uint32_t h,
+                                    uint8_t depth, uint8_t colour) {
+  unsigned char* ihdr = bytes.data() + 8;  // length, "IHDR", 13 bytes of data, CRC
+  EXPECT_EQ(std::memcmp(ihdr + 4, "IHDR", 4), 0);
+  put32(ihdr + 8, w);
+  put32(ihdr + 12, h);
+  ihdr[16] = depth;
+  ihdr[17] = colour;
+  put32(ihdr + 21, crc32(ihdr + 4, 17));
+  return bytes;
+}
+
+long peak_rss_kib() {
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_maxrss;
+}
+
+std::string decode_error(const std::vector<unsigned char>& bytes, const std::string& name,
+                         uint64_t max_bytes = UINT64_MAX) {
+  try {
+    decode_image(bytes.data(), bytes.size(), name, max_bytes);
+  } catch (const ImageError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind(name + ": ", 0), 0u) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    return m;
+  }
+  ADD_FAILURE() << name << " was decoded";
+  return "";
+}
+
+TEST(ImageLimits, APngClaimingMoreTexelsThanItsBytesHoldIsRefusedFromItsHeader) {
+  // 16384 x 16384 RGBA at 16 bits in under 100 bytes: 2 GiB of rows that deflate (at most
+  // 1032:1) cannot make from them. Decoding it allocated 4 GiB of floats before libpng found
+  // the data short; the refusal comes from the header, so this process stays far below that.
+  const std::vector<unsigned char> bomb = claiming(png(2, 2), 16384, 16384, 16, 6);
+  ASSERT_LT(bomb.size(), 100u);
+  const std::string m = decode_error(bomb, "bomb.png");
+  EXPECT_NE(m.find("claims 16384x16384 with 4 channels"), std::string::npos) << m;
+  EXPECT_NE(m.find("more than its " + std::to_string(bomb.size()) + " bytes can hold"),
+            std::string::npos)
+      << m;
+  EXPECT_LT(peak_rss_kib(), 1L << 20);  // 1 GiB: the bomb's texels alone are 4
+}
+
+TEST(ImageLimits, APngWhoseHeaderItsBytesCanHoldIsDecoded) {
+  // The bound is deflate's, not a guess: a flat 1024 x 1024 image compresses about 1000:1 and
+  // is still read.
+  const std::filesystem::path p =
+      std::filesystem::temp_directory_path() / ("pb_flat_" + std::to_string(getpid()) + ".png");
+  write_png(p.string(), 1024, 1024, std::vector<unsigned char>(3 * 1024 * 1024, 9));
+  const std::vector<unsigned char> flat = file_bytes(p.string());
+  std::filesystem::remove(p);
+  EXPECT_LT(flat.size(), 3u * 1024 * 1024 / 200);  // compressed past 200:1
+  const Image im = decode_image(flat.data(), flat.size(), "flat.png");
+  EXPECT_EQ(im.width, 1024);
+  EXPECT_EQ(im.u8[3 * 1024 * 1024 - 1], 9);
+}
+
+TEST(ImageLimits, AnImageOverTheBytesLeftIsRefusedBeforeDecoding) {
+  // 64 x 64 RGB at 8 bits: 12288 bytes decoded. One byte less is refused, with the size.
+  const std::vector<unsigned char> bytes = png(64, 64);
+  EXPECT_EQ(image_bytes(decode_image(bytes.data(), bytes.size(), "a.png", 12288)), 12288u);
+  try {
+    decode_image(bytes.data(), bytes.size(), "a.png", 12287);
+    ADD_FAILURE() << "decoded over the budget";
+  } catch (const ImageTooLarge& e) {
+    EXPECT_EQ(e.bytes, 12288u);
+    EXPECT_NE(std::string(e.what()).find("64x64 with 3 channels, 12 KiB decoded"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(ImageLimits, ATruncatedJpegIsRefusedNotFilledWithGrey) {
+  // libjpeg fills the rows it could not read with grey and only warns; OpenImageIO's reader then
+  // returns success with the warning recorded (has_error). Cut before its end-of-image marker,
+  // tests/data/textures/solid_200_100_50.jpg must be refused, naming the file.
+  std::vector<unsigned char> bytes =
+      file_bytes(std::string(PHOTONBOUND_TEST_DATA) + "/textures/solid_200_100_50.jpg");
+  ASSERT_GT(bytes.size(), 100u);
+  EXPECT_NO_THROW(decode_image(bytes.data(), bytes.size(), "whole.jpg"));
+  bytes.resize(bytes.size() - 8);
+  const std::string m = decode_error(bytes, "cut.jpg");
+  EXPECT_NE(m.find("cut.jpg: cannot decode the image: "), std::string::npos) << m;
+  EXPECT_NE(m.find("Premature end of JPEG file"), std::string::npos) << m;
+  EXPECT_EQ(m.find("image.jpg"), std::string::npos) << m;  // not the reader's made-up name
+}
+
+// A ZIP-compressed EXR of one pixel and `channels` channels whose header then claims w x h:
+// its data and display windows rewritten, and its offset table (one entry per 16 rows for
+// ZIP) grown to match, every entry pointing at the one chunk. A few KiB that claim gigabytes.
+std::string exr_claiming(const std::string& path, int w, int h, int channels) {
+  ExrImage one;
+  one.width = one.height = 1;
+  for (int c = 0; c < channels; ++c) one.channels.push_back("C" + std::to_string(c));
+  one.pixels.assign(size_t(channels), 0.5f);
+  write_exr(path, one, ExrCompression::Zip);
+  std::vector<unsigned char> d = file_bytes(path);
+  for (const std::string key : {"dataWindow", "displayWindow"}) {
+    const std::string attr = key + '\0' + "box2i" + '\0';
+    const auto at = std::search(d.begin(), d.end(), attr.begin(), attr.end());
+    EXPECT_NE(at, d.end());
+    const int32_t box[4] = {0, 0, w - 1, h - 1};
+    std::memcpy(&*(at + std::ptrdiff_t(attr.size() + 4)), box, sizeof box);
+  }
+  size_t table = 0;  // the one offset, which points just past itself
+  for (size_t i = 0; i + 8 < d.size() && !table; ++i) {
+    int64_t v;
+    std::memcpy(&v, &d[i], 8);
+    if (v == int64_t(i + 8)) table = i;
+  }
+  EXPECT_GT(table, 0u);
+  const size_t chunks = size_t(h + 15) / 16;
+  std::vector<unsigned char> out(d.begin(), d.begin() + std::ptrdiff_t(table));
+  const int64_t chunk = int64_t(table + 8 * chunks);
+  for (size_t k = 0; k < chunks; ++k)
+    out.insert(out.end(), reinterpret_cast<const unsigned char*>(&chunk),
+               reinterpret_cast<const unsigned char*>(&chunk) + 8);
+  out.insert(out.end(), d.begin() + std::ptrdiff_t(table + 8), d.end());
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(out.data()), std::streamsize(out.size()));
+  return path;
+}
+
+std::string temp(const std::string& name) {
+  return (std::filesystem::temp_directory_path() /
+          ("pb_limits_" + std::to_string(getpid()) + "_" + name))
+      .string();
+}
+
+template <class Read>
+std::string read_error(const std::string& path, Read read) {
+  try {
+    read();
+  } catch (const ImageError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.rfind(path + ": ", 0), 0u) << m;
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    return m;
+  }
+  ADD_FAILURE() << path << " was read";
+  return "";
+}
+
+TEST(ImageLimits, AnExrClaimingGigabytesIsRefusedFromItsHeader) {
+  // 16384 x 16384 x 20 channels: 20 GiB as floats. compare, preview and --reference allocated
+  // it and then found the file short (20.6 GB peak, 88 s). Past the limit it is refused from
+  // the header; within it, its ZIP chunks cannot hold what it claims (deflate: 1032:1).
+  const std::string path = exr_claiming(temp("claims.exr"), 16384, 16384, 20);
+  ASSERT_LT(std::filesystem::file_size(path), 20000u);
+  std::string m = read_error(path, [&] { read_exr(path, {uint64_t(1) << 30, "the test's"}); });
+  EXPECT_NE(m.find("claims 16384x16384 pixels of 20 channels, 20 GiB as floats, over the 1.0 "
+                   "GiB of the test's"),
+            std::string::npos)
+      << m;
+  m = read_error(path, [&] { read_exr(path); });
+  EXPECT_NE(m.find("bytes can hold"), std::string::npos) << m;
+  m = read_error(path, [&] { read_rgb_image(path); });  // --environment's reader
+  EXPECT_NE(m.find("bytes can hold"), std::string::npos) << m;
+  std::filesystem::remove(path);
+  EXPECT_LT(peak_rss_kib(), 1L << 20);  // 1 GiB
+}
+
+TEST(ImageLimits, AnExrWithinItsLimitIsReadAndOneByteLessIsNot) {
+  const std::string path = exr_claiming(temp("small.exr"), 1, 1, 4);  // 16 bytes as floats
+  EXPECT_EQ(read_exr(path, {16, "x"}).pixels.size(), 4u);
+  EXPECT_EQ(read_rgb_image(path, {16, "x"}).rgb.size(), 3u);
+  const std::string m = read_error(path, [&] { read_exr(path, {15, "x"}); });
+  EXPECT_NE(m.find("16 bytes as floats, over the 15 bytes of x"), std::string::npos) << m;
+  std::filesystem::remove(path);
+}
+
+TEST(ImageLimits, ADeepExrIsRefusedWithAMessage) {
+  // Deep images (several samples per pixel) have no flat pixels to read; OpenImageIO's own
+  // message was "called OpenEXRInput::read_native_scanlines without an open file".
+  const std::string path = temp("deep.exr");
+  OIIO::ImageSpec spec(4, 4, 1, OIIO::TypeDesc::FLOAT);
+  spec.channelnames = {"Z"};
+  spec.deep = true;
+  auto out = OIIO::ImageOutput::create(path);
+  ASSERT_TRUE(out && out->open(path, spec));
+  OIIO::DeepData deep(spec);
+  for (int p = 0; p < 16; ++p) deep.set_samples(p, 1);
+  ASSERT_TRUE(out->write_deep_image(deep));
+  out->close();
+  const std::string m = read_error(path, [&] { read_exr(path); });
+  EXPECT_NE(m.find("is a deep image (several samples per pixel), which photonbound does not read"),
+            std::string::npos)
+      << m;
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace pb
