@@ -76,6 +76,29 @@ struct SceneBuilder {
     add(std::move(m));
   }
 
+  // Closed cylinder along y (centre c, radius r, length 2 h) of `slices` flat sides and two
+  // flat caps, outward winding, flat shaded: a convex polyhedron, like sphere().
+  void tube(const vec3& c, float r, float h, int slices, uint32_t mat) {
+    Mesh m;
+    m.name = "tube";
+    for (int j = 0; j < slices; ++j) {
+      const float ph = 2.0f * kPi * float(j) / float(slices);
+      const vec3 rim = c + r * vec3(std::cos(ph), 0, std::sin(ph));
+      m.positions.push_back(rim + vec3(0, h, 0));
+      m.positions.push_back(rim - vec3(0, h, 0));
+    }
+    const uint32_t top = uint32_t(m.positions.size()), bottom = top + 1;
+    m.positions.push_back(c + vec3(0, h, 0));
+    m.positions.push_back(c - vec3(0, h, 0));
+    for (int j = 0; j < slices; ++j) {
+      const uint32_t a = uint32_t(2 * j), b = a + 1, d = uint32_t(2 * ((j + 1) % slices)),
+                     e = d + 1;
+      m.indices.insert(m.indices.end(), {a, d, b, d, e, b, top, d, a, bottom, b, e});
+    }
+    m.material = mat;
+    add(std::move(m));
+  }
+
   void point_light(const vec3& position, const vec3& intensity) {
     PunctualLight l;
     l.name = "point";

@@ -2,7 +2,9 @@
 
 #include "estimator/channels.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <sstream>
 
 namespace pb {
@@ -116,6 +118,41 @@ std::string to_text(const CompareResult& r) {
     << "bias-dominated pixels   " << r.bias_dominated << "\n"
     << "exact / unknown         " << r.exact << " / " << r.unknown << " pixel-channels\n";
   return s.str();
+}
+
+std::optional<std::string> exposure_warning(std::vector<float> levels, double exposure,
+                                            const std::string& image) {
+  std::erase_if(levels, [](float v) { return !std::isfinite(v); });
+  if (levels.empty()) return std::nullopt;
+  const double scale = std::exp2(exposure);
+  auto quantile = [&](double q) {
+    const size_t k = std::min(levels.size() - 1, size_t(q * double(levels.size())));
+    std::nth_element(levels.begin(), levels.begin() + std::ptrdiff_t(k), levels.end());
+    return double(levels[k]);
+  };
+  const size_t white = size_t(std::count_if(levels.begin(), levels.end(),
+                                            [&](float v) { return double(v) * scale > 1.0; }));
+  const double share = double(white) / double(levels.size());
+  const double p99 = quantile(0.99), p90 = quantile(0.90);
+  char what[160];
+  if (share >= 0.1) {
+    std::snprintf(what, sizeof what, "%.0f%% of the pixels are white", 100.0 * share);
+  } else if (p99 * scale < 0.003) {
+    std::snprintf(what, sizeof what, "99%% of the pixels are black (below %.3g)", 0.003 / scale);
+  } else {
+    return std::nullopt;
+  }
+  std::ostringstream line;
+  line << "photonbound: warning: preview of " << image << ": " << what << " at --exposure "
+       << exposure;
+  if (p90 > 0.0) {
+    // Half-stops: the 90th percentile at 0.5 (sRGB 188/255).
+    const double advice = std::round(2.0 * std::log2(0.5 / p90)) / 2.0;
+    line << "; --exposure " << advice << " shows them";
+  } else {
+    line << "; 90% of the pixels are 0, which no exposure shows";
+  }
+  return line.str();
 }
 
 }  // namespace pb

@@ -5,7 +5,9 @@
 #include "io/image_io.h"
 
 #include <cstdint>
+#include <optional>
 #include <string>
+#include <vector>
 
 namespace pb {
 
@@ -28,6 +30,14 @@ struct CompareResult {
 // Throws ImageError when the sizes differ or a needed channel is missing.
 CompareResult compare_images(const ExrImage& render, const ExrImage& reference,
                              const std::string& render_name, const std::string& reference_name);
+
+// preview's word on a picture that shows nothing (docs/usage.md "preview"): given each pixel's
+// largest radiance channel and the exposure, a one-line warning when at least 10% of the pixels
+// clip to white (above 1), or when 99% of them are darker than 1% grey (0.003 linear, sRGB 11/255),
+// with the --exposure that puts the 90th percentile at 0.5; nothing when the picture shows
+// something.
+std::optional<std::string> exposure_warning(std::vector<float> levels, double exposure,
+                                            const std::string& image);
 
 std::string to_json(const CompareResult& r);
 std::string to_text(const CompareResult& r);

@@ -266,8 +266,11 @@ int preview(const pb::PreviewOptions& o) {
   const double scale = std::exp2(o.exposure);
   const size_t pixels = size_t(in.width) * size_t(in.height), nc = in.channels.size();
   std::vector<unsigned char> rgb(3 * pixels);
+  std::vector<float> levels(pixels);
   for (size_t p = 0; p < pixels; ++p) {
     const int src[3] = {r, g, b};
+    levels[p] = std::max({in.pixels[p * nc + size_t(r)], in.pixels[p * nc + size_t(g)],
+                          in.pixels[p * nc + size_t(b)]});
     for (int c = 0; c < 3; ++c) {
       double v = std::clamp(double(in.pixels[p * nc + size_t(src[c])]) * scale, 0.0, 1.0);
       if (!(v == v)) v = 0.0;
@@ -276,6 +279,8 @@ int preview(const pb::PreviewOptions& o) {
     }
   }
   pb::write_png(o.output, in.width, in.height, rgb);
+  if (const auto w = pb::exposure_warning(std::move(levels), o.exposure, o.input))
+    std::cerr << *w << "\n";
   return 0;
 }
 

@@ -8,6 +8,7 @@
 #include "estimator/kernel.h"
 
 #include <algorithm>
+#include <cmath>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -59,6 +60,12 @@ void gather_kernel(const VisiblePoint& point, double r2, const HashGrid& grid,
                    const std::vector<PhotonHit>& hits, PhotonFlux&& photon_flux, PassSums& out) {
   const float radius = search_radius(r2);
   const double inv_r2 = 1.0 / r2;
+  // How far a photon may lie behind the point's tangent plane, facing it, and still count: far
+  // above the rounding of positions (the point is lifted off its surface by ~1e-7 of its
+  // coordinates, so a photon on the same flat surface is "behind" it by that much).
+  const vec3 p = point.position;
+  const float behind_tol =
+      1e-3f * radius + 1e-5f * std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
   dvec3 phi(0.0), lap(0.0), half(0.0);
   uint64_t count = 0;
   grid.query(point.position, radius, [&](uint32_t k, float dist2) {
@@ -67,6 +74,13 @@ void gather_kernel(const VisiblePoint& point, double r2, const HashGrid& grid,
     // point is seen from, on a surface facing the same way (not the back of a thin wall).
     const float cos_g = glm::dot(h.wi, point.normal);
     if (cos_g <= 0.0f || glm::dot(h.normal, point.normal) <= 0.0f) return;
+    // Nor across the point's own surface: a photon behind the point's tangent plane on a
+    // surface that faces the point lies on the far side of a sheet the point is on (the inner
+    // wall of a thin closed shell, the room under a floor), where no light from it can reach.
+    // On one smooth surface the two never hold together (convex: the point is behind the
+    // photon's plane; concave: the photon is in front of the point's).
+    const vec3 d = h.position - p;
+    if (glm::dot(d, point.normal) < -behind_tol && glm::dot(d, h.normal) < -behind_tol) return;
     const float cos_s = glm::dot(h.wi, point.shading);
     ++count;  // it could contribute, so it counts toward the radius reduction
     if (cos_s <= 0.0f) return;

@@ -103,5 +103,36 @@ TEST(ImageIo, UnreadableFileIsAnError) {
   EXPECT_THROW(read_exr("/nonexistent/photonbound.exr"), ImageError);
 }
 
+// preview's exposure warning: a sun-lit render in lux (values 1e3-1e4) is white at exposure 0 and
+// the advice puts its 90th percentile at 0.5; a picture a millionth as bright is black; a normal
+// one, or a sky of exactly 1 (white by design, not clipped), gets no word.
+TEST(ExposureWarning, NamesTheExposureThatShowsAWhiteOrBlackPicture) {
+  std::vector<float> sun(1000);
+  for (size_t k = 0; k < sun.size(); ++k) sun[k] = 1000.0f + 9.0f * float(k);  // 1e3 .. 1e4
+  const auto white = exposure_warning(sun, 0.0, "sun.exr");
+  ASSERT_TRUE(white.has_value());
+  // p90 = 1000 + 9 * 900 = 9100: log2(0.5 / 9100) = -14.15, to the half stop -14.
+  EXPECT_EQ(*white,
+            "photonbound: warning: preview of sun.exr: 100% of the pixels are white at "
+            "--exposure 0; --exposure -14 shows them");
+  EXPECT_FALSE(exposure_warning(sun, -14.0, "sun.exr").has_value());
+
+  std::vector<float> dark(sun);
+  for (float& v : dark) v *= 1e-7f;  // 1e-4 .. 1e-3
+  const auto black = exposure_warning(dark, 0.0, "dark.exr");
+  ASSERT_TRUE(black.has_value());
+  EXPECT_NE(black->find("99% of the pixels are black"), std::string::npos) << *black;
+  EXPECT_NE(black->find("--exposure 9 shows them"), std::string::npos)
+      << *black;  // log2(0.5 / 9.1e-4) = 9.1
+
+  std::vector<float> sky(1000, 1.0f);  // a sky of radiance 1
+  for (size_t k = 0; k < 300; ++k) sky[k] = 0.05f + 0.002f * float(k);
+  EXPECT_FALSE(exposure_warning(sky, 0.0, "sky.exr").has_value());
+  EXPECT_FALSE(exposure_warning(std::vector<float>(10, 0.0f), 0.0, "zero.exr")
+                   .value_or("")
+                   .empty());  // all 0: black, and no exposure shows it
+  EXPECT_FALSE(exposure_warning({}, 0.0, "empty.exr").has_value());
+}
+
 }  // namespace
 }  // namespace pb
