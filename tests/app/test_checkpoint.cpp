@@ -277,17 +277,22 @@ TEST_F(Checkpoints, KillNineLeavesLoadableFiles) {
   }
 }
 
-TEST_F(Checkpoints, CtrlCWritesImageAndStateAndExitsZero) {
-  const std::string out = path("i.exr"), state = path("i.pbstate");
-  const pid_t pid = spawn(long_render(out, 0.0));
+// Sends SIGINT `ms` after the render has installed its handler; the render must exit 0.
+void interrupt_and_expect_exit_zero(pid_t pid, int ms) {
   ASSERT_GT(pid, 0);
   ASSERT_TRUE(wait_for_handler(pid, SIGINT));
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  std::this_thread::sleep_for(std::chrono::milliseconds(ms));
   kill(pid, SIGINT);
   int status = 0;
   waitpid(pid, &status, 0);
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 0);
+}
+
+TEST_F(Checkpoints, CtrlCWritesImageAndStateAndExitsZero) {
+  const std::string out = path("i.exr"), state = path("i.pbstate");
+  const pid_t pid = spawn(long_render(out, 0.0));
+  ASSERT_NO_FATAL_FAILURE(interrupt_and_expect_exit_zero(pid, 1500));
   const ExrImage img = read_exr(out);
   EXPECT_EQ(meta(img, "stop_reason"), "interrupted");
   const SavedRender s = load_state(state);
@@ -303,14 +308,7 @@ TEST_F(Checkpoints, CtrlCMidPassKeepsTheLastWholePass) {
   const pid_t pid =
       spawn({"photonbound", "render", test::scene_path("cornell.gltf"), "-o", out, "--passes",
              "1000000", "--resolution", "24x24", "--photons-per-pass", "400000", "--quiet"});
-  ASSERT_GT(pid, 0);
-  ASSERT_TRUE(wait_for_handler(pid, SIGINT));
-  std::this_thread::sleep_for(std::chrono::milliseconds(2500));
-  kill(pid, SIGINT);
-  int status = 0;
-  waitpid(pid, &status, 0);
-  ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 0);
+  ASSERT_NO_FATAL_FAILURE(interrupt_and_expect_exit_zero(pid, 2500));
   const ExrImage img = read_exr(out);
   EXPECT_EQ(meta(img, "stop_reason"), "interrupted");
   const SavedRender s = load_state(state);

@@ -6,12 +6,28 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+#include <optional>
 
 namespace pb {
 namespace {
 
 using test::SceneBuilder;
+
+FilmImage render(Scene scene, Method method, DirectMode direct, int size, uint64_t photons,
+                 int passes, std::optional<double> radius = std::nullopt) {
+  RenderOptions o;
+  o.method = method;
+  o.direct = direct;
+  o.width = o.height = size;
+  o.radius = radius;
+  o.photons_per_pass = photons;
+  o.progress = ProgressMode::Never;
+  Renderer r(std::move(scene), o);
+  for (int pass = 0; pass < passes; ++pass) r.step();
+  FilmImage img;
+  r.develop(&img);
+  return img;
+}
 
 // A closed double-sided emissive tube (radius 0.02, length 1, 16 sides, base colour
 // (1, 0, 0.733), emission (1, 0.305, 1): issue 37's neon tube) alone in the dark, seen from
@@ -33,17 +49,8 @@ TEST(ThinRender, AClosedEmissiveTubeShowsItsEmissionAndNoMore) {
   const vec3 emitted(1.0f, 0.305f, 1.0f);
   for (Method method : {Method::PPM, Method::SPPM})
     for (DirectMode direct : {DirectMode::NextEvent, DirectMode::Photons}) {
-      RenderOptions o;
-      o.method = method;
-      o.direct = direct;
-      o.width = o.height = 24;  // the tube is about 2.6 pixels wide, the disc 3.3 in radius
-      o.radius = 0.05f;
-      o.photons_per_pass = 20000;
-      o.progress = ProgressMode::Never;
-      Renderer r(neon_tube(), o);
-      for (int pass = 0; pass < 4; ++pass) r.step();
-      FilmImage img;
-      r.develop(&img);
+      // The tube is about 2.6 pixels wide, the disc 3.3 in radius.
+      const FilmImage img = render(neon_tube(), method, direct, 24, 20000, 4, 0.05);
       float most = 0.0f;
       for (size_t k = 0; k < img.radiance.size(); k += 3) {
         for (int c = 0; c < 3; ++c) {
@@ -84,16 +91,7 @@ TEST(ThinRender, ThinSlatTopsUnderTheSkyShowTheSkyAndNotTheGroundBelow) {
   constexpr int kSize = 48;
   for (Method method : {Method::PPM, Method::SPPM})
     for (DirectMode direct : {DirectMode::NextEvent, DirectMode::Photons}) {
-      RenderOptions o;
-      o.method = method;
-      o.direct = direct;
-      o.width = o.height = kSize;
-      o.photons_per_pass = 50000;
-      o.progress = ProgressMode::Never;
-      Renderer r(slats(), o);
-      for (int pass = 0; pass < 16; ++pass) r.step();
-      FilmImage img;
-      r.develop(&img);
+      const FilmImage img = render(slats(), method, direct, kSize, 50000, 16);
       // Pixel column x spans world x in [x0, x1] on the tops (2.98 below the camera, which
       // looks down with +x to the right); the columns wholly on a top are averaged.
       double sum = 0.0;
