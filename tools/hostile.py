@@ -10,9 +10,10 @@ written); and never by a signal, a crash, the time limit or the memory limit. No
 change. Prints one line per case and exits 1 if any fails. Standard library only (the files are
 written by tools/gltf_writer.py and by hand). tests/CMakeLists.txt runs it as Tools.hostile.
 
-Left out: the classes another change is still fixing (decoded-texel budgets, images claiming
-huge sizes, data: URI and EXR header caps, the up-front memory estimate of --resolution and
---photons-per-pass) and a truncated JPEG, which still renders as libjpeg's grey fill.
+Left out (covered by the C++ tests, whose files are not a few bytes of standard-library
+output): a data: URI over its 256 MiB cap (tests/gltf/test_gltf_budgets.cpp) and EXR headers
+claiming gigabytes or deep data for compare, preview and --reference (tests/io/
+test_image_limits.cpp); signals during a checkpoint (tests/app/test_checkpoint.cpp).
 """
 
 import argparse
@@ -28,7 +29,7 @@ import zlib
 
 from . import gltf_writer
 from .cli import check_photonbound, default_photonbound
-from .common import ToolError, run_main
+from .common import REPO, ToolError, run_main
 from .gltf_scene import FLOAT, UNSIGNED_INT
 
 FAST = ["--resolution", "16x16", "--photons-per-pass", "2000", "--passes", "2", "--quiet"]
@@ -179,6 +180,30 @@ def make_truncated_png(d):
     return render_args("scene.gltf")
 
 
+def make_truncated_jpeg(d):
+    # The shipped 8 x 8 JPEG cut before its last third: libjpeg would fill the rest with grey.
+    with open(os.path.join(REPO, "tests", "data", "textures", "solid_200_100_50.jpg"), "rb") as f:
+        data = f.read()
+    with open(os.path.join(d, "tex.jpg"), "wb") as f:
+        f.write(data[:2 * len(data) // 3])
+    write_scene(os.path.join(d, "scene.gltf"), image_uri="tex.jpg")
+    return render_args("scene.gltf")
+
+
+def make_huge_resolution(d):
+    # 16384 x 16384 pixels: about 30 GB of per-pixel state, refused by the estimate up front.
+    write_scene(os.path.join(d, "scene.gltf"))
+    return ["render", "scene.gltf", "-o", "out.exr", "--resolution", "16384x16384", "--passes",
+            "1", "--max-memory", "2G", "--quiet"]
+
+
+def make_preview_over_input(d):
+    # preview IN -o IN: refused before IN is read (so IN need not even be an EXR).
+    with open(os.path.join(d, "render.exr"), "wb") as f:
+        f.write(b"not an image")
+    return ["preview", "render.exr", "-o", "render.exr"]
+
+
 def make_png_claiming_huge(d):
     # A valid 1x1 PNG whose header then claims 16384 x 16384: the rows cannot come from its few
     # bytes (deflate expands at most 1032:1), so it is refused from the header, unallocated.
@@ -255,7 +280,10 @@ CASES = [
     Case("matrix-mirror", "render", matrix_case([-1, 0, 0, 0] + IDENTITY[4:])),
     Case("output-is-scene", "refuse", output_case("-o", "out.exr", "--state", "scene.gltf")),
     Case("output-not-exr", "refuse", output_case("-o", "out.jpg")),
+    Case("truncated-jpeg", "refuse", make_truncated_jpeg),
     Case("png-claims-huge", "refuse", make_png_claiming_huge),
+    Case("resolution-beyond-memory", "refuse", make_huge_resolution),
+    Case("preview-over-input", "refuse", make_preview_over_input),
     Case("image-beyond-memory", "refuse", make_image_beyond_memory),
     Case("long-pass-time", "render", make_long_pass),
     Case("pass-beyond-memory", "refuse", make_huge_pass),
