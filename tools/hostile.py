@@ -152,46 +152,47 @@ def make_pipe_scene(d):
     return render_args("scene.gltf")
 
 
-def make_deep_json(d):
+def edited_scene(d, old, new):
+    """The scene with its first `old` replaced by `new` in the JSON text."""
     path = os.path.join(d, "scene.gltf")
     write_scene(path)
     with open(path, encoding="utf-8") as f:
         text = f.read()
-    deep = "[" * 100000 + "]" * 100000
     with open(path, "w", encoding="utf-8") as f:
-        f.write(text.replace('"asset": {', '"extras": ' + deep + ', "asset": {', 1))
+        f.write(text.replace(old, new, 1))
     return render_args("scene.gltf")
+
+
+def make_deep_json(d):
+    deep = "[" * 100000 + "]" * 100000
+    return edited_scene(d, '"asset": {', '"extras": ' + deep + ', "asset": {')
 
 
 def make_string_number(d):
-    path = os.path.join(d, "scene.gltf")
-    write_scene(path)
-    with open(path, encoding="utf-8") as f:
-        text = f.read()
-    with open(path, "w", encoding="utf-8") as f:
-        f.write(text.replace('"intensity": 20', '"intensity": "NaN"', 1))
-    return render_args("scene.gltf")
+    return edited_scene(d, '"intensity": 20', '"intensity": "NaN"')
+
+
+def texture_scene(d, name, data, *extra):
+    """The scene with the floor's base colour texture `name` holding `data`."""
+    with open(os.path.join(d, name), "wb") as f:
+        f.write(data)
+    write_scene(os.path.join(d, "scene.gltf"), image_uri=name)
+    return render_args("scene.gltf", *extra)
 
 
 def make_truncated_png(d):
-    with open(os.path.join(d, "tex.png"), "wb") as f:
-        f.write(png(64, 64)[:60])
-    write_scene(os.path.join(d, "scene.gltf"), image_uri="tex.png")
-    return render_args("scene.gltf")
+    return texture_scene(d, "tex.png", png(64, 64)[:60])
 
 
 def make_truncated_jpeg(d):
     # The shipped 8 x 8 JPEG cut before its last third: libjpeg would fill the rest with grey.
     with open(os.path.join(REPO, "tests", "data", "textures", "solid_200_100_50.jpg"), "rb") as f:
         data = f.read()
-    with open(os.path.join(d, "tex.jpg"), "wb") as f:
-        f.write(data[:2 * len(data) // 3])
-    write_scene(os.path.join(d, "scene.gltf"), image_uri="tex.jpg")
-    return render_args("scene.gltf")
+    return texture_scene(d, "tex.jpg", data[:2 * len(data) // 3])
 
 
 def make_huge_resolution(d):
-    # 16384 x 16384 pixels: about 30 GB of per-pixel state, refused by the estimate up front.
+    # 16384 x 16384 pixels: about 150 GiB of per-pixel state, refused by the estimate up front.
     write_scene(os.path.join(d, "scene.gltf"))
     return ["render", "scene.gltf", "-o", "out.exr", "--resolution", "16384x16384", "--passes",
             "1", "--max-memory", "2G", "--quiet"]
@@ -210,19 +211,13 @@ def make_png_claiming_huge(d):
     data = bytearray(png(1, 1))
     data[16:24] = struct.pack(">II", 16384, 16384)
     data[29:33] = struct.pack(">I", zlib.crc32(bytes(data[12:29])) & 0xFFFFFFFF)
-    with open(os.path.join(d, "tex.png"), "wb") as f:
-        f.write(bytes(data))
-    write_scene(os.path.join(d, "scene.gltf"), image_uri="tex.png")
-    return render_args("scene.gltf")
+    return texture_scene(d, "tex.png", bytes(data))
 
 
 def make_image_beyond_memory(d):
     # A real 4096 x 4096 PNG (48 MiB of texels) under --max-memory 160M: with the program's own
     # 140 MiB the render does not fit, and it is refused before it starts.
-    with open(os.path.join(d, "tex.png"), "wb") as f:
-        f.write(png(4096, 4096))
-    write_scene(os.path.join(d, "scene.gltf"), image_uri="tex.png")
-    return render_args("scene.gltf", "--max-memory", "160M")
+    return texture_scene(d, "tex.png", png(4096, 4096), "--max-memory", "160M")
 
 
 def make_copies(d):
