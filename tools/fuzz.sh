@@ -5,7 +5,8 @@
 # Builds fuzz/ in build-fuzz/, seeds the loader's corpus with every shipped scene and the image
 # decoders' with small images of every format OpenImageIO writes here, and runs in fork mode
 # so that one finding does not end the run. Findings (crash-*, leak-*, timeout-*, oom-*) land in
-# build-fuzz/findings/; each one fixed is kept in tests/data/fuzz/ where test_gltf_loader_files replays it.
+# build-fuzz/findings-TARGET/; each one fixed is kept in tests/data/fuzz/ (images: fuzz/images/),
+# where test_gltf_loader_files (test_image_limits) replays it.
 set -euo pipefail
 root="$(cd "$(dirname "${BASH_SOURCE[0]}")/.." && pwd)"
 seconds="${1:-900}"
@@ -53,6 +54,7 @@ for ext, fmt, ch in [("png", "uint8", 4), ("png", "uint16", 3), ("jpg", "uint8",
         o.write_image(pixels[:, :, :ch])
         o.close()
 PY
+  cp "$root"/tests/data/fuzz/images/* "$corpus"/  # the findings fixed so far
   ./fuzz_image_decode -fork="$workers" -ignore_crashes=1 -ignore_timeouts=1 -ignore_ooms=1 \
     -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
     -artifact_prefix="$findings/" "$corpus"

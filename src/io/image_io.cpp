@@ -12,6 +12,7 @@
 #include <cstring>
 #include <filesystem>
 
+#include "io/container_check.h"
 #include "util/file_io.h"
 #include "util/memory.h"
 #include "util/message_text.h"
@@ -23,6 +24,12 @@ namespace {
 // deflate's largest expansion: a 258-byte match costs at least 2 bits, about 1032:1 (zlib's
 // "Maximum compression factor", zlib.net/zlib_tech.html).
 constexpr uint64_t kDeflateMaxRatio = 1032;
+
+// The most texels a texture may have (decode_image's message says 2^28).
+constexpr uint64_t kMaxTexels = uint64_t(1) << 28;
+
+// The most texels a whole read within `limit` can have: one float channel each.
+uint64_t max_texels(const ReadLimit& limit) { return limit.max_bytes / sizeof(float); }
 
 // OpenImageIO writes the temporary file write_atomically names (it picks the format by the
 // extension, which the name keeps); its errors become one ImageError naming `path`.
@@ -124,6 +131,7 @@ void check_read(const std::string& path, OIIO::ImageInput& in, bool ok) {
 }  // namespace
 
 ExrImage read_exr(const std::string& path, const ReadLimit& limit) {
+  check_container_file(path, max_texels(limit));
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw ImageError(path + ": cannot read image: " + one_line(OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
@@ -155,6 +163,30 @@ std::string format_name(const unsigned char* d, size_t n, const std::string& nam
     return "image.webp";
   return name;
 }
+
+// OpenImageIO 2.4's IOMemReader reads wherever it is told: an EXR whose chunk offset table holds
+// a negative offset made OpenEXR read before the buffer (ASan: heap-buffer-overflow in
+// IOMemReader::pread, found by tools/fuzz.sh image). This one reads only inside it.
+class BoundedMemReader final : public OIIO::Filesystem::IOMemReader {
+ public:
+  using IOMemReader::IOMemReader;
+  bool seek(int64_t offset) override {
+    if (offset < 0) return false;
+    m_pos = offset;
+    return true;
+  }
+  size_t read(void* buf, size_t size) override {
+    const size_t n = pread(buf, size, m_pos);
+    m_pos += int64_t(n);
+    return n;
+  }
+  size_t pread(void* buf, size_t size, int64_t offset) override {
+    if (offset < 0 || offset >= int64_t(m_buf.size())) return 0;
+    const size_t n = std::min(size, size_t(int64_t(m_buf.size()) - offset));
+    std::memcpy(buf, m_buf.data() + offset, n);
+    return n;
+  }
+};
 
 // A reader that takes its bytes from an IOProxy; "null" makes images up from the name alone.
 bool from_memory(const OIIO::ImageInput& reader) {
@@ -238,9 +270,11 @@ Image decode_image(const unsigned char* data, size_t size, const std::string& na
     throw ImageError(name +
                      ": cannot decode the image: it is KTX2 (Basis Universal), which "
                      "photonbound does not read");
+  // Before any reader sees the bytes: the scan below offers them to every format's reader.
+  check_container(data, size, name, kMaxTexels);
   const QuietStderr quiet;
   const std::string file = format_name(data, size, name);
-  OIIO::Filesystem::IOMemReader memory(data, size);
+  BoundedMemReader memory(data, size);
   OIIO::ImageSpec config;
   config.attribute("oiio:UnassociatedAlpha", 1);  // keep colour as stored, not premultiplied
   // With a configuration the readers take the proxy from it (ioproxy_retrieve_from_config).
@@ -301,7 +335,7 @@ Image decode_image(const unsigned char* data, size_t size, const std::string& na
   const std::string claim = std::to_string(spec.width) + "x" + std::to_string(spec.height) +
                             " with " + std::to_string(spec.nchannels) + " channels";
   const uint64_t texels = uint64_t(std::max(spec.width, 0)) * uint64_t(std::max(spec.height, 0));
-  if (spec.width <= 0 || spec.height <= 0 || im.channels <= 0 || texels > (uint64_t(1) << 28))
+  if (spec.width <= 0 || spec.height <= 0 || im.channels <= 0 || texels > kMaxTexels)
     throw ImageError(name + ": the image is " + claim +
                      "; photonbound reads 1 to 4 channels and up to 2^28 texels");
   check_plausible(*in, data, size, name, claim);
@@ -324,7 +358,7 @@ Image decode_image(const unsigned char* data, size_t size, const std::string& na
   if (!ok || in->has_error()) {
     // OpenImageIO's readers quote the name they were opened with, here the made-up `file`.
     std::string why = in->has_error() ? one_line(in->geterror()) : "the decoder failed";
-    for (const std::string quoted : {" (\"" + file + "\")", " \"" + file + "\""})
+    for (const std::string& quoted : {" (\"" + file + "\")", " \"" + file + "\""})
       for (size_t at; (at = why.find(quoted)) != std::string::npos;) why.erase(at, quoted.size());
     throw ImageError(name + ": cannot decode the image: " + why);
   }
@@ -337,6 +371,7 @@ uint64_t image_bytes(const Image& image) {
 }
 
 RgbImage read_rgb_image(const std::string& path, const ReadLimit& limit) {
+  check_container_file(path, max_texels(limit));
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw ImageError(path + ": cannot read image: " + one_line(OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();

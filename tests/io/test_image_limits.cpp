@@ -245,5 +245,200 @@ TEST(ImageLimits, ADeepExrIsRefusedWithAMessage) {
   std::filesystem::remove(path);
 }
 
+// ---- Container structure (io/container_check.h): what tools/fuzz.sh image found ----
+
+// A 13x7 image of `channels` channels written by OpenImageIO with `spec`'s extra settings,
+// as bytes; its pixel values are k / 1000 for value k in row-major order.
+std::vector<unsigned char> written(const std::string& ext, OIIO::ImageSpec spec,
+                                   int subimages = 1) {
+  const std::string path = temp("written." + ext);
+  std::vector<float> pixels(size_t(spec.width) * size_t(spec.height) * size_t(spec.nchannels));
+  for (size_t k = 0; k < pixels.size(); ++k) pixels[k] = float(k % 1000) / 1000.0f;
+  auto out = OIIO::ImageOutput::create(path);
+  EXPECT_TRUE(out);
+  std::vector<OIIO::ImageSpec> specs(size_t(subimages), spec);
+  EXPECT_TRUE(out->open(path, subimages, specs.data())) << out->geterror();
+  for (int s = 0; s < subimages; ++s) {
+    if (s > 0) EXPECT_TRUE(out->open(path, spec, OIIO::ImageOutput::AppendSubimage));
+    EXPECT_TRUE(out->write_image(OIIO::TypeDesc::FLOAT, pixels.data())) << out->geterror();
+  }
+  out->close();
+  std::vector<unsigned char> bytes = file_bytes(path);
+  std::filesystem::remove(path);
+  return bytes;
+}
+
+OIIO::ImageSpec spec13x7(int channels, OIIO::TypeDesc type) {
+  OIIO::ImageSpec spec(13, 7, channels, type);
+  return spec;
+}
+
+TEST(ContainerCheck, ExrAndTiffFilesOfEveryLayoutStillDecode) {
+  // The checks refuse only what no valid file has: every layout OpenImageIO writes passes,
+  // scan lines under each compression (1 to 256 lines a chunk), tiles, several parts, and
+  // TIFF strips, tiles and BigTIFF; the first texel and the last (value 90 of 91 x channels)
+  // come back.
+  struct Case {
+    std::string what, ext;
+    OIIO::ImageSpec spec;
+    int subimages = 1;
+  };
+  std::vector<Case> cases;
+  for (const char* c : {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "dwaa", "dwab"}) {
+    OIIO::ImageSpec s = spec13x7(3, OIIO::TypeDesc::FLOAT);
+    s.attribute("compression", c);
+    cases.push_back({std::string("EXR ") + c, "exr", s});
+  }
+  OIIO::ImageSpec tiled = spec13x7(4, OIIO::TypeDesc::HALF);
+  tiled.tile_width = tiled.tile_height = 4;
+  tiled.attribute("compression", "zip");
+  cases.push_back({"tiled EXR", "exr", tiled});
+  cases.push_back({"two-part EXR", "exr", spec13x7(3, OIIO::TypeDesc::HALF), 2});
+  cases.push_back({"TIFF strips", "tif", spec13x7(3, OIIO::TypeDesc::UINT8)});
+  OIIO::ImageSpec tiff_tiles = spec13x7(4, OIIO::TypeDesc::UINT16);
+  tiff_tiles.tile_width = tiff_tiles.tile_height = 16;
+  tiff_tiles.attribute("compression", "zip");
+  cases.push_back({"TIFF tiles", "tif", tiff_tiles});
+  OIIO::ImageSpec big = spec13x7(3, OIIO::TypeDesc::FLOAT);
+  big.attribute("tiff:bigtiff", 1);
+  cases.push_back({"BigTIFF", "tif", big});
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    const std::vector<unsigned char> bytes = written(c.ext, c.spec, c.subimages);
+    // The writer made what the case names: a BigTIFF, a multi-part or a tiled EXR (version
+    // bits 0x1000 and 0x200).
+    if (c.what == "BigTIFF") ASSERT_EQ(bytes[2], 43);
+    if (c.what == "two-part EXR") ASSERT_TRUE(bytes[5] & 0x10);
+    if (c.what == "tiled EXR") ASSERT_TRUE(bytes[5] & 0x02);
+    const Image im = decode_image(bytes.data(), bytes.size(), "t." + c.ext, UINT64_MAX);
+    ASSERT_EQ(im.width, 13);
+    ASSERT_EQ(im.height, 7);
+    const size_t last = size_t(13 * 7 * c.spec.nchannels) - 1;
+    const float first_value = im.u8.empty() ? im.f32.front() : im.u8.front() / 255.0f;
+    const float last_value = im.u8.empty() ? im.f32.back() : im.u8.back() / 255.0f;
+    // Within half's and 8 bits' rounding, and B44/DWA's lossy coding.
+    const float tol = c.what.find("b44") != std::string::npos ||
+                              c.what.find("dwa") != std::string::npos
+                          ? 0.05f
+                          : 0.005f;
+    EXPECT_NEAR(first_value, 0.0f, tol);
+    EXPECT_NEAR(last_value, float(last % 1000) / 1000.0f, tol);
+  }
+}
+
+// `bytes` with the 4-byte little-endian value at `at` replaced.
+std::vector<unsigned char> patched32(std::vector<unsigned char> bytes, size_t at, uint32_t v) {
+  for (int k = 0; k < 4; ++k) bytes[at + size_t(k)] = uint8_t(v >> (8 * k));
+  return bytes;
+}
+
+size_t find_text(const std::vector<unsigned char>& d, const std::string& s) {
+  const auto at = std::search(d.begin(), d.end(), s.begin(), s.end());
+  EXPECT_NE(at, d.end()) << s;
+  return size_t(at - d.begin());
+}
+
+TEST(ContainerCheck, AnExrAttributeLongerThanTheFileIsRefusedBeforeOpenExrAllocatesIt) {
+  // OpenEXR allocated 1.7 to 2 GB for the fuzzer's string attributes of 200-byte files.
+  const std::vector<unsigned char> good = written("exr", spec13x7(3, OIIO::TypeDesc::HALF));
+  const std::string attr = std::string("channels") + '\0' + "chlist" + '\0';
+  const size_t size_at = find_text(good, attr) + attr.size();
+  const std::vector<unsigned char> bad = patched32(good, size_at, 1900000000u);
+  const std::string m = decode_error(bad, "claims.exr");
+  EXPECT_NE(m.find("EXR attribute 'channels' claims 1.8 GiB, more than the"), std::string::npos)
+      << m;
+  EXPECT_LT(peak_rss_kib(), 1L << 20);  // 1 GiB
+  // The same from a file (compare, preview, --reference, --environment).
+  const std::string path = temp("claims.exr");
+  std::ofstream(path, std::ios::binary)
+      .write(reinterpret_cast<const char*>(bad.data()), std::streamsize(bad.size()));
+  EXPECT_NE(read_error(path, [&] { read_exr(path); }).find("'channels' claims 1.8 GiB"),
+            std::string::npos);
+  std::filesystem::remove(path);
+}
+
+TEST(ContainerCheck, AnExrAttributeNameOverThirtyOneBytesNeedsTheLongNameFlag) {
+  // The fuzzer's crash: a 70-byte name in a file without the long-name bit (0x400) made
+  // OpenEXR read past the attribute; 31 bytes is the format's limit without that bit.
+  std::vector<unsigned char> d = written("exr", spec13x7(3, OIIO::TypeDesc::HALF));
+  const size_t at = find_text(d, std::string("lineOrder") + '\0');
+  std::vector<unsigned char> longer(d.begin(), d.begin() + std::ptrdiff_t(at));
+  const std::string name(40, 'x');
+  longer.insert(longer.end(), name.begin(), name.end());
+  longer.insert(longer.end(), d.begin() + std::ptrdiff_t(at + 9), d.end());  // "lineOrder"
+  EXPECT_NE(decode_error(longer, "long.exr").find("an EXR attribute name is longer than 31 bytes"),
+            std::string::npos);
+}
+
+TEST(ContainerCheck, AnExrChunkOffsetOutsideTheFileIsAnErrorNotAReadOutsideTheBuffer) {
+  // A negative chunk offset made OpenEXR read before the bytes in memory (ASan: heap-buffer-
+  // overflow in OpenImageIO's IOMemReader::pread); under tools/sanitize.sh this would report
+  // it. A valid scan-line file whose first table entry is then -1, or past the end.
+  OIIO::ImageSpec spec = spec13x7(3, OIIO::TypeDesc::HALF);
+  spec.attribute("compression", "none");  // one line a chunk: 7 table entries
+  const std::vector<unsigned char> good = written("exr", spec);
+  size_t table = 0;  // the first entry points just past the 7 entries
+  for (size_t i = 8; i + 8 < good.size() && !table; ++i) {
+    int64_t v;
+    std::memcpy(&v, &good[i], 8);
+    if (v == int64_t(i + 7 * 8)) table = i;
+  }
+  ASSERT_GT(table, 0u);
+  for (const int64_t offset : {int64_t(-1), int64_t(-1000), int64_t(good.size()) + 100}) {
+    SCOPED_TRACE(offset);
+    std::vector<unsigned char> bad = good;
+    std::memcpy(&bad[table], &offset, 8);
+    try {
+      const Image im = decode_image(bad.data(), bad.size(), "offset.exr", UINT64_MAX);
+      // OpenEXR may rebuild a broken table by scanning the chunks: then the image is whole.
+      EXPECT_EQ(im.width * im.height, 13 * 7);
+    } catch (const ImageError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind("offset.exr: ", 0), 0u) << e.what();
+    }
+  }
+}
+
+TEST(ContainerCheck, TiffDataPastTheEndOfTheFileIsRefused) {
+  // A tag's values, a strip, or a directory past the end: the fuzzer's TIFFs made libtiff
+  // allocate what they claimed.
+  const std::vector<unsigned char> good = written("tif", spec13x7(3, OIIO::TypeDesc::UINT8));
+  ASSERT_EQ(good[0], 'I');
+  const uint32_t ifd = uint32_t(good[4]) | uint32_t(good[5]) << 8 | uint32_t(good[6]) << 16 |
+                       uint32_t(good[7]) << 24;
+  const size_t n = size_t(good[ifd]) | size_t(good[ifd + 1]) << 8;
+  size_t strip_counts = 0;  // the entry of tag 279, StripByteCounts
+  for (size_t k = 0; k < n; ++k)
+    if ((good[ifd + 2 + 12 * k] | good[ifd + 3 + 12 * k] << 8) == 279) strip_counts = ifd + 2 + 12 * k;
+  ASSERT_GT(strip_counts, 0u);
+  // One strip (13x7 RGB fits the default rows a strip): its byte count is the value itself.
+  std::string m = decode_error(patched32(good, strip_counts + 8, 50000000u), "strip.tif");
+  EXPECT_NE(m.find("TIFF strip or tile 0 claims 48 MiB"), std::string::npos) << m;
+  // The strip count claims 2^28 LONGs of byte counts, stored at an offset past the end.
+  std::vector<unsigned char> tag = patched32(good, strip_counts + 2, 4);  // LONG
+  tag = patched32(tag, strip_counts + 4, 1u << 28);
+  m = decode_error(patched32(tag, strip_counts + 8, 4000000000u), "tag.tif");
+  EXPECT_NE(m.find("TIFF tag 279 claims 1.0 GiB at offset 4000000000"), std::string::npos) << m;
+  m = decode_error(patched32(good, 4, uint32_t(good.size()) + 10), "ifd.tif");
+  EXPECT_NE(m.find("TIFF directory 0 lies past the end of the file"), std::string::npos) << m;
+}
+
+TEST(ContainerCheck, TheImageFuzzersFindingsAreRefusedWithOneLine) {
+  // Kept from tools/fuzz.sh image (tests/data/fuzz/README.md): 15 EXRs whose attributes claim
+  // 0.8 to 2 GB, or a name of 70 bytes, and 2 TIFFs whose data lies past their end.
+  std::vector<std::filesystem::path> files;
+  for (const auto& e : std::filesystem::directory_iterator(PHOTONBOUND_TEST_DATA "/fuzz/images"))
+    files.push_back(e.path());
+  ASSERT_GE(files.size(), 17u) << "the image fuzz regression inputs are missing";
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files) {
+    SCOPED_TRACE(f.string());
+    const std::vector<unsigned char> bytes = file_bytes(f.string());
+    const std::string m = decode_error(bytes, f.filename().string(), uint64_t(256) << 20);
+    EXPECT_NE(m.find("a corrupt or hostile file"), std::string::npos) << m;
+    for (const char c : m) EXPECT_TRUE(c >= 0x20 && c < 0x7f) << m;
+  }
+  EXPECT_LT(peak_rss_kib(), 1L << 20);  // 1 GiB
+}
+
 }  // namespace
 }  // namespace pb

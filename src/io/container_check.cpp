@@ -1,0 +1,279 @@
+#include "io/container_check.h"
+
+#include <algorithm>
+#include <cstring>
+#include <fstream>
+#include <set>
+#include <vector>
+
+#include "io/image_io.h"
+#include "util/memory.h"
+
+namespace pb {
+
+namespace {
+
+// Little- or big-endian unsigned integers of 1 to 8 bytes.
+uint64_t load(const unsigned char* p, int bytes, bool big_endian) {
+  uint64_t v = 0;
+  for (int k = 0; k < bytes; ++k) v |= uint64_t(p[big_endian ? bytes - 1 - k : k]) << (8 * k);
+  return v;
+}
+
+// Pieces of the file read through a ByteReader, each checked to lie inside it.
+class Bytes {
+ public:
+  Bytes(const ByteReader& read, uint64_t size, const std::string& name)
+      : read_(read), size_(size), name_(name) {}
+  uint64_t size() const { return size_; }
+  bool holds(uint64_t offset, uint64_t n) const { return offset <= size_ && n <= size_ - offset; }
+  // Unsigned integer of `bytes` bytes at `offset`; false past the end.
+  bool uint(uint64_t offset, int bytes, bool big_endian, uint64_t& v) const {
+    unsigned char b[8];
+    if (!holds(offset, uint64_t(bytes)) || !read_(offset, uint64_t(bytes), b)) return false;
+    v = load(b, bytes, big_endian);
+    return true;
+  }
+  bool get(uint64_t offset, uint64_t n, unsigned char* out) const {
+    return holds(offset, n) && read_(offset, n, out);
+  }
+  [[noreturn]] void refuse(const std::string& what) const {
+    throw ImageError(name_ + ": " + what + ": a corrupt or hostile file");
+  }
+
+ private:
+  const ByteReader& read_;
+  uint64_t size_;
+  const std::string& name_;
+};
+
+// ---- OpenEXR (the "OpenEXR File Layout" document: magic, version, headers, offset tables) ----
+
+// Scan lines in one chunk, by compression (ImfCompression.h's order); 256 (DWAB's, the most)
+// for a code OpenEXR does not know, which OpenEXR refuses itself.
+uint64_t exr_lines_per_chunk(unsigned code) {
+  static const uint64_t lines[] = {1, 1, 1, 16, 32, 16, 32, 32, 32, 256};
+  return code < 10 ? lines[code] : 256;
+}
+
+void check_exr(const Bytes& b, uint64_t max_texels) {
+  uint64_t version = 0;
+  if (!b.uint(4, 4, false, version)) b.refuse("the EXR file ends inside its version field");
+  const bool long_names = version & 0x400, multipart = version & 0x1000;
+  const bool single_tiled = version & 0x200;
+  const uint64_t max_name = long_names ? 255 : 31;  // bytes, before the terminating null
+  // A name or type name: up to max_name bytes and a null; the offset after it.
+  auto text = [&](uint64_t at, std::string& out) {
+    out.clear();
+    for (uint64_t k = 0;; ++k) {
+      unsigned char c;
+      if (!b.get(at + k, 1, &c)) b.refuse("the EXR header ends inside an attribute name");
+      if (c == 0) return at + k + 1;
+      if (k == max_name)
+        b.refuse("an EXR attribute name is longer than " + std::to_string(max_name) + " bytes");
+      out.push_back(c >= 0x20 && c < 0x7f ? char(c) : '?');  // it may be quoted in a message
+    }
+  };
+  uint64_t at = 8, chunks = 0;
+  for (int part = 0;; ++part) {
+    unsigned char first;
+    if (!b.get(at, 1, &first)) b.refuse("the EXR file ends inside its header");
+    if (first == 0 && part > 0) {  // the empty header that ends a multi-part file's headers
+      ++at;
+      break;
+    }
+    int64_t window[4] = {0, 0, -1, -1};
+    bool has_window = false, tiled = single_tiled;
+    unsigned compression = 0;
+    uint64_t tile_x = 0, tile_y = 0, chunk_count = 0;
+    bool has_chunk_count = false;
+    std::string name, type;
+    for (;;) {
+      at = text(at, name);
+      if (name.empty()) break;
+      at = text(at, type);
+      uint64_t size = 0;
+      if (!b.uint(at, 4, false, size)) b.refuse("the EXR header ends inside attribute " + name);
+      at += 4;
+      if (size > 0x7fffffff || !b.holds(at, size))
+        b.refuse("EXR attribute '" + name + "' claims " + bytes_text(size) + ", more than the " +
+                 std::to_string(b.size() - std::min(at, b.size())) + " bytes after it");
+      uint64_t v = 0;
+      if (name == "dataWindow" && type == "box2i" && size == 16) {
+        for (int k = 0; k < 4; ++k) {
+          b.uint(at + 4 * uint64_t(k), 4, false, v);
+          window[k] = int64_t(int32_t(uint32_t(v)));
+        }
+        has_window = true;
+      } else if (name == "compression" && type == "compression" && size == 1) {
+        b.uint(at, 1, false, v);
+        compression = unsigned(v);
+      } else if (name == "tiles" && type == "tiledesc" && size == 9) {
+        b.uint(at, 4, false, tile_x);
+        b.uint(at + 4, 4, false, tile_y);
+        tiled = true;
+      } else if (name == "chunkCount" && type == "int" && size == 4) {
+        b.uint(at, 4, false, chunk_count);
+        has_chunk_count = true;
+      } else if (name == "type" && type == "string") {
+        std::string kind(size_t(std::min<uint64_t>(size, 16)), '\0');
+        b.get(at, kind.size(), reinterpret_cast<unsigned char*>(kind.data()));
+        tiled = kind == "tiledimage" || kind == "deeptile";
+      }
+      at += size;
+    }
+    if (has_window) {
+      const int64_t w = window[2] - window[0] + 1, h = window[3] - window[1] + 1;
+      if (w < 1 || h < 1)
+        b.refuse("the EXR data window is empty or inverted (" + std::to_string(w) + "x" +
+                 std::to_string(h) + ")");
+      if (uint64_t(w) * uint64_t(h) > max_texels)  // each below 2^32: no overflow
+        b.refuse("the EXR data window is " + std::to_string(w) + "x" + std::to_string(h) +
+                 " pixels, over the " + std::to_string(max_texels) + " this read allows");
+      // Every chunk has an 8-byte entry in the offset table after the headers: the chunks of
+      // level 0 alone are a lower bound on the table's length.
+      uint64_t n;
+      if (tiled) {
+        if (tile_x == 0 || tile_y == 0) b.refuse("an EXR tile size is 0");
+        n = ((uint64_t(w) + tile_x - 1) / tile_x) * ((uint64_t(h) + tile_y - 1) / tile_y);
+      } else {
+        const uint64_t lines = exr_lines_per_chunk(compression);
+        n = (uint64_t(h) + lines - 1) / lines;
+      }
+      chunks = saturating_add(chunks, n);
+    }
+    if (has_chunk_count) chunks = saturating_add(chunks, chunk_count);
+    if (!multipart) break;  // one header, ended by the null `text` read
+  }
+  if (!b.holds(at, saturating_mul(chunks, 8)))
+    b.refuse("the EXR header needs an offset table of " + std::to_string(chunks) +
+             " chunks, more than the file's " + std::to_string(b.size()) + " bytes hold");
+}
+
+// ---- TIFF (TIFF 6.0 section 2; BigTIFF: 8-byte counts and offsets) ----
+
+uint64_t tiff_type_size(uint64_t type) {
+  switch (type) {
+    case 1: case 2: case 6: case 7: return 1;   // BYTE, ASCII, SBYTE, UNDEFINED
+    case 3: case 8: return 2;                   // SHORT, SSHORT
+    case 4: case 9: case 11: case 13: return 4;  // LONG, SLONG, FLOAT, IFD
+    case 5: case 10: case 12: case 16: case 17: case 18: return 8;  // RATIONALs, DOUBLE, 64-bit
+    default: return 0;  // unknown: libtiff skips the entry
+  }
+}
+
+void check_tiff(const Bytes& b, bool big_endian, uint64_t max_texels) {
+  uint64_t magic = 0;
+  b.uint(2, 2, big_endian, magic);
+  const bool big = magic == 43;
+  const int word = big ? 8 : 4;                     // offsets, counts and inline values
+  const uint64_t entry = big ? 20 : 12, count_bytes = big ? 8 : 2;
+  uint64_t ifd = 0;
+  if (!b.uint(big ? 8 : 4, word, big_endian, ifd)) b.refuse("the TIFF file ends in its header");
+  std::set<uint64_t> seen;
+  for (int index = 0; ifd != 0 && index < 1024; ++index) {
+    if (!seen.insert(ifd).second) break;  // a loop of directories: libtiff stops there too
+    uint64_t n = 0;
+    if (!b.uint(ifd, int(count_bytes), big_endian, n) ||
+        !b.holds(ifd + count_bytes, saturating_add(saturating_mul(n, entry), uint64_t(word))))
+      b.refuse("TIFF directory " + std::to_string(index) + " lies past the end of the file");
+    uint64_t width = 0, height = 0, samples = 1;
+    uint64_t offsets_at = 0, offsets_n = 0, offsets_type = 0;
+    uint64_t counts_at = 0, counts_n = 0, counts_type = 0;
+    for (uint64_t k = 0; k < n; ++k) {
+      const uint64_t e = ifd + count_bytes + k * entry;
+      uint64_t tag = 0, type = 0, count = 0, value = 0;
+      b.uint(e, 2, big_endian, tag);
+      b.uint(e + 2, 2, big_endian, type);
+      b.uint(e + 4, word, big_endian, count);
+      const uint64_t field = e + 4 + uint64_t(word);  // the value, or the offset of the values
+      const uint64_t unit = tiff_type_size(type);
+      if (unit == 0) continue;
+      const uint64_t bytes = saturating_mul(count, unit);
+      uint64_t data = field;
+      if (bytes > uint64_t(word)) {
+        b.uint(field, word, big_endian, data);
+        if (!b.holds(data, bytes))
+          b.refuse("TIFF tag " + std::to_string(tag) + " claims " + bytes_text(bytes) +
+                   " at offset " + std::to_string(data) + ", past the end of the file's " +
+                   std::to_string(b.size()) + " bytes");
+      }
+      if (count == 1 && (type == 3 || type == 4 || type == 16)) b.uint(field, int(unit), big_endian, value);
+      if (tag == 256) width = value;
+      if (tag == 257) height = value;
+      if (tag == 277) samples = std::max<uint64_t>(value, 1);
+      if (tag == 273 || tag == 324) offsets_at = data, offsets_n = count, offsets_type = type;
+      if (tag == 279 || tag == 325) counts_at = data, counts_n = count, counts_type = type;
+    }
+    if (index == 0) {
+      const uint64_t texels = saturating_mul(width, height);
+      if (texels > max_texels || saturating_mul(texels, samples) > saturating_mul(max_texels, 4))
+        b.refuse("the TIFF header claims " + std::to_string(width) + "x" +
+                 std::to_string(height) + " pixels of " + std::to_string(samples) +
+                 " samples, over the " + std::to_string(max_texels) + " texels this read allows");
+    }
+    // Each strip or tile lies inside the file (read only for tables of a sane length: a valid
+    // file's table is inside it, which the loop above checked).
+    const uint64_t strips = std::min(offsets_n, counts_n);
+    const uint64_t ou = tiff_type_size(offsets_type), cu = tiff_type_size(counts_type);
+    if (strips > 0 && strips <= (uint64_t(1) << 20) && (ou == 2 || ou == 4 || ou == 8) &&
+        (cu == 2 || cu == 4 || cu == 8)) {
+      std::vector<unsigned char> o(size_t(strips * ou)), c(size_t(strips * cu));
+      if (b.get(offsets_at, o.size(), o.data()) && b.get(counts_at, c.size(), c.data()))
+        for (uint64_t s = 0; s < strips; ++s) {
+          const uint64_t off = load(&o[size_t(s * ou)], int(ou), big_endian);
+          const uint64_t len = load(&c[size_t(s * cu)], int(cu), big_endian);
+          if (!b.holds(off, len))
+            b.refuse("TIFF strip or tile " + std::to_string(s) + " claims " + bytes_text(len) +
+                     " at offset " + std::to_string(off) + ", past the end of the file's " +
+                     std::to_string(b.size()) + " bytes");
+        }
+    }
+    uint64_t next = 0;
+    b.uint(ifd + count_bytes + n * entry, word, big_endian, next);
+    ifd = next;
+  }
+}
+
+}  // namespace
+
+void check_container(const ByteReader& read, uint64_t size, const std::string& name,
+                     uint64_t max_texels) {
+  const Bytes b(read, size, name);
+  unsigned char head[4];
+  if (!b.get(0, 4, head)) return;
+  if (std::memcmp(head, "\x76\x2f\x31\x01", 4) == 0) check_exr(b, max_texels);
+  const bool le = std::memcmp(head, "II", 2) == 0, be = std::memcmp(head, "MM", 2) == 0;
+  if (le || be) {
+    uint64_t magic = 0;
+    b.uint(2, 2, be, magic);
+    if (magic == 42 || magic == 43) check_tiff(b, be, max_texels);
+  }
+}
+
+void check_container(const unsigned char* data, uint64_t size, const std::string& name,
+                     uint64_t max_texels) {
+  const ByteReader read = [&](uint64_t offset, uint64_t n, unsigned char* out) {
+    if (offset > size || n > size - offset) return false;
+    if (n) std::memcpy(out, data + offset, size_t(n));
+    return true;
+  };
+  check_container(read, size, name, max_texels);
+}
+
+void check_container_file(const std::string& path, uint64_t max_texels) {
+  std::ifstream f(path, std::ios::binary);
+  if (!f) return;
+  f.seekg(0, std::ios::end);
+  const std::streamoff end = f.tellg();
+  if (end <= 0) return;
+  const ByteReader read = [&](uint64_t offset, uint64_t n, unsigned char* out) {
+    f.clear();
+    f.seekg(std::streamoff(offset));
+    f.read(reinterpret_cast<char*>(out), std::streamsize(n));
+    return f.good() || uint64_t(f.gcount()) == n;
+  };
+  check_container(read, uint64_t(end), path, max_texels);
+}
+
+}  // namespace pb
