@@ -25,8 +25,8 @@ namespace pb {
 // 4: glTF's metallic-roughness materials (a version 3 state was rendered with other ones), the
 // sparse-photon bound's SPPM kernel masses, largest photon power and glossy caps;
 // 5: PointState with the alternating sums of the noise replica (192 B); 6: with the two-scale
-// check's moments (208 B).
-inline constexpr uint32_t kStateVersion = 6;
+// check's moments (208 B); 7: SPPM's glossy caps as f / c, not f.
+inline constexpr uint32_t kStateVersion = 7;
 
 struct SavedRender {
   RenderOptions options;    // as rendered (scene path, everything that shapes the image)

@@ -45,16 +45,19 @@ void count_slopes(PixelResult& r, const PointEstimate& e) {
 // (ESTIMATOR.md section 5). W_k is already inside each point's estimate (VisiblePoint::f).
 // SPPM (section 10): one state per pixel, whose samples carry the emission seen along the path.
 // The bound of a state's photon part while it has fewer than kMinPhotonsForBound photons.
-dvec3 sparse_term(const PixelLayout& layout, const PointState& s, size_t k, const vec3& f,
+// `f_over_c`: the largest f / c a photon's pass sample can carry (f the BRDF, c the kernel mass).
+dvec3 sparse_term(const PixelLayout& layout, const PointState& s, const dvec3& f_over_c,
                   uint64_t passes_with_point, double confidence) {
   if (s.photons >= kMinPhotonsForBound || !(layout.photon_cap > 0.0)) return dvec3(0.0);
-  const double c = layout.mass.empty() ? 1.0 : std::max(double(layout.mass[k]), kMinKernelMass);
-  const double area = c * kPiD * s.r2;
   dvec3 out;
   for (int ch = 0; ch < 3; ++ch)
-    out[ch] = sparse_photon_bound(s.photons, passes_with_point, layout.photon_cap * f[ch] / area,
-                                  confidence);
+    out[ch] = sparse_photon_bound(s.photons, passes_with_point,
+                                  layout.photon_cap * f_over_c[ch] / (kPiD * s.r2), confidence);
   return out;
+}
+
+double kernel_mass(const PixelLayout& layout, size_t k) {
+  return layout.mass.empty() ? 1.0 : std::max(double(layout.mass[k]), kMinKernelMass);
 }
 
 PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& states, size_t pixel,
@@ -73,14 +76,16 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
     // A pixel that never had a visible point has no photon part to wait for: its samples are
     // the emission along its paths, known from two passes on.
     const uint64_t visible = layout.visible_passes.empty() ? passes : layout.visible_passes[pixel];
-    const vec3 f = layout.glossy_f.empty() ? layout.max_f
-                                           : glm::max(layout.max_f, vec3(layout.glossy_f[pixel]));
+    // Lambertian points: the scene's largest Lambertian f over the pixel's smallest c; glossy
+    // points: the largest f / c any of them had.
+    dvec3 f_over_c = dvec3(layout.max_f) / kernel_mass(layout, pixel);
+    if (!layout.glossy_f.empty()) f_over_c = glm::max(f_over_c, dvec3(layout.glossy_f[pixel]));
     // The pixel's estimate averages its samples over every pass, and a pass without a visible
     // point has no photon part: the photon part's mean is at most k_v lambda_u / i times a
     // photon's cap, with lambda_u the bound per visible pass (n photons in k_v such passes), so
     // chi^2 / (2 i) times the cap, over all i passes (ESTIMATOR.md section 12).
     r.sparse = visible == 0 ? dvec3(0.0)
-                            : sparse_term(layout, states[pixel], pixel, f, passes, confidence);
+                            : sparse_term(layout, states[pixel], f_over_c, passes, confidence);
     // Without the photon cap a state with few photons has no bound (unknown); a pixel that never
     // had a visible point has no photon part to wait for.
     r.photon_free = visible == 0;
@@ -102,7 +107,8 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
     if (r.exact) r.radius = float(std::sqrt(states[k].r2));
     r.exact = false;
     if (!layout.point_f.empty())
-      r.sparse += sparse_term(layout, states[k], k, layout.point_f[k], passes, confidence);
+      r.sparse += sparse_term(layout, states[k], dvec3(layout.point_f[k]) / kernel_mass(layout, k),
+                              passes, confidence);
     r.known = r.known && passes >= 2 && (e.known || layout.photon_cap > 0.0) &&
               (layout.mass.empty() || layout.mass[k] >= kValidKernelMass);
   }

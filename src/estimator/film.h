@@ -96,7 +96,7 @@ struct PixelLayout {
   double photon_cap = 0.0;
   StridedColours point_f;           // PPM
   vec3 max_f{0.0f};                 // SPPM
-  std::span<const float> glossy_f;  // SPPM: per pixel, glossy points' (empty: none)
+  std::span<const float> glossy_f;  // SPPM: per pixel, glossy points' largest f / c (empty: none)
   std::vector<float> mass;          // per state; empty: 1
   double footprint = 0.0;  // median pixel footprint at the points (the errors' correlation)
 };

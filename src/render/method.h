@@ -39,7 +39,7 @@ struct RenderState {
   std::vector<uint32_t> visible;   // SPPM: passes with a visible point, per pixel
   std::vector<float> min_mass;     // SPPM: smallest kernel mass of a visible point, per pixel
   double max_photon_power = 0.0;   // largest channel of a photon's power seen (section 12)
-  std::vector<float> glossy_f;     // SPPM: largest f a glossy visible point had, per pixel
+  std::vector<float> glossy_f;     // SPPM: largest f / c a glossy visible point had, per pixel
 };
 
 class PhotonMethod {

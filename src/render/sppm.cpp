@@ -83,9 +83,14 @@ void SppmMethod::record_visible(size_t first, std::span<const VisiblePoint> poin
   }
   for (const PointBsdf& g : glossy) {  // only while the cap can still matter
     if (states[g.point].photons >= kMinPhotonsForBound) continue;
-    const float f = max_component(points[g.point].f * g.bsdf.max_f(g.wo));
+    // f / c of this pass's point: one photon adds at most w(0) f Phi_max / (c pi R^2 M_e) to
+    // this pass's sample, so the largest ratio over the passes bounds every pass, where the
+    // largest f and the smallest c, often of different points (a grazing view; a disc over a
+    // crease), bound them up to 10-100 times looser (ESTIMATOR.md section 12).
+    const double c = std::max(owner[g.point].disc.mass, kMinKernelMass);
+    const float ratio = float(max_component(points[g.point].f * g.bsdf.max_f(g.wo)) / c);
     float& cap = glossy_f_[first + g.point];
-    cap = std::max(cap, f);
+    cap = std::max(cap, ratio);
   }
 }
 

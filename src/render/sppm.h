@@ -44,7 +44,7 @@ class SppmMethod final : public PhotonMethod {
   vec3 max_f_{0.0f};               // the largest BRDF a Lambertian visible point can have
   std::vector<uint32_t> visible_;  // passes with a visible point, per pixel
   std::vector<float> min_mass_;    // smallest kernel mass seen, per pixel
-  std::vector<float> glossy_f_;    // largest glossy f seen, per pixel
+  std::vector<float> glossy_f_;    // largest glossy f / c seen, per pixel
   // One fold block's visible points, their Bsdfs where not Lambertian (each chunk's at the
   // front of its chunk's share), pass sums and owner values, reused every pass.
   std::vector<VisiblePoint> points_;

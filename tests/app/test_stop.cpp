@@ -121,40 +121,54 @@ TEST(Stop, LightThatNoPointSeesStopsWithFiniteBounds) {
 // SPPM: a pixel on the plane's edge meets the plane in some passes and the black background in
 // the others, and its estimate is the mean over every pass. With the light under the plane no
 // photon lands and all its samples are 0, so its bound is the sparse-photon bound alone:
-// chi^2 / (2 i) x its cap = ln(10) / i x w(0) Phi_max f / (c pi R^2 M_e) at 90%, with i all the
-// passes (ESTIMATOR.md section 12). Dividing by the passes with a visible point instead made it
-// i / k_v times wider, widest where the visible point is rare. Exact to float rounding (1e-5).
+// chi^2 / (2 i) x its cap = ln(10) / i x w(0) Phi_max (f / c) / (pi R^2 M_e) at 90%, with i all
+// the passes (ESTIMATOR.md section 12). Dividing by the passes with a visible point instead made
+// it i / k_v times wider, widest where the visible point is rare. Exact to float rounding
+// (1e-5). A Lambertian plane (the scene's largest Lambertian f over the pixel's smallest c) and
+// a rough metal one (glTF's default material: the largest f / c its glossy points had, which
+// the bound must take as it is, not divided by c again).
 TEST(Stop, SppmSparseBoundOfAPartlyCoveredPixelCountsEveryPass) {
-  test::SceneBuilder b;
-  b.quad(vec3(0), vec3(1, 0, 0), vec3(0, 0, -1), b.material(vec3(0.5f)));
-  b.point_light(vec3(0, -1, 0), vec3(10.0f));
-  b.camera(vec3(0, 3, 0), vec3(0), 0.8f, vec3(0, 0, -1));
-  RenderOptions o = test::quick_options("plane_point.gltf", 16, 1);
-  o.method = Method::SPPM;
-  o.photons_per_pass = 2000;
-  o.confidence = 0.9;
-  Renderer r(std::move(b.scene), o);
-  const uint64_t passes = 40;
-  for (uint64_t k = 0; k < passes; ++k) r.step();
-  FilmImage img;
-  r.develop(&img);
-  const PixelLayout l = r.layout();
-  int partial = 0;
-  for (size_t p = 0; p < r.states().size(); ++p) {
-    const uint32_t v = l.visible_passes[p];
-    if (v == 0 || v == passes) continue;
-    ++partial;
-    const PointState& s = r.states()[p];
-    ASSERT_EQ(s.photons, 0u);
-    const double c = std::max(double(l.mass[p]), kMinKernelMass);
-    for (int ch = 0; ch < 3; ++ch) {
-      const double f = std::max(l.max_f[ch], l.glossy_f.empty() ? 0.0f : l.glossy_f[p]);
-      const double want = std::log(10.0) / double(passes) * l.photon_cap * f / (c * kPiD * s.r2);
-      EXPECT_NEAR(img.bound[3 * p + size_t(ch)], want, 1e-5 * want)
-          << "pixel " << p << ", visible in " << v << " of " << passes << " passes";
+  for (const bool metal : {false, true}) {
+    SCOPED_TRACE(metal ? "rough metal" : "Lambertian");
+    test::SceneBuilder b;
+    const uint32_t mat = b.material(vec3(0.5f));
+    if (metal) b.scene.materials[mat] = Material::metal(vec3(0.5f), 1.0f);
+    b.quad(vec3(0), vec3(1, 0, 0), vec3(0, 0, -1), mat);
+    b.point_light(vec3(0, -1, 0), vec3(10.0f));
+    b.camera(vec3(0, 3, 0), vec3(0), 0.8f, vec3(0, 0, -1));
+    RenderOptions o = test::quick_options("plane_point.gltf", 16, 1);
+    o.method = Method::SPPM;
+    o.photons_per_pass = 2000;
+    o.confidence = 0.9;
+    Renderer r(std::move(b.scene), o);
+    const uint64_t passes = 40;
+    for (uint64_t k = 0; k < passes; ++k) r.step();
+    FilmImage img;
+    r.develop(&img);
+    const PixelLayout l = r.layout();
+    int partial = 0, glossy = 0;
+    for (size_t p = 0; p < r.states().size(); ++p) {
+      const uint32_t v = l.visible_passes[p];
+      if (v == 0 || v == passes) continue;
+      ++partial;
+      const PointState& s = r.states()[p];
+      ASSERT_EQ(s.photons, 0u);
+      const double c = std::max(double(l.mass[p]), kMinKernelMass);
+      const double glossy_cap = l.glossy_f.empty() ? 0.0 : double(l.glossy_f[p]);
+      glossy += glossy_cap > 0.0;
+      for (int ch = 0; ch < 3; ++ch) {
+        const double f_over_c = std::max(l.max_f[ch] / c, glossy_cap);
+        const double want =
+            std::log(10.0) / double(passes) * l.photon_cap * f_over_c / (kPiD * s.r2);
+        EXPECT_NEAR(img.bound[3 * p + size_t(ch)], want, 1e-5 * want)
+            << "pixel " << p << ", visible in " << v << " of " << passes << " passes";
+      }
     }
+    EXPECT_GT(partial, 4);  // the plane's edges cross pixels
+    // The metal plane's pixels bound with their glossy caps, the Lambertian's with max_f.
+    if (metal) EXPECT_EQ(glossy, partial);
+    else EXPECT_EQ(glossy, 0);
   }
-  EXPECT_GT(partial, 4);  // the plane's edges cross pixels
 }
 
 // A plane under a point light with, 0.3 above it, a sliver 0.12 wide across the view, at a radius

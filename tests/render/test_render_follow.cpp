@@ -178,7 +178,8 @@ TEST(PassOver, ASharpLobeAtTheDepthLimitIsFollowedNotGathered) {
   // roughness 0.1 gathered there with its whole Bsdf gives its pixels the lobe's peak f (about
   // 1/(pi alpha^2) = 3183 here) as the sparse-photon bound's f (ESTIMATOR.md section 12); split
   // off and followed by roulette, the floor's pixels gather where the lobe leads (the
-  // Lambertian walls), so no pixel's glossy f exceeds the walls' 0.6 / pi. The image stays an
+  // Lambertian walls), so no pixel keeps a glossy cap f / c above 1 (the floor gathers nothing:
+  // 0), where the peak over a disc of full mass would be 3183. The image stays an
   // estimate of the same light: within 4 sd of a render at --max-depth 8, whose only extra light
   // is what depth-1+ delta chains would add (there are none in this room).
   RenderOptions o = sppm(kDefaultFollowRoughness, 32);
@@ -188,8 +189,8 @@ TEST(PassOver, ASharpLobeAtTheDepthLimitIsFollowedNotGathered) {
   for (uint64_t p = 0; p < 32; ++p) r.step();
   const PixelLayout l = r.layout();
   float largest = 0.0f;
-  for (float f : l.glossy_f) largest = std::max(largest, f);
-  std::printf("sharp lobe at --max-depth 0: largest glossy f %.3g\n", double(largest));
+  for (float f_over_c : l.glossy_f) largest = std::max(largest, f_over_c);
+  std::printf("sharp lobe at --max-depth 0: largest glossy f / c %.3g\n", double(largest));
   EXPECT_LT(largest, 1.0f);
   const Result limited = render(scene, o);
   RenderOptions deep = o;
