@@ -56,6 +56,58 @@ uint64_t exr_lines_per_chunk(unsigned code) {
   return code < 10 ? lines[code] : 256;
 }
 
+// The bytes OpenEXR reads for a value of a type whose length is fixed (ImfStandardAttributes,
+// the Typed attributes' readValueFrom); 0 for the others.
+uint64_t exr_fixed_size(const std::string& type) {
+  static const std::pair<const char*, uint64_t> sizes[] = {
+      {"box2i", 16},  {"box2f", 16},    {"int", 4},           {"float", 4},
+      {"double", 8},  {"compression", 1}, {"lineOrder", 1},   {"envmap", 1},
+      {"v2i", 8},     {"v2f", 8},       {"v2d", 16},          {"v3i", 12},
+      {"v3f", 12},    {"v3d", 24},      {"m33f", 36},         {"m33d", 72},
+      {"m44f", 64},   {"m44d", 128},    {"tiledesc", 9},      {"rational", 8},
+      {"keycode", 28}, {"timecode", 8}, {"chromaticities", 32}, {"deepImageState", 1}};
+  for (const auto& [name, size] : sizes)
+    if (type == name) return size;
+  return 0;
+}
+
+// OpenEXR reads a value of a known type by what the type says, not by the size the attribute
+// declares (a channel list up to its empty name, a box as 16 bytes), and goes on reading the
+// header from where that ends: a file whose declared size differs would be read one way here
+// and another way there (the fuzzer's second run found two such, each then allocating 1.9 GB
+// for a string this walk never saw). So the declared size must be what the type reads.
+void check_exr_value(const Bytes& b, const std::string& name, const std::string& type,
+                     uint64_t at, uint64_t size, uint64_t max_name) {
+  auto mismatch = [&](uint64_t reads) {
+    b.refuse("EXR attribute '" + name + "' of type " + type + " declares " +
+             std::to_string(size) + " bytes where its value reads " + std::to_string(reads));
+  };
+  if (const uint64_t fixed = exr_fixed_size(type)) {
+    if (size != fixed) mismatch(fixed);
+  } else if (type == "chlist") {
+    // Channels: a name (up to max_name bytes and a null), then 16 bytes; an empty name ends it.
+    uint64_t p = at;
+    for (;;) {
+      uint64_t k = 0;
+      unsigned char c = 1;
+      for (; k <= max_name && b.get(p + k, 1, &c) && c != 0; ++k) {
+      }
+      if (c != 0) b.refuse("EXR attribute '" + name + "' holds a channel name that does not end");
+      p += k + 1;
+      if (k == 0) break;
+      p += 16;
+      if (p > at + size) break;
+    }
+    if (p - at != size) mismatch(p - at);
+  } else if (type == "preview") {
+    // Width and height, then 4 bytes per pixel: OpenEXR allocates them from the two ints.
+    uint64_t w = 0, h = 0;
+    if (size < 8 || !b.uint(at, 4, false, w) || !b.uint(at + 4, 4, false, h) ||
+        saturating_add(8, saturating_mul(saturating_mul(w, h), 4)) != size)
+      mismatch(8 + 4 * w * h);
+  }
+}
+
 void check_exr(const Bytes& b, uint64_t max_texels) {
   uint64_t version = 0;
   if (!b.uint(4, 4, false, version)) b.refuse("the EXR file ends inside its version field");
@@ -98,6 +150,7 @@ void check_exr(const Bytes& b, uint64_t max_texels) {
       if (size > 0x7fffffff || !b.holds(at, size))
         b.refuse("EXR attribute '" + name + "' claims " + bytes_text(size) + ", more than the " +
                  std::to_string(b.size() - std::min(at, b.size())) + " bytes after it");
+      check_exr_value(b, name, type, at, size, max_name);
       uint64_t v = 0;
       if (name == "dataWindow" && type == "box2i" && size == 16) {
         for (int k = 0; k < 4; ++k) {
