@@ -76,8 +76,10 @@ uint64_t exr_fixed_size(const std::string& type) {
 // header from where that ends: a file whose declared size differs would be read one way here
 // and another way there (the fuzzer's second run found two such, each then allocating 1.9 GB
 // for a string this walk never saw). So the declared size must be what the type reads.
-void check_exr_value(const Bytes& b, const std::string& name, const std::string& type,
-                     uint64_t at, uint64_t size, uint64_t max_name) {
+// Returns, for a channel list, the bytes of one pixel of all its channels (UINT and FLOAT 4,
+// HALF 2); 0 for other types.
+uint64_t check_exr_value(const Bytes& b, const std::string& name, const std::string& type,
+                         uint64_t at, uint64_t size, uint64_t max_name) {
   auto mismatch = [&](uint64_t reads) {
     b.refuse("EXR attribute '" + name + "' of type " + type + " declares " +
              std::to_string(size) + " bytes where its value reads " + std::to_string(reads));
@@ -85,8 +87,9 @@ void check_exr_value(const Bytes& b, const std::string& name, const std::string&
   if (const uint64_t fixed = exr_fixed_size(type)) {
     if (size != fixed) mismatch(fixed);
   } else if (type == "chlist") {
-    // Channels: a name (up to max_name bytes and a null), then 16 bytes; an empty name ends it.
-    uint64_t p = at;
+    // Channels: a name (up to max_name bytes and a null), then the pixel type (int: 0 UINT,
+    // 1 HALF, 2 FLOAT) and 12 bytes more; an empty name ends it.
+    uint64_t p = at, pixel_bytes = 0;
     for (;;) {
       uint64_t k = 0;
       unsigned char c = 1;
@@ -95,10 +98,14 @@ void check_exr_value(const Bytes& b, const std::string& name, const std::string&
       if (c != 0) b.refuse("EXR attribute '" + name + "' holds a channel name that does not end");
       p += k + 1;
       if (k == 0) break;
+      uint64_t pixel_type = 2;
+      b.uint(p, 4, false, pixel_type);
+      pixel_bytes += pixel_type == 1 ? 2 : 4;
       p += 16;
       if (p > at + size) break;
     }
     if (p - at != size) mismatch(p - at);
+    return pixel_bytes;
   } else if (type == "preview") {
     // Width and height, then 4 bytes per pixel: OpenEXR allocates them from the two ints.
     uint64_t w = 0, h = 0;
@@ -106,9 +113,10 @@ void check_exr_value(const Bytes& b, const std::string& name, const std::string&
         saturating_add(8, saturating_mul(saturating_mul(w, h), 4)) != size)
       mismatch(8 + 4 * w * h);
   }
+  return 0;
 }
 
-void check_exr(const Bytes& b, uint64_t max_texels) {
+void check_exr(const Bytes& b, uint64_t max_texels, uint64_t max_bytes) {
   uint64_t version = 0;
   if (!b.uint(4, 4, false, version)) b.refuse("the EXR file ends inside its version field");
   const bool long_names = version & 0x400, multipart = version & 0x1000;
@@ -137,7 +145,7 @@ void check_exr(const Bytes& b, uint64_t max_texels) {
     int64_t window[4] = {0, 0, -1, -1};
     bool has_window = false, tiled = single_tiled;
     unsigned compression = 0;
-    uint64_t tile_x = 0, tile_y = 0, chunk_count = 0;
+    uint64_t tile_x = 0, tile_y = 0, chunk_count = 0, pixel_bytes = 0;
     bool has_chunk_count = false;
     std::string name, type;
     for (;;) {
@@ -150,7 +158,8 @@ void check_exr(const Bytes& b, uint64_t max_texels) {
       if (size > 0x7fffffff || !b.holds(at, size))
         b.refuse("EXR attribute '" + name + "' claims " + bytes_text(size) + ", more than the " +
                  std::to_string(b.size() - std::min(at, b.size())) + " bytes after it");
-      check_exr_value(b, name, type, at, size, max_name);
+      const uint64_t channel_bytes = check_exr_value(b, name, type, at, size, max_name);
+      if (name == "channels") pixel_bytes = channel_bytes;
       uint64_t v = 0;
       if (name == "dataWindow" && type == "box2i" && size == 16) {
         for (int k = 0; k < 4; ++k) {
@@ -184,15 +193,28 @@ void check_exr(const Bytes& b, uint64_t max_texels) {
         b.refuse("the EXR data window is " + std::to_string(w) + "x" + std::to_string(h) +
                  " pixels, over the " + std::to_string(max_texels) + " this read allows");
       // Every chunk has an 8-byte entry in the offset table after the headers: the chunks of
-      // level 0 alone are a lower bound on the table's length.
-      uint64_t n;
+      // level 0 alone are a lower bound on the table's length. And OpenEXR allocates the
+      // buffers of one whole chunk (every line of it, however few the image has) when it
+      // opens the file: 6 million pixels wide and 1 high, in 32-line chunks, 3 GB for a file
+      // of 490 bytes (the fuzzer's third run). That must fit in what the read may take.
+      uint64_t n, chunk_pixels;
       if (tiled) {
         if (tile_x == 0 || tile_y == 0) b.refuse("an EXR tile size is 0");
         n = ((uint64_t(w) + tile_x - 1) / tile_x) * ((uint64_t(h) + tile_y - 1) / tile_y);
+        chunk_pixels = saturating_mul(tile_x, tile_y);
       } else {
         const uint64_t lines = exr_lines_per_chunk(compression);
         n = (uint64_t(h) + lines - 1) / lines;
+        chunk_pixels = uint64_t(w) * lines;
       }
+      // At least 256 MiB (a 16384-pixel line of 4 floats in DWAB's 256-line chunks takes
+      // 64 MiB), so that a small budget does not refuse a small image for its chunk's lines.
+      const uint64_t chunk_bytes = saturating_mul(chunk_pixels, pixel_bytes);
+      const uint64_t allowed = std::max(max_bytes, uint64_t(256) << 20);
+      if (chunk_bytes > allowed)
+        b.refuse("one EXR chunk of " + std::to_string(chunk_pixels) + " pixels takes " +
+                 bytes_text(chunk_bytes) + " to decode, over the " + bytes_text(allowed) +
+                 " this read may take");
       chunks = saturating_add(chunks, n);
     }
     if (has_chunk_count) chunks = saturating_add(chunks, chunk_count);
@@ -291,11 +313,11 @@ void check_tiff(const Bytes& b, bool big_endian, uint64_t max_texels) {
 }  // namespace
 
 void check_container(const ByteReader& read, uint64_t size, const std::string& name,
-                     uint64_t max_texels) {
+                     uint64_t max_texels, uint64_t max_bytes) {
   const Bytes b(read, size, name);
   unsigned char head[4];
   if (!b.get(0, 4, head)) return;
-  if (std::memcmp(head, "\x76\x2f\x31\x01", 4) == 0) check_exr(b, max_texels);
+  if (std::memcmp(head, "\x76\x2f\x31\x01", 4) == 0) check_exr(b, max_texels, max_bytes);
   const bool le = std::memcmp(head, "II", 2) == 0, be = std::memcmp(head, "MM", 2) == 0;
   if (le || be) {
     uint64_t magic = 0;
@@ -305,16 +327,16 @@ void check_container(const ByteReader& read, uint64_t size, const std::string& n
 }
 
 void check_container(const unsigned char* data, uint64_t size, const std::string& name,
-                     uint64_t max_texels) {
+                     uint64_t max_texels, uint64_t max_bytes) {
   const ByteReader read = [&](uint64_t offset, uint64_t n, unsigned char* out) {
     if (offset > size || n > size - offset) return false;
     if (n) std::memcpy(out, data + offset, size_t(n));
     return true;
   };
-  check_container(read, size, name, max_texels);
+  check_container(read, size, name, max_texels, max_bytes);
 }
 
-void check_container_file(const std::string& path, uint64_t max_texels) {
+void check_container_file(const std::string& path, uint64_t max_texels, uint64_t max_bytes) {
   std::ifstream f(path, std::ios::binary);
   if (!f) return;
   f.seekg(0, std::ios::end);
@@ -326,7 +348,7 @@ void check_container_file(const std::string& path, uint64_t max_texels) {
     f.read(reinterpret_cast<char*>(out), std::streamsize(n));
     return f.good() || uint64_t(f.gcount()) == n;
   };
-  check_container(read, uint64_t(end), path, max_texels);
+  check_container(read, uint64_t(end), path, max_texels, max_bytes);
 }
 
 }  // namespace pb

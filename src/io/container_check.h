@@ -18,17 +18,18 @@ namespace pb {
 using ByteReader = std::function<bool(uint64_t offset, uint64_t n, unsigned char* out)>;
 
 // Throws ImageError (io/image_io.h) starting with `name` when the bytes (`size` of them, read
-// through `read`) are an EXR or TIFF file whose structure claims more than they hold, or more
-// than `max_texels` texels (counting TIFF samples in a pixel as texels). Other formats, and
-// structures it does not know, pass unchecked: the decoder's own checks apply to them.
+// through `read`) are an EXR or TIFF file whose structure claims more than they hold, more
+// than `max_texels` texels (a TIFF: or 4 x max_texels samples), or an EXR chunk whose decoding
+// buffers take more than `max_bytes`. Other formats, and structures it does not know, pass
+// unchecked: the decoder's own checks apply to them.
 void check_container(const ByteReader& read, uint64_t size, const std::string& name,
-                     uint64_t max_texels);
+                     uint64_t max_texels, uint64_t max_bytes);
 
 // The same for bytes in memory.
 void check_container(const unsigned char* data, uint64_t size, const std::string& name,
-                     uint64_t max_texels);
+                     uint64_t max_texels, uint64_t max_bytes);
 
 // The same for a file (read in pieces; an unreadable file passes, for the reader to report).
-void check_container_file(const std::string& path, uint64_t max_texels);
+void check_container_file(const std::string& path, uint64_t max_texels, uint64_t max_bytes);
 
 }  // namespace pb

@@ -131,7 +131,7 @@ void check_read(const std::string& path, OIIO::ImageInput& in, bool ok) {
 }  // namespace
 
 ExrImage read_exr(const std::string& path, const ReadLimit& limit) {
-  check_container_file(path, max_texels(limit));
+  check_container_file(path, max_texels(limit), limit.max_bytes);
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw ImageError(path + ": cannot read image: " + one_line(OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
@@ -271,7 +271,7 @@ Image decode_image(const unsigned char* data, size_t size, const std::string& na
                      ": cannot decode the image: it is KTX2 (Basis Universal), which "
                      "photonbound does not read");
   // Before any reader sees the bytes: the scan below offers them to every format's reader.
-  check_container(data, size, name, kMaxTexels);
+  check_container(data, size, name, kMaxTexels, max_bytes);
   const QuietStderr quiet;
   const std::string file = format_name(data, size, name);
   BoundedMemReader memory(data, size);
@@ -371,7 +371,7 @@ uint64_t image_bytes(const Image& image) {
 }
 
 RgbImage read_rgb_image(const std::string& path, const ReadLimit& limit) {
-  check_container_file(path, max_texels(limit));
+  check_container_file(path, max_texels(limit), limit.max_bytes);
   auto in = OIIO::ImageInput::open(path);
   if (!in) throw ImageError(path + ": cannot read image: " + one_line(OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();

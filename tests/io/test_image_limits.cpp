@@ -446,6 +446,7 @@ TEST(ContainerCheck, TiffDataPastTheEndOfTheFileIsRefused) {
 TEST(ContainerCheck, TheImageFuzzersFindingsAreRefusedWithOneLine) {
   // Kept from tools/fuzz.sh image (tests/data/fuzz/README.md): 15 EXRs whose attributes claim
   // 0.8 to 2 GB, or a name of 70 bytes, 2 whose channel list is shorter than its declared size,
+  // an EXR 6 million pixels wide whose one 32-line chunk OpenEXR allocated (3 GB for 490 bytes),
   // and 2 TIFFs whose data lies past their end, each refused by the container check; and one
   // TIFF (rss-*) that the fuzzer blamed for its process's memory but that needs 135 MB alone,
   // refused by libtiff.
