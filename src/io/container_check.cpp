@@ -59,6 +59,7 @@ uint64_t exr_lines_per_chunk(unsigned code) {
 // The bytes OpenEXR reads for a value of a type whose length is fixed (ImfStandardAttributes,
 // the Typed attributes' readValueFrom); 0 for the others.
 uint64_t exr_fixed_size(const std::string& type) {
+  // clang-format off
   static const std::pair<const char*, uint64_t> sizes[] = {
       {"box2i", 16},  {"box2f", 16},    {"int", 4},           {"float", 4},
       {"double", 8},  {"compression", 1}, {"lineOrder", 1},   {"envmap", 1},
@@ -66,6 +67,7 @@ uint64_t exr_fixed_size(const std::string& type) {
       {"v3f", 12},    {"v3d", 24},      {"m33f", 36},         {"m33d", 72},
       {"m44f", 64},   {"m44d", 128},    {"tiledesc", 9},      {"rational", 8},
       {"keycode", 28}, {"timecode", 8}, {"chromaticities", 32}, {"deepImageState", 1}};
+  // clang-format on
   for (const auto& [name, size] : sizes)
     if (type == name) return size;
   return 0;
@@ -81,8 +83,8 @@ uint64_t exr_fixed_size(const std::string& type) {
 uint64_t check_exr_value(const Bytes& b, const std::string& name, const std::string& type,
                          uint64_t at, uint64_t size, uint64_t max_name) {
   auto mismatch = [&](uint64_t reads) {
-    b.refuse("EXR attribute '" + name + "' of type " + type + " declares " +
-             std::to_string(size) + " bytes where its value reads " + std::to_string(reads));
+    b.refuse("EXR attribute '" + name + "' of type " + type + " declares " + std::to_string(size) +
+             " bytes where its value reads " + std::to_string(reads));
   };
   if (const uint64_t fixed = exr_fixed_size(type)) {
     if (size != fixed) mismatch(fixed);
@@ -228,20 +230,18 @@ void check_exr(const Bytes& b, uint64_t max_texels, uint64_t max_bytes) {
 // ---- TIFF (TIFF 6.0 section 2; BigTIFF: 8-byte counts and offsets) ----
 
 uint64_t tiff_type_size(uint64_t type) {
-  switch (type) {
-    case 1: case 2: case 6: case 7: return 1;   // BYTE, ASCII, SBYTE, UNDEFINED
-    case 3: case 8: return 2;                   // SHORT, SSHORT
-    case 4: case 9: case 11: case 13: return 4;  // LONG, SLONG, FLOAT, IFD
-    case 5: case 10: case 12: case 16: case 17: case 18: return 8;  // RATIONALs, DOUBLE, 64-bit
-    default: return 0;  // unknown: libtiff skips the entry
-  }
+  // By type code: 1 BYTE, 2 ASCII, 3 SHORT, 4 LONG, 5 RATIONAL, 6 SBYTE, 7 UNDEFINED, 8 SSHORT,
+  // 9 SLONG, 10 SRATIONAL, 11 FLOAT, 12 DOUBLE, 13 IFD, 16 LONG8, 17 SLONG8, 18 IFD8; 0 for a
+  // code libtiff does not know, whose entry it skips.
+  static const uint8_t sizes[] = {0, 1, 1, 2, 4, 8, 1, 1, 2, 4, 8, 4, 8, 4, 0, 0, 8, 8, 8};
+  return type < sizeof sizes ? sizes[type] : 0;
 }
 
 void check_tiff(const Bytes& b, bool big_endian, uint64_t max_texels) {
   uint64_t magic = 0;
   b.uint(2, 2, big_endian, magic);
   const bool big = magic == 43;
-  const int word = big ? 8 : 4;                     // offsets, counts and inline values
+  const int word = big ? 8 : 4;  // offsets, counts and inline values
   const uint64_t entry = big ? 20 : 12, count_bytes = big ? 8 : 2;
   uint64_t ifd = 0;
   if (!b.uint(big ? 8 : 4, word, big_endian, ifd)) b.refuse("the TIFF file ends in its header");
@@ -273,7 +273,8 @@ void check_tiff(const Bytes& b, bool big_endian, uint64_t max_texels) {
                    " at offset " + std::to_string(data) + ", past the end of the file's " +
                    std::to_string(b.size()) + " bytes");
       }
-      if (count == 1 && (type == 3 || type == 4 || type == 16)) b.uint(field, int(unit), big_endian, value);
+      if (count == 1 && (type == 3 || type == 4 || type == 16))
+        b.uint(field, int(unit), big_endian, value);
       if (tag == 256) width = value;
       if (tag == 257) height = value;
       if (tag == 277) samples = std::max<uint64_t>(value, 1);
@@ -283,9 +284,9 @@ void check_tiff(const Bytes& b, bool big_endian, uint64_t max_texels) {
     if (index == 0) {
       const uint64_t texels = saturating_mul(width, height);
       if (texels > max_texels || saturating_mul(texels, samples) > saturating_mul(max_texels, 4))
-        b.refuse("the TIFF header claims " + std::to_string(width) + "x" +
-                 std::to_string(height) + " pixels of " + std::to_string(samples) +
-                 " samples, over the " + std::to_string(max_texels) + " texels this read allows");
+        b.refuse("the TIFF header claims " + std::to_string(width) + "x" + std::to_string(height) +
+                 " pixels of " + std::to_string(samples) + " samples, over the " +
+                 std::to_string(max_texels) + " texels this read allows");
     }
     // Each strip or tile lies inside the file (read only for tables of a sane length: a valid
     // file's table is inside it, which the loop above checked).

@@ -166,8 +166,10 @@ TEST(Stop, SppmSparseBoundOfAPartlyCoveredPixelCountsEveryPass) {
     }
     EXPECT_GT(partial, 4);  // the plane's edges cross pixels
     // The metal plane's pixels bound with their glossy caps, the Lambertian's with max_f.
-    if (metal) EXPECT_EQ(glossy, partial);
-    else EXPECT_EQ(glossy, 0);
+    if (metal)
+      EXPECT_EQ(glossy, partial);
+    else
+      EXPECT_EQ(glossy, 0);
   }
 }
 

@@ -317,10 +317,9 @@ TEST(ContainerCheck, ExrAndTiffFilesOfEveryLayoutStillDecode) {
     const float first_value = im.u8.empty() ? im.f32.front() : im.u8.front() / 255.0f;
     const float last_value = im.u8.empty() ? im.f32.back() : im.u8.back() / 255.0f;
     // Within half's and 8 bits' rounding, and B44/DWA's lossy coding.
-    const float tol = c.what.find("b44") != std::string::npos ||
-                              c.what.find("dwa") != std::string::npos
-                          ? 0.05f
-                          : 0.005f;
+    const float tol =
+        c.what.find("b44") != std::string::npos || c.what.find("dwa") != std::string::npos ? 0.05f
+                                                                                           : 0.005f;
     EXPECT_NEAR(first_value, 0.0f, tol);
     EXPECT_NEAR(last_value, float(last % 1000) / 1000.0f, tol);
   }
@@ -429,7 +428,8 @@ TEST(ContainerCheck, TiffDataPastTheEndOfTheFileIsRefused) {
   const size_t n = size_t(good[ifd]) | size_t(good[ifd + 1]) << 8;
   size_t strip_counts = 0;  // the entry of tag 279, StripByteCounts
   for (size_t k = 0; k < n; ++k)
-    if ((good[ifd + 2 + 12 * k] | good[ifd + 3 + 12 * k] << 8) == 279) strip_counts = ifd + 2 + 12 * k;
+    if ((good[ifd + 2 + 12 * k] | good[ifd + 3 + 12 * k] << 8) == 279)
+      strip_counts = ifd + 2 + 12 * k;
   ASSERT_GT(strip_counts, 0u);
   // One strip (13x7 RGB fits the default rows a strip): its byte count is the value itself.
   std::string m = decode_error(patched32(good, strip_counts + 8, 50000000u), "strip.tif");
