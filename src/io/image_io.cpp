@@ -121,6 +121,30 @@ void check_whole_read(const std::string& path, const OIIO::ImageInput& in, const
                      std::to_string(size) + " bytes can hold: a corrupt or hostile file");
 }
 
+// OpenImageIO reads scan lines it must convert (half or 16-bit to float, or with per-channel
+// formats) through one buffer of round_up(max(2^26 / scanline bytes, 256), rows per strip) rows,
+// however few the image has (ImageInput::read_scanlines; 256 is its "read_chunk", the rows per
+// strip TIFF's tag or 64): an EXR 1,048,592 pixels wide and one high took 2 GiB for 481 bytes, a
+// TIFF 65,526 wide claiming 24,946 rows per strip 13 GB (tools/fuzz.sh image, fourth run).
+// Refused when that buffer is over what the read may take (at least 256 MiB: a 16384-pixel row
+// of 4 floats takes 64 MiB in 256 rows).
+void check_read_chunk(const std::string& name, const OIIO::ImageSpec& spec, OIIO::TypeDesc to,
+                      uint64_t max_bytes) {
+  if (spec.tile_width > 0) return;                               // tiles are read one at a time
+  if (to == spec.format && spec.channelformats.empty()) return;  // read in place
+  const uint64_t scanline = std::max<uint64_t>(spec.scanline_bytes(/*native=*/true), 1);
+  const uint64_t rps = uint64_t(std::max(spec.get_int_attribute("tiff:RowsPerStrip", 64), 1));
+  const uint64_t rows = std::max<uint64_t>((uint64_t(1) << 26) / scanline, 256);
+  const uint64_t buffer = saturating_mul((rows + rps - 1) / rps * rps, scanline);
+  const uint64_t allowed = std::max(max_bytes, uint64_t(256) << 20);
+  if (buffer > allowed)
+    throw ImageError(name + ": the image is " + std::to_string(spec.width) + "x" +
+                     std::to_string(spec.height) + " pixels of " + bytes_text(scanline) +
+                     " a row; OpenImageIO would decode it through a buffer of " +
+                     bytes_text(buffer) + ", over the " + bytes_text(allowed) +
+                     " this read may take");
+}
+
 // read_image returned `ok`; a reader may also have recorded an error and returned true.
 void check_read(const std::string& path, OIIO::ImageInput& in, bool ok) {
   if (!ok || in.has_error())
@@ -136,6 +160,7 @@ ExrImage read_exr(const std::string& path, const ReadLimit& limit) {
   if (!in) throw ImageError(path + ": cannot read image: " + one_line(OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
   check_whole_read(path, *in, limit);
+  check_read_chunk(path, spec, OIIO::TypeDesc::FLOAT, limit.max_bytes);
   ExrImage image;
   image.width = spec.width;
   image.height = spec.height;
@@ -340,6 +365,7 @@ Image decode_image(const unsigned char* data, size_t size, const std::string& na
                      "; photonbound reads 1 to 4 channels and up to 2^28 texels");
   check_plausible(*in, data, size, name, claim);
   const bool u8 = spec.format == OIIO::TypeDesc::UINT8;
+  check_read_chunk(name, spec, u8 ? OIIO::TypeDesc::UINT8 : OIIO::TypeDesc::FLOAT, max_bytes);
   const size_t values = size_t(texels) * size_t(im.channels);
   const uint64_t bytes = uint64_t(values) * (u8 ? 1 : sizeof(float));
   if (bytes > max_bytes)
@@ -376,6 +402,7 @@ RgbImage read_rgb_image(const std::string& path, const ReadLimit& limit) {
   if (!in) throw ImageError(path + ": cannot read image: " + one_line(OIIO::geterror()));
   const OIIO::ImageSpec& spec = in->spec();
   check_whole_read(path, *in, limit);
+  check_read_chunk(path, spec, OIIO::TypeDesc::FLOAT, limit.max_bytes);
   const size_t pixels = size_t(spec.width) * size_t(spec.height);
   if (pixels * size_t(spec.nchannels) > (size_t(1) << 29))
     throw ImageError(path + ": " + std::to_string(spec.width) + "x" + std::to_string(spec.height) +
