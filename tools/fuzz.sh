@@ -37,18 +37,25 @@ if [ "$target" = loader ]; then
 else
   corpus="$root/build-fuzz/corpus-image"
   mkdir -p "$corpus"
-  # Seeds: a 16x12 gradient in every format this OpenImageIO writes (8- and 16-bit, float).
+  # Seeds: a 16x12 gradient in glTF's formats (PNG 8 and 16 bit, grey, grey + alpha, RGB,
+  # RGBA; baseline and progressive JPEG; WebP) and, for the refusal path, the other formats
+  # OpenImageIO writes here.
   /usr/bin/python3 - "$corpus" <<'PY'
 import sys
 import numpy as np
 import OpenImageIO as oiio
 out = sys.argv[1]
 pixels = np.linspace(0.0, 1.0, 16 * 12 * 4, dtype=np.float32).reshape(12, 16, 4)
-for ext, fmt, ch in [("png", "uint8", 4), ("png", "uint16", 3), ("jpg", "uint8", 3),
-                     ("tga", "uint8", 4), ("bmp", "uint8", 3), ("hdr", "float", 3),
-                     ("exr", "half", 4), ("tif", "uint16", 4), ("ppm", "uint8", 3)]:
+for ext, fmt, ch, extra in [
+        ("png", "uint8", 4, None), ("png", "uint16", 3, None), ("png", "uint8", 1, None),
+        ("png", "uint16", 2, None), ("jpg", "uint8", 3, None), ("jpg", "uint8", 1, None),
+        ("jpg", "uint8", 3, "jpeg:progressive"), ("webp", "uint8", 3, None),
+        ("webp", "uint8", 4, None), ("tga", "uint8", 4, None), ("bmp", "uint8", 3, None),
+        ("hdr", "float", 3, None), ("exr", "half", 4, None), ("tif", "uint16", 4, None)]:
     spec = oiio.ImageSpec(16, 12, ch, fmt)
-    path = f"{out}/seed_{fmt}_{ch}.{ext}"
+    if extra:
+        spec.attribute(extra, 1)
+    path = f"{out}/seed_{fmt}_{ch}{'_' + extra.split(':')[1] if extra else ''}.{ext}"
     o = oiio.ImageOutput.create(path)
     if o and o.open(path, spec):
         o.write_image(pixels[:, :, :ch])

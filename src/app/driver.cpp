@@ -85,6 +85,13 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
   if (state_.next_check == 0) state_.next_check = o.min_passes;
   RenderReport report;
   bool developed = false;
+  double develop_seconds = 0.0;  // this pass's develop
+  auto develop = [&] {
+    const auto start = Clock::now();
+    report.summary = renderer_.develop();
+    developed = true;
+    develop_seconds = seconds_since(start);
+  };
   // A resumed render that already did its passes does not run another one.
   if (o.passes && renderer_.passes() >= *o.passes) report.stop = StopReason::Passes;
   // Ctrl-C and the end of --time cut the pass in progress (docs/usage.md "Stop rules").
@@ -107,9 +114,9 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
       // The render is the last whole pass's: its summary, told again with the stop (observers
       // do not repeat a pass they have written).
       report.stop = interrupt && interrupt->load() ? StopReason::Interrupted : StopReason::Time;
-      report.summary = renderer_.develop();
-      developed = true;
-      const PassInfo info{renderer_, state_, pass, run_seconds, true, report.summary, report.stop};
+      develop();
+      const PassInfo info{renderer_, state_,         pass,        run_seconds,
+                          true,      report.summary, report.stop, develop_seconds};
       for (PassObserver* obs : observers) obs->after_pass(info);
       break;
     }
@@ -117,8 +124,9 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
     const bool check = o.target_error && pass >= state_.next_check;
     bool want = check;
     for (PassObserver* obs : observers) want = obs->wants_summary(pass, run_seconds) || want;
-    developed = want;
-    if (developed) report.summary = renderer_.develop();
+    developed = false;
+    develop_seconds = 0.0;
+    if (want) develop();
     if (check) {
       // Sparse schedule (ESTIMATOR.md section 7): checks about 10% apart in pass count, so the
       // criterion is not retried after every pass (optional stopping).
@@ -149,12 +157,9 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
     if (check && report.summary.model_refuted) report.stop = StopReason::ModelRefuted;
     if (interrupt && interrupt->load()) report.stop = StopReason::Interrupted;
 
-    if (report.stop != StopReason::None && !developed) {
-      report.summary = renderer_.develop();
-      developed = true;
-    }
-    const PassInfo info{renderer_, state_,         pass,       run_seconds,
-                        developed, report.summary, report.stop};
+    if (report.stop != StopReason::None && !developed) develop();
+    const PassInfo info{renderer_, state_,         pass,        run_seconds,
+                        developed, report.summary, report.stop, develop_seconds};
     for (PassObserver* obs : observers) obs->after_pass(info);
   }
   for (PassObserver* obs : observers) obs->finish();

@@ -46,6 +46,9 @@ struct PassInfo {
   bool developed = false;    // summary is of this pass (else of an earlier one, or empty)
   const FilmSummary& summary;
   StopReason stop = StopReason::None;  // None: more passes follow
+  // What developing this pass's summary took (0 when it was not developed): observers that
+  // ask for it count it in their overhead (--log's budget, the progress line's interval).
+  double develop_seconds = 0.0;
 };
 
 class PassObserver {

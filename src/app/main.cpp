@@ -99,8 +99,9 @@ void print_lines(const std::vector<std::string>& lines) {
 // The scene, completed for rendering (its warnings and notes printed); with `saved`, checked to
 // be the scene and options that render was made with.
 pb::Scene load_scene(const pb::RenderOptions& options, const pb::SavedRender* saved) {
-  pb::Scene scene =
-      pb::load_gltf(options.scene, pb::LoadPolicy{options.asset_dirs, pb::memory_budget(options)});
+  pb::Scene scene = pb::load_gltf(
+      options.scene, pb::LoadPolicy{options.asset_dirs, pb::memory_budget(options),
+                                    options.texture_formats == pb::TextureFormats::Any});
   for (const std::string& w : scene.warnings)
     std::cerr << "photonbound: warning: " << options.scene << ": " << w << "\n";
   for (const std::string& n : pb::complete_scene(scene, options))

@@ -8,7 +8,8 @@
 
 namespace pb {
 
-// A progress line at most every 0.5 s and after the last pass: pass, photons, mean bound,
+// A progress line at most every 0.5 s (less often when developing the image takes over 25 ms:
+// at most 5% of the run) and after the last pass: pass, photons, mean bound,
 // share of pixels below the target, unknown pixels, elapsed time and time left. A pass is told
 // again when the next one was cut short (Driver::run): not printed twice, and pass 0 never.
 class ProgressPrinter : public PassObserver {
@@ -19,9 +20,11 @@ class ProgressPrinter : public PassObserver {
   static std::string line(const PassInfo& info);
 
  private:
+  double interval() const;
   std::ostream& out_;
   double last_print_ = -1.0;
-  uint64_t printed_ = 0;  // the last pass printed
+  double develop_seconds_ = 0.0;  // the last development's time
+  uint64_t printed_ = 0;          // the last pass printed
 };
 
 // --log: one JSON object per logged pass (docs/usage.md "Logging"). Passes are logged while

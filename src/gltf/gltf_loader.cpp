@@ -362,7 +362,8 @@ Scene load_gltf_bytes(const std::string& path, const std::vector<unsigned char>&
   for (const tinygltf::Buffer& b : model.buffers) total += b.data.size();
   for (const tinygltf::Image& im : model.images) total += im.image.size();
   // The decoded texels may take what the file and its buffers and images leave of the budget.
-  Scene scene = gltf::Loader(path, model, pre, policy.max_memory, total).run(warnings);
+  Scene scene = gltf::Loader(path, model, pre, policy.max_memory, total, policy.any_texture_format)
+                    .run(warnings);
   scene.files = files.read_paths();
   // External images are part of the identity too (embedded ones already are: their bytes are in
   // the file or a buffer).

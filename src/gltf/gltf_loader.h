@@ -21,6 +21,10 @@ namespace pb {
 struct LoadPolicy {
   std::vector<std::string> asset_dirs;  // further folders files may be read from
   uint64_t max_memory = UINT64_MAX;     // --max-memory
+  // --texture-formats any: images in any format OpenImageIO reads, not only glTF's PNG, JPEG
+  // and WebP (image_io.h ImageFormats; an image in another format gives a warning and the
+  // textures using it their factors).
+  bool any_texture_format = false;
 };
 
 // Reads a .gltf (embedded or external buffers) or .glb file. Throws SceneError for anything

@@ -88,8 +88,13 @@ class Loader {
   // `held`: the bytes of the file and of the buffers and images it names, which count against
   // `max_memory` with the decoded texels.
   Loader(const std::string& file, const tinygltf::Model& model, const Prepass& pre,
-         uint64_t max_memory = UINT64_MAX, uint64_t held = 0)
-      : file_(file), m_(model), pre_(pre), max_memory_(max_memory), held_bytes_(held) {}
+         uint64_t max_memory = UINT64_MAX, uint64_t held = 0, bool any_texture_format = false)
+      : file_(file),
+        m_(model),
+        pre_(pre),
+        max_memory_(max_memory),
+        held_bytes_(held),
+        any_texture_format_(any_texture_format) {}
   Scene run(const std::vector<std::string>& parse_warnings);
 
  private:
@@ -178,9 +183,10 @@ class Loader {
   Scene scene_;
   std::set<std::string> warned_;
   std::vector<char> visited_;
-  std::vector<int64_t> material_slot_;         // glTF material -> Scene::materials index, -1 unused
-  std::vector<int64_t> image_slot_;            // glTF image -> Scene::images index, -1 not decoded
-  static constexpr int64_t kUndecodable = -2;  // a KTX2 image, warned about once
+  std::vector<int64_t> material_slot_;  // glTF material -> Scene::materials index, -1 unused
+  std::vector<int64_t> image_slot_;     // glTF image -> Scene::images index, -1 not decoded
+  // A KTX2 image, or one in a format --texture-formats leaves out, warned about once.
+  static constexpr int64_t kUndecodable = -2;
   // What the files and all decoded texels may take (LoadPolicy::max_memory), and what they take
   // so far. Images with the same bytes are decoded once: image_by_bytes_ maps their checksum to
   // the Scene::images index (the bytes compared before sharing).
@@ -188,6 +194,7 @@ class Loader {
   uint64_t held_bytes_;
   std::multimap<uint64_t, int64_t> image_by_bytes_;
   std::vector<Bytes> image_source_;  // Scene::images index -> the encoded bytes
+  bool any_texture_format_;          // LoadPolicy::any_texture_format
   int64_t default_material_ = -1;
   // Recentring (Loader::choose_origin): the world bounds of the POSITION accessors' min/max.
   dvec3 measured_lo_{INFINITY}, measured_hi_{-INFINITY};

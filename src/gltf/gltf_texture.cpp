@@ -83,7 +83,8 @@ int32_t Loader::image(int index, const std::string& where) {
   const std::string name = gi.uri.empty() ? il : one_line(gi.uri);
   try {
     const uint64_t left = max_memory_ - std::min(held_bytes_, max_memory_);
-    Image decoded = decode_image(bytes.data, bytes.size, name, left);
+    Image decoded = decode_image(bytes.data, bytes.size, name, left,
+                                 any_texture_format_ ? ImageFormats::Any : ImageFormats::Gltf);
     held_bytes_ += image_bytes(decoded);
     decoded.name = il;
     slot = int64_t(scene_.images.size());
@@ -91,6 +92,17 @@ int32_t Loader::image(int index, const std::string& where) {
     image_by_bytes_.emplace(key, slot);
     image_source_.push_back(bytes);
   } catch (const ImageError& e) {
+    // An image in a format photonbound recognises but does not decode by default renders as
+    // its factors, like KTX2 (approximate: a warning, not a refusal); bytes in no recognised
+    // format are a corrupt image, refused below.
+    if (const auto* other = dynamic_cast<const ImageFormatRefused*>(&e);
+        other && !other->format.empty()) {
+      warn(il + " is " + other->format +
+           ", not one of glTF's image formats (PNG, JPEG, WebP); the textures using it take "
+           "their factors (--texture-formats any decodes it, for files you trust)");
+      slot = kUndecodable;
+      return -1;
+    }
     // decode_image names the image itself; il is said once.
     std::string what = e.what();
     if (what.rfind(name + ": ", 0) == 0) what.erase(0, name.size() + 2);

@@ -6,6 +6,7 @@
 #include <set>
 #include <vector>
 
+#include "io/container_bytes.h"
 #include "io/image_io.h"
 #include "util/memory.h"
 
@@ -13,39 +14,8 @@ namespace pb {
 
 namespace {
 
-// Little- or big-endian unsigned integers of 1 to 8 bytes.
-uint64_t load(const unsigned char* p, int bytes, bool big_endian) {
-  uint64_t v = 0;
-  for (int k = 0; k < bytes; ++k) v |= uint64_t(p[big_endian ? bytes - 1 - k : k]) << (8 * k);
-  return v;
-}
-
-// Pieces of the file read through a ByteReader, each checked to lie inside it.
-class Bytes {
- public:
-  Bytes(const ByteReader& read, uint64_t size, const std::string& name)
-      : read_(read), size_(size), name_(name) {}
-  uint64_t size() const { return size_; }
-  bool holds(uint64_t offset, uint64_t n) const { return offset <= size_ && n <= size_ - offset; }
-  // Unsigned integer of `bytes` bytes at `offset`; false past the end.
-  bool uint(uint64_t offset, int bytes, bool big_endian, uint64_t& v) const {
-    unsigned char b[8];
-    if (!holds(offset, uint64_t(bytes)) || !read_(offset, uint64_t(bytes), b)) return false;
-    v = load(b, bytes, big_endian);
-    return true;
-  }
-  bool get(uint64_t offset, uint64_t n, unsigned char* out) const {
-    return holds(offset, n) && read_(offset, n, out);
-  }
-  [[noreturn]] void refuse(const std::string& what) const {
-    throw ImageError(name_ + ": " + what + ": a corrupt or hostile file");
-  }
-
- private:
-  const ByteReader& read_;
-  uint64_t size_;
-  const std::string& name_;
-};
+using container::Bytes;
+using container::load;
 
 // ---- OpenEXR (the "OpenEXR File Layout" document: magic, version, headers, offset tables) ----
 
@@ -325,6 +295,7 @@ void check_container(const ByteReader& read, uint64_t size, const std::string& n
     b.uint(2, 2, be, magic);
     if (magic == 42 || magic == 43) check_tiff(b, be, max_texels);
   }
+  if (head[0] == 0xff && head[1] == 0xd8) container::check_jpeg(b, max_texels, max_bytes);
 }
 
 void check_container(const unsigned char* data, uint64_t size, const std::string& name,

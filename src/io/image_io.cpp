@@ -110,14 +110,48 @@ ExrImage read_exr(const std::string& path, const ReadLimit& limit) {
 
 namespace {
 
-// A file name whose extension names the format the bytes are in: PNG and JPEG by their
+// glTF's own image formats by their signatures: OpenImageIO's reader name, or "".
+std::string gltf_format(const unsigned char* d, size_t n) {
+  if (n >= 8 && std::memcmp(d, "\x89PNG\r\n\x1a\n", 8) == 0) return "png";
+  if (n >= 3 && d[0] == 0xff && d[1] == 0xd8 && d[2] == 0xff) return "jpeg";
+  if (n >= 12 && std::memcmp(d, "RIFF", 4) == 0 && std::memcmp(d + 8, "WEBP", 4) == 0)
+    return "webp";
+  return "";
+}
+
+// A file name whose extension names the format the bytes are in: glTF's formats by their
 // signatures, otherwise whatever `name` says.
 std::string format_name(const unsigned char* d, size_t n, const std::string& name) {
-  if (n >= 8 && std::memcmp(d, "\x89PNG\r\n\x1a\n", 8) == 0) return "image.png";
-  if (n >= 3 && d[0] == 0xff && d[1] == 0xd8 && d[2] == 0xff) return "image.jpg";
-  if (n >= 12 && std::memcmp(d, "RIFF", 4) == 0 && std::memcmp(d + 8, "WEBP", 4) == 0)
-    return "image.webp";
-  return name;
+  const std::string f = gltf_format(d, n);
+  return f.empty() ? name : "image." + f;
+}
+
+// Another format an image might be in, for the message that refuses it: by its signature, or
+// TGA (which has none) by its extension or version 2 footer; "" when nothing is recognised.
+std::string other_format(const unsigned char* d, size_t n, const std::string& name) {
+  auto starts = [&](const char* magic, size_t len) {
+    return n >= len && std::memcmp(d, magic, len) == 0;
+  };
+  if (starts("II*\0", 4) || starts("MM\0*", 4) || starts("II+\0", 4) || starts("MM\0+", 4))
+    return "TIFF";
+  if (starts("\x76\x2f\x31\x01", 4)) return "OpenEXR";
+  if (starts("#?RADIANCE", 10) || starts("#?RGBE", 6)) return "Radiance HDR";
+  if (starts("BM", 2)) return "BMP";
+  if (starts("GIF8", 4)) return "GIF";
+  if (starts("8BPS", 4)) return "Photoshop";
+  if (starts("DDS ", 4)) return "DDS";
+  if (starts("\xabKTX 11\xbb", 8)) return "KTX";
+  if (starts("\x01\xda", 2)) return "SGI";
+  if (starts("\0\0\1\0", 4)) return "ICO";
+  if (starts("\0\0\0\x0cjP  ", 8) || starts("\xff\x4f\xff\x51", 4)) return "JPEG 2000";
+  if (n >= 12 && std::memcmp(d + 4, "ftyp", 4) == 0) return "HEIF/AVIF";
+  if (n >= 2 && d[0] == 'P' && d[1] >= '1' && d[1] <= '7') return "PNM";
+  if (n >= 18 && std::memcmp(d + n - 18, "TRUEVISION-XFILE.", 17) == 0) return "TGA";
+  std::string ext = std::filesystem::path(name).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return char(std::tolower(c)); });
+  if (ext == ".tga" || ext == ".targa") return "TGA";
+  return "";
 }
 
 // OpenImageIO 2.4's IOMemReader reads wherever it is told: an EXR whose chunk offset table holds
@@ -188,7 +222,16 @@ class QuietStderr {
 }  // namespace
 
 Image decode_image(const unsigned char* data, size_t size, const std::string& name,
-                   uint64_t max_bytes) {
+                   uint64_t max_bytes, ImageFormats formats) {
+  const std::string gltf = gltf_format(data, size);
+  if (formats == ImageFormats::Gltf && gltf.empty()) {
+    const std::string other = is_ktx2(data, size) ? "KTX2" : other_format(data, size, name);
+    throw ImageFormatRefused(
+        name + (other.empty() ? ": cannot decode the image: it is not a PNG, JPEG or WebP image"
+                              : ": the image is " + other +
+                                    ", not one of glTF's image formats (PNG, JPEG, WebP)"),
+        other);
+  }
   // KTX2 (KHR_texture_basisu's container) has no OpenImageIO reader; without this, OpenImageIO
   // falls back to opening `name` as a path relative to the working directory and reports a
   // missing file.
@@ -238,7 +281,11 @@ Image decode_image(const unsigned char* data, size_t size, const std::string& na
                          "decodes images only from the bytes the scene holds (use PNG, JPEG, "
                          "WebP, TIFF, EXR, HDR, BMP or TGA)");
     }
-  if (named_format.empty() || !attempt(named_format)) {
+  // glTF's formats are read by the reader their signature names alone: an image that fails
+  // there is not offered to the other readers.
+  if (formats == ImageFormats::Gltf) {
+    attempt(gltf);
+  } else if (named_format.empty() || !attempt(named_format)) {
     const std::string list = OIIO::get_string_attribute("input_format_list");
     for (size_t at = 0; at <= list.size() && !in;) {
       const size_t comma = std::min(list.find(',', at), list.size());

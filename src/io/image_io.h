@@ -61,21 +61,35 @@ RgbImage read_rgb_image(const std::string& path, const ReadLimit& limit = {});
 void write_png(const std::string& path, int width, int height,
                const std::vector<unsigned char>& rgb);
 
-// Decodes an image file held in memory (PNG, JPEG and whatever else OpenImageIO reads; the
-// format is recognised from the bytes, else from `name`'s extension) into texels as stored:
-// 8-bit images as 8-bit values, others as floats in [0, 1], colour not premultiplied by alpha
-// (glTF's images are unassociated). At most 4 channels are kept. Throws ImageError naming
-// `name` when the bytes are not an image it can read, the decoder reports any error (a
-// truncated or corrupt file), the image is beyond 2^28 texels, or its header claims more texels
-// than its bytes can hold (PNG: deflate expands at most 1032:1); ImageTooLarge, from the header
-// and before any texel is decoded, when the texels would take more than `max_bytes`.
+// Decodes an image file held in memory (PNG, JPEG, WebP; with ImageFormats::Any whatever else
+// OpenImageIO reads, the format recognised from the bytes, else from `name`'s extension) into
+// texels as stored: 8-bit images as 8-bit values, others as floats in [0, 1], colour not
+// premultiplied by alpha (glTF's images are unassociated). At most 4 channels are kept. Throws
+// ImageError naming `name` when the bytes are not an image it can read, the decoder reports any
+// error (a truncated or corrupt file), the image is beyond 2^28 texels, or its header claims more
+// texels than its bytes can hold (PNG: deflate expands at most 1032:1); ImageTooLarge, from the
+// header and before any texel is decoded, when the texels would take more than `max_bytes`.
 class ImageTooLarge : public ImageError {
  public:
   ImageTooLarge(const std::string& what, uint64_t bytes) : ImageError(what), bytes(bytes) {}
   uint64_t bytes;  // what the decoded texels would take
 };
+// Which formats decode_image takes. A scene's textures default to glTF's own (PNG, JPEG and
+// EXT_texture_webp's WebP: each read only by the reader its signature names), so that an
+// untrusted scene reaches none of the other decoders (OpenEXR, libtiff, ...), whose headers
+// made them allocate what they claimed again and again under the fuzzer (docs/testing.md);
+// Any is --texture-formats any, for trusted files.
+enum class ImageFormats { Gltf, Any };
+// Thrown under ImageFormats::Gltf for bytes in another format; `format` names it when its
+// signature (or, for TGA, which has none, `name`'s extension) is recognised, else is empty.
+class ImageFormatRefused : public ImageError {
+ public:
+  ImageFormatRefused(const std::string& what, std::string format)
+      : ImageError(what), format(std::move(format)) {}
+  std::string format;
+};
 Image decode_image(const unsigned char* data, size_t size, const std::string& name,
-                   uint64_t max_bytes = UINT64_MAX);
+                   uint64_t max_bytes = UINT64_MAX, ImageFormats formats = ImageFormats::Any);
 // What decode_image's image takes: 1 byte per value for 8-bit images, 4 (a float) otherwise.
 uint64_t image_bytes(const Image& image);
 // The bytes begin with KTX2's identifier (KHR_texture_basisu's container), which no reader here

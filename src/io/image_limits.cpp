@@ -107,5 +107,4 @@ void check_plausible(const OIIO::ImageInput& in, const unsigned char* data, size
                      "hostile file");
 }
 
-
 }  // namespace pb

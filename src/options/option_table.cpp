@@ -290,6 +290,12 @@ std::vector<OptionSpec> make_table() {
                         "factor on the environment's radiance"),
                    &RenderOptions::environment_scale, {0, 1e30, true, false, "", ""}));
   t.push_back(asset_dirs());
+  t.push_back(choice(base("--texture-formats", "texture_formats", "gltf|any", render, K::Image,
+                          "formats a scene's images are decoded from: glTF's (PNG, JPEG, WebP; "
+                          "others give a warning and their textures' factors), or any "
+                          "OpenImageIO reads (TIFF, EXR, TGA, ...: only for files you trust)"),
+                     &RenderOptions::texture_formats,
+                     {{"gltf", TextureFormats::Gltf}, {"any", TextureFormats::Any}}));
   t.push_back(integer(base("--threads", "threads", "T", run, K::Run,
                            "worker threads, 0 = all; the image does not depend on it"),
                       &RenderOptions::threads, {0, 1024}));

@@ -30,6 +30,8 @@ enum class DirectMode { NextEvent, Photons };
 enum class ProgressMode { Auto, Always, Never };
 // What --target-error tests (docs/usage.md "Stop rules", ESTIMATOR.md section 7).
 enum class StopRule { MeanError, MeanBound, Pixels };
+// Which image formats a scene's textures may be in (gltf_loader.h LoadPolicy).
+enum class TextureFormats { Gltf, Any };
 
 // Members only: ranges, defaults and help live in the option table.
 // Below this roughness a gathered GGX lobe's sparse-photon bound falls slowly where photons
@@ -43,6 +45,8 @@ struct RenderOptions {
   // Folders besides the scene's own that its buffers and images may be read from (--asset-dir,
   // repeatable; absolute: the state is resumed from anywhere).
   std::vector<std::string> asset_dirs;
+  // --texture-formats: glTF's image formats only (PNG, JPEG, WebP), or any OpenImageIO reads.
+  TextureFormats texture_formats = TextureFormats::Gltf;
   std::string output;  // -o
   // Stop conditions: whichever comes first; at least one is required.
   std::optional<uint64_t> passes;

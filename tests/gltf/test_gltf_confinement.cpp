@@ -219,13 +219,17 @@ std::vector<unsigned char> ico_bytes(int seed) {
 }
 
 // OpenImageIO's SGI and ICO readers cannot read from memory: given the URI, they opened it by
-// name in the working directory. A file there with the URI's name must never be read: the
-// format is refused (the scene's own file present or not), and a missing image is missing.
+// name in the working directory. A file there with the URI's name must never be read. By
+// default such an image is not decoded at all (not one of glTF's formats: a warning, and the
+// texture's factor); with --texture-formats any its format is refused (the scene's own file
+// present or not), and a missing image is missing.
 TEST_F(Confinement, ImagesAreDecodedOnlyFromTheBytesRead) {
   fs::create_directories(dir_ / "cwd");
   fs::current_path(dir_ / "cwd");
   const std::vector<std::pair<std::string, std::vector<unsigned char>>> formats = {
       {"tex.sgi", sgi_bytes(2, 2, {255, 0, 0})}, {"tex.ico", ico_bytes(1)}};
+  LoadPolicy any;
+  any.any_texture_format = true;
   for (const auto& [name, bytes] : formats) {
     SCOPED_TRACE(name);
     put("cwd/" + name, bytes);
@@ -235,7 +239,13 @@ TEST_F(Confinement, ImagesAreDecodedOnlyFromTheBytesRead) {
                  json{{"pbrMetallicRoughness", json{{"baseColorTexture", json{{"index", 0}}}}}});
     const std::string file = put("scene/scene.gltf", to_bytes(d.gltf()));
     put("scene/" + name, name == "tex.sgi" ? sgi_bytes(2, 2, {0, 0, 255}) : ico_bytes(2));
-    expect_refused(file, "reads files by name, not bytes in memory");
+    const Scene scene = load_gltf(file);
+    EXPECT_TRUE(scene.images.empty());
+    ASSERT_FALSE(scene.materials.empty());
+    for (const Material& m : scene.materials) EXPECT_FALSE(m.base_color_texture.present());
+    EXPECT_TRUE(has_warning(scene, name == "tex.sgi" ? "is SGI, not one of glTF's image formats"
+                                                     : "is ICO, not one of glTF's image formats"));
+    expect_refused(file, "reads files by name, not bytes in memory", any);
     fs::remove(dir_ / "scene" / name);
     expect_refused(file, "has no data (a missing file");
   }
@@ -244,7 +254,16 @@ TEST_F(Confinement, ImagesAreDecodedOnlyFromTheBytesRead) {
   Doc d = textured(json{{"images", json::array({json{{"uri", "tex.png"}}})},
                         {"textures", json::array({json{{"source", 0}}})}},
                    json{{"pbrMetallicRoughness", json{{"baseColorTexture", json{{"index", 0}}}}}});
-  expect_refused(put("scene/scene.gltf", to_bytes(d.gltf())), "has no data (a missing file");
+  const std::string file = put("scene/scene.gltf", to_bytes(d.gltf()));
+  expect_refused(file, "has no data (a missing file");
+  // Bytes in no format photonbound recognises are a corrupt image, refused either way.
+  put("scene/tex.png", to_bytes("not an image at all, whatever its name says"));
+  expect_refused(file, "image 'tex.png': cannot decode the image: it is not a PNG, JPEG or WebP");
+  expect_refused(file, "image 'tex.png': cannot decode the image", any);
+  // A PNG decodes under both policies.
+  put("scene/tex.png", png_bytes(2, 2));
+  EXPECT_EQ(error_of(file), "");
+  EXPECT_EQ(error_of(file, any), "");
 }
 
 // 100,000 nested arrays in extras (200 KB) overflowed the stack in the JSON parser.

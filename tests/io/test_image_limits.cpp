@@ -443,10 +443,88 @@ TEST(ContainerCheck, TiffDataPastTheEndOfTheFileIsRefused) {
   EXPECT_NE(m.find("TIFF directory 0 lies past the end of the file"), std::string::npos) << m;
 }
 
+// A scene's textures (ImageFormats::Gltf, the default of --texture-formats): PNG, JPEG and WebP
+// decode, each by its own reader; every other format OpenImageIO writes here is refused before
+// any reader sees it, named for the loader's warning (TGA, which has no signature, by its
+// extension), and bytes in no format are refused unnamed (the loader refuses those).
+TEST(GltfFormats, OnlyPngJpegAndWebpAreDecoded) {
+  for (const char* ext : {"png", "jpg", "webp"}) {
+    SCOPED_TRACE(ext);
+    const std::vector<unsigned char> bytes = written(ext, spec13x7(3, OIIO::TypeDesc::UINT8));
+    const Image im =
+        decode_image(bytes.data(), bytes.size(), "t.bin", UINT64_MAX, ImageFormats::Gltf);
+    EXPECT_EQ(im.width * im.height * im.channels, 13 * 7 * 3);
+  }
+  const std::vector<std::pair<std::string, std::string>> others = {
+      {"tif", "TIFF"}, {"exr", "OpenEXR"}, {"hdr", "Radiance HDR"}, {"bmp", "BMP"},
+      {"tga", "TGA"},  {"ppm", "PNM"},     {"sgi", "SGI"},          {"", ""}};
+  for (const auto& [ext, format] : others) {
+    SCOPED_TRACE(ext);
+    const std::vector<unsigned char> bytes = ext.empty()
+                                                 ? std::vector<unsigned char>(64, 'x')
+                                                 : written(ext, spec13x7(3, OIIO::TypeDesc::UINT8));
+    const std::string name = "t." + (ext.empty() ? std::string("png") : ext);
+    try {
+      decode_image(bytes.data(), bytes.size(), name, UINT64_MAX, ImageFormats::Gltf);
+      ADD_FAILURE() << "decoded";
+    } catch (const ImageFormatRefused& e) {
+      EXPECT_EQ(e.format, format);
+      EXPECT_EQ(std::string(e.what()).rfind(name + ": ", 0), 0u) << e.what();
+    }
+    // Under ImageFormats::Any the same bytes decode (OpenImageIO's PNM and SGI readers read
+    // files by name only: those stay refused).
+    if (!ext.empty() && ext != "ppm" && ext != "sgi")
+      EXPECT_NO_THROW(decode_image(bytes.data(), bytes.size(), name));
+  }
+  // A PNG that its reader refuses is not offered to the other readers: the PNG reader's error.
+  std::vector<unsigned char> cut = written("png", spec13x7(3, OIIO::TypeDesc::UINT8));
+  cut.resize(cut.size() / 2);
+  const std::string m = decode_error(cut, "cut.png");
+  EXPECT_NE(m.find("cannot decode the image"), std::string::npos) << m;
+}
+
+// libjpeg holds every coefficient of a progressive JPEG (2 bytes for each of 64 per 8x8 block
+// and component) from the moment OpenImageIO opens it; the walk refuses them over the read's
+// budget (at least 256 MiB) first. A baseline JPEG decodes row by row: only its texels count.
+TEST(ContainerCheck, AProgressiveJpegsCoefficientsCountAgainstTheBudget) {
+  OIIO::ImageSpec spec = spec13x7(3, OIIO::TypeDesc::UINT8);
+  spec.attribute("jpeg:progressive", 1);
+  const std::vector<unsigned char> progressive = written("jpg", spec);
+  const std::vector<unsigned char> baseline = written("jpg", spec13x7(3, OIIO::TypeDesc::UINT8));
+  // The frame header (SOF2, SOF0): its height and width, big-endian, 3 and 5 bytes in.
+  auto sof = [](const std::vector<unsigned char>& b, unsigned char code) {
+    for (size_t i = 2; i + 1 < b.size(); ++i)
+      if (b[i] == 0xff && b[i + 1] == code) return i + 2;
+    return size_t(0);
+  };
+  const size_t p = sof(progressive, 0xc2), q = sof(baseline, 0xc0);
+  ASSERT_GT(p, 0u) << "OpenImageIO wrote no progressive JPEG";
+  ASSERT_GT(q, 0u);
+  const Image small =
+      decode_image(progressive.data(), progressive.size(), "p.jpg", 13 * 7 * 3, ImageFormats::Gltf);
+  EXPECT_EQ(small.u8.size(), 13u * 7u * 3u);
+  // 16384x16384 (2^28 texels, the most) with OpenImageIO's 4:2:0 sampling: 4 Mi blocks of luma
+  // and 2 x 1 Mi of chroma, 128 bytes each.
+  for (const bool is_progressive : {true, false}) {
+    std::vector<unsigned char> bytes = is_progressive ? progressive : baseline;
+    const size_t at = is_progressive ? p : q;
+    for (const size_t k : {size_t(3), size_t(5)}) {
+      bytes[at + k] = 0x40;
+      bytes[at + k + 1] = 0x00;
+    }
+    const std::string m = decode_error(bytes, is_progressive ? "p.jpg" : "b.jpg", 64 << 20);
+    const bool counted =
+        m.find("holds 768 MiB of coefficients, over the 256 MiB") != std::string::npos;
+    EXPECT_EQ(counted, is_progressive) << m;
+  }
+  EXPECT_LT(peak_rss_kib(), 1L << 19);  // 512 MiB: nothing was allocated for them
+}
+
 TEST(ContainerCheck, TheImageFuzzersFindingsAreRefusedWithOneLine) {
   // Kept from tools/fuzz.sh image (tests/data/fuzz/README.md): 15 EXRs whose attributes claim
   // 0.8 to 2 GB, or a name of 70 bytes, 2 whose channel list is shorter than its declared size,
   // an EXR 6 million pixels wide whose one 32-line chunk OpenEXR allocated (3 GB for 490 bytes),
+  // 2 progressive JPEGs (25104x23807, 65296x65496) whose coefficients libjpeg allocated on open,
   // and 2 TIFFs whose data lies past their end, each refused by the container check; an EXR
   // 1,048,592 pixels wide that OpenImageIO read through a 2 GiB buffer of 256 rows, refused by
   // decode_image; and one TIFF (rss-*) that the fuzzer blamed for its process's memory but that
@@ -454,7 +532,7 @@ TEST(ContainerCheck, TheImageFuzzersFindingsAreRefusedWithOneLine) {
   std::vector<std::filesystem::path> files;
   for (const auto& e : std::filesystem::directory_iterator(PHOTONBOUND_TEST_DATA "/fuzz/images"))
     files.push_back(e.path());
-  ASSERT_GE(files.size(), 20u) << "the image fuzz regression inputs are missing";
+  ASSERT_GE(files.size(), 25u) << "the image fuzz regression inputs are missing";
   std::sort(files.begin(), files.end());
   for (const auto& f : files) {
     SCOPED_TRACE(f.string());
@@ -463,6 +541,15 @@ TEST(ContainerCheck, TheImageFuzzersFindingsAreRefusedWithOneLine) {
     // Refused by what the header or the decoder's buffers claim, not by a failed allocation.
     EXPECT_EQ(m.find("alloc"), std::string::npos) << m;
     for (const char c : m) EXPECT_TRUE(c >= 0x20 && c < 0x7f) << m;
+    // As a scene's texture: an EXR or TIFF is not decoded at all, a JPEG is refused as above.
+    try {
+      decode_image(bytes.data(), bytes.size(), "f", uint64_t(256) << 20, ImageFormats::Gltf);
+      ADD_FAILURE() << "decoded as a texture";
+    } catch (const ImageFormatRefused& e) {
+      EXPECT_TRUE(e.format == "OpenEXR" || e.format == "TIFF") << e.what();
+    } catch (const ImageError& e) {
+      EXPECT_EQ(f.extension(), ".jpg") << e.what();
+    }
   }
   EXPECT_LT(peak_rss_kib(), 1L << 20);  // 1 GiB
 }
