@@ -7,7 +7,7 @@ set -euo pipefail
 
 packages=(
   cmake ninja-build g++ pkg-config
-  libembree-dev libopenimageio-dev libopenexr-dev libglm-dev libtinygltf-dev
+  libembree-dev libopenimageio-dev libopenexr-dev libjpeg-dev libglm-dev libtinygltf-dev
   libdraco-dev libmeshoptimizer-dev nlohmann-json3-dev
   libtbb-dev libboost-dev libgtest-dev
   python3-numpy python3-matplotlib python3-openimageio

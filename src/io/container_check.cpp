@@ -6,16 +6,47 @@
 #include <set>
 #include <vector>
 
-#include "io/container_bytes.h"
 #include "io/image_io.h"
+#include "io/jpeg_header.h"
 #include "util/memory.h"
 
 namespace pb {
 
 namespace {
 
-using container::Bytes;
-using container::load;
+// Little- or big-endian unsigned integers of 1 to 8 bytes.
+uint64_t load(const unsigned char* p, int bytes, bool big_endian) {
+  uint64_t v = 0;
+  for (int k = 0; k < bytes; ++k) v |= uint64_t(p[big_endian ? bytes - 1 - k : k]) << (8 * k);
+  return v;
+}
+
+// Pieces of the file read through a ByteReader, each checked to lie inside it.
+class Bytes {
+ public:
+  Bytes(const ByteReader& read, uint64_t size, const std::string& name)
+      : read_(read), size_(size), name_(name) {}
+  uint64_t size() const { return size_; }
+  bool holds(uint64_t offset, uint64_t n) const { return offset <= size_ && n <= size_ - offset; }
+  // Unsigned integer of `bytes` bytes at `offset`; false past the end.
+  bool uint(uint64_t offset, int bytes, bool big_endian, uint64_t& v) const {
+    unsigned char b[8];
+    if (!holds(offset, uint64_t(bytes)) || !read_(offset, uint64_t(bytes), b)) return false;
+    v = load(b, bytes, big_endian);
+    return true;
+  }
+  bool get(uint64_t offset, uint64_t n, unsigned char* out) const {
+    return holds(offset, n) && read_(offset, n, out);
+  }
+  [[noreturn]] void refuse(const std::string& what) const {
+    throw ImageError(name_ + ": " + what + ": a corrupt or hostile file");
+  }
+
+ private:
+  const ByteReader& read_;
+  uint64_t size_;
+  const std::string& name_;
+};
 
 // ---- OpenEXR (the "OpenEXR File Layout" document: magic, version, headers, offset tables) ----
 
@@ -295,11 +326,21 @@ void check_container(const ByteReader& read, uint64_t size, const std::string& n
     b.uint(2, 2, be, magic);
     if (magic == 42 || magic == 43) check_tiff(b, be, max_texels);
   }
-  if (head[0] == 0xff && head[1] == 0xd8) container::check_jpeg(b, max_texels, max_bytes);
+  if (head[0] == 0xff && head[1] == 0xd8) {
+    // libjpeg reads the header from bytes in memory: the first 16 MiB hold it in any real file
+    // (its markers before the first scan are tables and APPn segments of at most 64 KiB).
+    std::vector<unsigned char> start(size_t(std::min<uint64_t>(size, uint64_t(16) << 20)));
+    if (!b.get(0, start.size(), start.data())) return;
+    check_jpeg(start.data(), start.size(), start.size() < size, name, max_texels, max_bytes);
+  }
 }
 
 void check_container(const unsigned char* data, uint64_t size, const std::string& name,
                      uint64_t max_texels, uint64_t max_bytes) {
+  if (size >= 2 && data[0] == 0xff && data[1] == 0xd8) {  // in memory already: no copy
+    check_jpeg(data, size_t(size), false, name, max_texels, max_bytes);
+    return;
+  }
   const ByteReader read = [&](uint64_t offset, uint64_t n, unsigned char* out) {
     if (offset > size || n > size - offset) return false;
     if (n) std::memcpy(out, data + offset, size_t(n));

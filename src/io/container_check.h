@@ -5,8 +5,8 @@
 // file. The libFuzzer run of the image decoders (tools/fuzz.sh image, docs/testing.md) found
 // such files within minutes. Each check here walks the container's own structure (the OpenEXR
 // file layout; TIFF 6.0 section 2, and BigTIFF) and refuses a size that the file's bytes cannot
-// hold, which no valid file has. A JPEG's frame header is read too: libjpeg allocates a
-// buffer of every coefficient of a progressive image when it is opened (container_jpeg.cpp).
+// hold, which no valid file has. A JPEG's header is read by libjpeg itself first
+// (jpeg_header.h): libjpeg allocates every coefficient of a progressive image when it is opened.
 #pragma once
 
 #include <cstdint>
@@ -22,8 +22,8 @@ using ByteReader = std::function<bool(uint64_t offset, uint64_t n, unsigned char
 // through `read`) are an EXR or TIFF file whose structure claims more than they hold, more
 // than `max_texels` texels (a TIFF: or 4 x max_texels samples), or an EXR chunk whose decoding
 // buffers take more than `max_bytes`; a JPEG over `max_texels`, or whose coefficient buffer
-// takes more than max(`max_bytes`, 256 MiB) (ImageTooLarge). Other formats, and structures it does
-// not know, pass unchecked: the decoder's own checks apply to them.
+// takes more than max(`max_bytes`, 256 MiB) (ImageTooLarge; jpeg_header.h). Other formats, and
+// structures it does not know, pass unchecked: the decoder's own checks apply to them.
 void check_container(const ByteReader& read, uint64_t size, const std::string& name,
                      uint64_t max_texels, uint64_t max_bytes);
 
