@@ -1,14 +1,16 @@
 """Adaptive against uniform: passes and seconds to a target error, per --adaptive mode.
 
-  python3 -m tools.adaptive_study OUTDIR [--scenes caustic,indirect,cornell,plane,box]
-                                  [--modes none,radius] [--targets T1,T2,...] [--resolution WxH]
+  python3 -m tools.adaptive_study OUTDIR [--scenes caustic,indirect,cornell,plane,box,door]
+                                  [--modes none,radius,photons,radius+photons]
+                                  [--targets T1,T2,...] [--resolution WxH]
                                   [--time-limit S] [--reference-passes N] [--photonbound EXE]
 
 For each scene, target and mode, `photonbound render --target-error T` runs with the default
 stop rule (mean-error, 90%) and seed 1, and its image is measured with `photonbound compare`
 against the scene's reference. The table gives each mode's passes, seconds and actual mean
 error, and the passes and seconds of each mode over the first mode's (issue 39's "time to a
-target against --adaptive none"). Passes are the machine-independent figure; seconds on a
+target against --adaptive none"). A mode joins --adaptive parts with + (radius+photons is
+--adaptive radius,photons). Passes are the machine-independent figure; seconds on a
 shared machine are noisy.
 
 References: the exact pixel-area answers for the plane and the closed box (tools/analytic.py),
@@ -41,6 +43,8 @@ SCENES = {
               "options": ["--direct", "photons"], "targets": [0.02, 0.01]},
     "box": {"file": "closed_box.gltf", "resolution": "64x64", "reference": "exact box",
             "targets": [0.08, 0.04]},
+    "door": {"file": "door_room.gltf", "resolution": "128x96", "reference": "render",
+             "targets": [0.002, 0.0014, 0.001]},
 }
 
 
@@ -129,10 +133,11 @@ def main():
         rows = []
         for target in targets or cfg["targets"]:
             for mode in modes:
-                path = os.path.join(runs_dir, f"{name}_t{target:g}_{mode.replace(',', '+')}.exr")
+                path = os.path.join(runs_dir, f"{name}_t{target:g}_{mode}.exr")
                 cli.render(exe, os.path.join(REPO, "scenes", cfg["file"]), path,
                            ["--resolution", res, "--target-error", f"{target:g}", "--time",
-                            f"{args.time_limit:g}", "--seed", str(SEED), "--adaptive", mode,
+                            f"{args.time_limit:g}", "--seed", str(SEED), "--adaptive",
+                            mode.replace("+", ","),
                             "--quiet"] + cfg.get("options", []))
                 meta = exr.read_exr(path).metadata
                 c = cli.compare_json(exe, path, ref)

@@ -60,6 +60,10 @@ Scenes (analytic answers are radiances in the renderer's units):
                      faces the back wall from 0.4 m and the camera looks the other way, so
                      all light it sees has bounced at least once. No analytic answer.
 
+  door_room.gltf     Two 4 x 3 x 4 m white rooms joined by a 1 x 2 m door; a 0.5 m lamp on
+                     the far room's ceiling, the camera in the other room looking at the
+                     door: the light it sees came through the door. No analytic answer.
+
   unlit.gltf         A model as exporters write one with neither camera nor light: a 4 x 4
                      grey ground (rho 0.8), a red box, a blue sphere and a mirror sphere.
                      Rendered as shipped it gets the default view (framing the bounds) and the
@@ -586,6 +590,26 @@ def build_indirect():
     return b
 
 
+def build_door_room():
+    """Issue 39's room lit through a door: the lamp is in the next room."""
+    b = GltfBuilder()
+    white = b.lambertian("white", (0.7, 0.7, 0.7))
+    lamp = b.lambertian("light", (0.0, 0.0, 0.0), radiance=40.0)
+    # Two 4 x 3 x 4 m rooms side by side (x < 0 and x > 0) in one enclosure, split by a
+    # 0.1 m wall with a 1 x 2 m door; each wall piece a closed box facing both rooms.
+    b.mesh_node("rooms", [(box((-4.0, 0.0, -2.0), (4.0, 3.0, 2.0), inward=True), white)])
+    wall = merge([box((-0.05, 0.0, -2.0), (0.05, 3.0, -0.5)),
+                  box((-0.05, 0.0, 0.5), (0.05, 3.0, 2.0)),
+                  box((-0.05, 2.0, -0.5), (0.05, 3.0, 0.5))])
+    b.mesh_node("wall", [(wall, white)])
+    # On the far room's ceiling, facing down: its light reaches the camera's room only
+    # through the door, directly (a patch of floor) or after bounces.
+    b.mesh_node("light", [(quad((-2.5, 2.99, 0.0), (0.25, 0.0, 0.0), (0.0, 0.0, 0.25)), lamp)])
+    b.camera_node("camera", eye=(3.6, 1.6, 1.6), target=(0.0, 0.6, -0.4), yfov=0.9,
+                  aspect=4.0 / 3.0)
+    return b
+
+
 def unlit_parts(b):
     """The unlit model: ground, box, sphere, mirror sphere (docs/gltf.md's example)."""
     ground = b.lambertian("ground", (0.8, 0.8, 0.8))
@@ -891,6 +915,7 @@ OUTPUTS = [  # (file name, builder, writer)
     ("sun.gltf", build_sun, GltfBuilder.write_gltf),
     ("caustic.gltf", build_caustic, GltfBuilder.write_gltf),
     ("indirect_room.gltf", build_indirect, GltfBuilder.write_gltf),
+    ("door_room.gltf", build_door_room, GltfBuilder.write_gltf),
 ]
 
 CORPUS = [

@@ -173,6 +173,9 @@ void save_state(const std::string& path, const SavedRender& s) {
   w.f64(s.render.max_photon_power);
   w.u64(s.render.glossy_f.size());
   w.raw(s.render.glossy_f.data(), s.render.glossy_f.size() * sizeof(float));
+  w.u64(s.render.guide_learnt);
+  w.u64(s.render.guide.size());
+  w.raw(s.render.guide.data(), s.render.guide.size() * sizeof(double));
   const std::vector<PointState>& states = s.render.states;
   w.u64(states.size());
   // The states go to the file straight from the snapshot, without a copy into the buffer.
@@ -238,6 +241,11 @@ SavedRender load_state(const std::string& path) {
     if (gf > r.remaining() / sizeof(float)) throw StateError(path + ": truncated state file");
     s.render.glossy_f.resize(gf);
     r.raw(s.render.glossy_f.data(), gf * sizeof(float));
+    s.render.guide_learnt = r.u64();
+    const uint64_t gc = r.u64();
+    if (gc > r.remaining() / sizeof(double)) throw StateError(path + ": truncated state file");
+    s.render.guide.resize(gc);
+    r.raw(s.render.guide.data(), gc * sizeof(double));
     const uint64_t n = r.u64();
     if (n > r.remaining() / sizeof(PointState)) throw StateError(path + ": truncated state file");
     s.render.states.resize(n);

@@ -26,7 +26,7 @@ namespace pb {
 // sparse-photon bound's SPPM kernel masses, largest photon power and glossy caps;
 // 5: PointState with the alternating sums of the noise replica (192 B); 6: with the two-scale
 // check's moments (208 B); 7: SPPM's glossy caps as f / c, not f.
-inline constexpr uint32_t kStateVersion = 7;
+inline constexpr uint32_t kStateVersion = 8;
 
 struct SavedRender {
   RenderOptions options;    // as rendered (scene path, everything that shapes the image)

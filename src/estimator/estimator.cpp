@@ -30,6 +30,17 @@ SlopeAndSpread slope_and_spread(const PointState& s, double i, double photons_pe
 
 }  // namespace
 
+double relative_error(const PointState& s, uint64_t passes, double photons_per_pass) {
+  const double level = s.mean_x.x + s.mean_x.y + s.mean_x.z;
+  if (passes < 2 || !(level > 0.0) || !(s.r2 > 0.0)) return 1.0;
+  const double i = double(passes);
+  const auto [a, s2] = slope_and_spread(s, i, photons_per_pass);
+  const dvec3 b = a * s.mean_r2;
+  const double e2 = (s2.x + s2.y + s2.z) / i + glm::dot(b, b);
+  const double r = std::sqrt(3.0 * e2) / level;  // sqrt(mean e_c^2) / mean L_c
+  return std::isfinite(r) ? std::min(r, 1.0) : 1.0;
+}
+
 double ppm_radius_update(double& n, double& r2, double m, double alpha, double min_r2) {
   const double r2_pass = r2;
   double shrink = 1.0;

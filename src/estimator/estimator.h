@@ -94,6 +94,11 @@ inline constexpr double kAdaptiveSlopeZ = 3.0;
 // photons, no significant slope): the PPM schedule then decides alone.
 double preferred_r2(const PointState& state, uint64_t passes, double photons_per_pass);
 
+// A point's predicted error relative to its radiance, sqrt(mean_c(S_c^2 / i + B_c^2)) /
+// mean_c L_c, at most 1; 1 where it cannot be formed (fewer than 2 passes, no radiance). The
+// photon guide weighs what a photon brings to the point by it (ESTIMATOR.md section 14).
+double relative_error(const PointState& state, uint64_t passes, double photons_per_pass);
+
 // The PPM radius update (HOJ08; ESTIMATOR.md section 3) for m photons that could contribute:
 // R^2 *= (N + alpha m) / (N + m), N += alpha m, R^2 floored at min_r2. Returns the factor R^2
 // actually changed by, which tau and tauLap must follow exactly.

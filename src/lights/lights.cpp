@@ -153,7 +153,17 @@ vec3 Lights::spot_falloff(const PunctualLight& l, const vec3& dir) const {
   return l.intensity * spot_attenuation(l, glm::dot(dir, l.direction));
 }
 
-EmittedPhoton Lights::sample_photon(Rng& rng) const {
+EmittedPhoton Lights::sample_photon(Rng& rng) const { return sample_photon_from(rng); }
+
+EmittedPhoton Lights::sample_photon(PrimarySample& u) const { return sample_photon_from(u); }
+
+int Lights::direction_pair(float u0) const {
+  const size_t k = pick(u0);
+  return k < punctual_.size() || k == punctual_.size() + triangles_.size() ? 1 : 3;
+}
+
+template <class Random>
+EmittedPhoton Lights::sample_photon_from(Random& rng) const {
   const size_t k = pick(rng.next_float());
   const float p_pick = probability_[k];
   EmittedPhoton ph;

@@ -21,6 +21,18 @@ struct EmittedPhoton {
   float error = 0.0f;  // the origin's position error bound along normal (ray_offset.h)
 };
 
+// The uniform numbers a photon's emission draws, in the order Lights::sample_photon draws them
+// from an Rng: the emitter choice, then two pairs (a punctual light's direction; a triangle's
+// position, then its direction; the environment's direction, then the point it enters by) and
+// the side of a two-sided triangle. A photon guide (render/photon_guide.h) warps some of them
+// before the emission reads them: importance sampling in this primary sample space.
+struct PrimarySample {
+  static constexpr int kDims = 7;
+  float u[kDims] = {};
+  int next = 0;
+  float next_float() { return next < kDims ? u[next++] : 0.5f; }
+};
+
 struct DirectSample {
   vec3 wi{0.0f};       // unit direction from the receiver toward the light
   float distance = 0;  // to the sampled light point; infinite for directional and environment
@@ -70,6 +82,11 @@ class Lights {
   size_t emitter_count() const { return probability_.size(); }  // pieces counted one by one
 
   EmittedPhoton sample_photon(Rng& rng) const;
+  EmittedPhoton sample_photon(PrimarySample& u) const;
+  // The first of the two primary-sample dimensions that choose the direction of a photon of
+  // the emitter u0 picks: 1 for punctual lights and the environment (the first pair), 3 for a
+  // triangle (the second pair; the first places it on the triangle).
+  int direction_pair(float u0) const;
   // The largest channel of the power any emitted photon can carry (before the division by the
   // photons per pass): emitter power over its choice probability; for a map, its largest
   // radiance over its sampling density.
@@ -136,6 +153,8 @@ class Lights {
   vec3 spot_falloff(const PunctualLight& light, const vec3& dir) const;
   // A photon entering through the disc (emission_radius) perpendicular to `travel`.
   EmittedPhoton from_disc(const vec3& travel, float u0, float u1) const;
+  template <class Random>
+  EmittedPhoton sample_photon_from(Random& rng) const;
   bool sample_environment(const vec3& normal, float p_pick, Rng& rng, DirectSample& out) const;
 
   std::vector<PunctualLight> punctual_;

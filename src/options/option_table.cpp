@@ -140,36 +140,44 @@ OptionSpec asset_dirs() {
   return s;
 }
 
-// --adaptive LIST: a comma list of the parts that follow the error estimates. Only `radius`
-// is built; `photons` (guided emission) and `paths` (more camera paths where the camera part
-// dominates) are named by issue 39 and refused by name until they exist.
+// --adaptive LIST: a comma list of the parts that follow the error estimates: `radius`
+// (ESTIMATOR.md section 13) and `photons` (section 14). `paths` (more camera paths where the
+// camera part dominates) is named by issue 39 and refused by name until it exists.
 OptionSpec adaptive() {
   OptionSpec s = base("--adaptive", "adaptive", "LIST", "rendering", OptionKind::Image,
                       "comma list of what follows each pixel's error estimates: radius (each "
                       "point's radius minimises its predicted error, never above the --alpha "
-                      "schedule), or none");
+                      "schedule), photons (emission learnt from where past photons met the "
+                      "error), or none");
   s.parse = [](RenderOptions& o, const std::string& t) {
-    bool radius = false, none = false;
+    bool radius = false, photons = false, none = false;
     for (const std::string& part : split(t, ',')) {
       if (part == "radius")
         radius = true;
+      else if (part == "photons")
+        photons = true;
       else if (part == "none")
         none = true;
-      else if (part == "photons" || part == "paths")
-        fail("--adaptive", "'" + part + "' is not implemented yet; use radius or none");
+      else if (part == "paths")
+        fail("--adaptive", "'" + part + "' is not implemented yet; use radius, photons or none");
       else
-        fail("--adaptive", "'" + part + "' is not one of radius, none");
+        fail("--adaptive", "'" + part + "' is not one of radius, photons, none");
     }
-    if (none && radius) fail("--adaptive", "none cannot be combined with radius");
+    if (none && (radius || photons)) fail("--adaptive", "none cannot be combined with others");
     o.adaptive_radius = radius;
+    o.adaptive_photons = photons;
   };
   s.check = [](const RenderOptions&) {};
   s.format = [](const RenderOptions& o) -> std::string {
-    return o.adaptive_radius ? "radius" : "none";
+    if (o.adaptive_radius && o.adaptive_photons) return "radius,photons";
+    return o.adaptive_radius ? "radius" : o.adaptive_photons ? "photons" : "none";
   };
-  s.reset = [](RenderOptions& o) { o.adaptive_radius = RenderOptions{}.adaptive_radius; };
-  s.accepted = {"radius", "none", "radius,radius"};
-  s.rejected = {"", "photons", "radius,none", "radius,", "speed"};
+  s.reset = [](RenderOptions& o) {
+    o.adaptive_radius = RenderOptions{}.adaptive_radius;
+    o.adaptive_photons = RenderOptions{}.adaptive_photons;
+  };
+  s.accepted = {"radius", "none", "radius,radius", "photons", "photons,radius"};
+  s.rejected = {"", "paths", "radius,none", "none,photons", "radius,", "speed"};
   return s;
 }
 

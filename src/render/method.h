@@ -40,6 +40,10 @@ struct RenderState {
   std::vector<float> min_mass;     // SPPM: smallest kernel mass of a visible point, per pixel
   double max_photon_power = 0.0;   // largest channel of a photon's power seen (section 12)
   std::vector<float> glossy_f;     // SPPM: largest f / c a glossy visible point had, per pixel
+  // --adaptive photons: the photon guide's running histogram and the passes it has learnt
+  // (render/photon_guide.h); empty without.
+  std::vector<double> guide;
+  uint64_t guide_learnt = 0;
 };
 
 class PhotonMethod {

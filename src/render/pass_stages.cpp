@@ -57,7 +57,8 @@ namespace {
 // f(wo, wi) (glossy points, whose f holds the path weight alone).
 template <bool kLaplacian, class PhotonFlux>
 void gather_kernel(const VisiblePoint& point, double r2, const HashGrid& grid,
-                   const std::vector<PhotonHit>& hits, PhotonFlux&& photon_flux, PassSums& out) {
+                   const std::vector<PhotonHit>& hits, PhotonFlux&& photon_flux, PassSums& out,
+                   const GuideLearning* learn) {
   const float radius = search_radius(r2);
   const double inv_r2 = 1.0 / r2;
   // How far a photon may lie behind the point's tangent plane, facing it, and still count: far
@@ -88,7 +89,9 @@ void gather_kernel(const VisiblePoint& point, double r2, const HashGrid& grid,
     // against the shading cosine, hence cos_s / cos_g.
     const dvec3 flux = photon_flux(h) * double(cos_s / cos_g);
     const double t = std::min(1.0, std::sqrt(double(dist2) * inv_r2));
-    phi += kernel::weight(t) * flux;
+    const double w = kernel::weight(t);
+    phi += w * flux;
+    if (learn) learn->chunk->add(h.cell, learn->weight * w * (flux.x + flux.y + flux.z));
     if constexpr (kLaplacian) {
       lap += kernel::laplacian_weight_r2(t) * flux;
       if (t < 0.5) half += kernel::weight(2.0 * t) * flux;
@@ -127,40 +130,53 @@ class PointBsdfCursor {
 
 template <bool kLaplacian>
 void gather_photons(const VisiblePoint& point, double r2, const HashGrid& grid,
-                    const std::vector<PhotonHit>& hits, PassSums& out) {
+                    const std::vector<PhotonHit>& hits, PassSums& out, const GuideLearning* learn) {
   gather_kernel<kLaplacian>(
-      point, r2, grid, hits, [](const PhotonHit& h) { return dvec3(h.flux); }, out);
+      point, r2, grid, hits, [](const PhotonHit& h) { return dvec3(h.flux); }, out, learn);
 }
 
 template <bool kLaplacian>
 void gather_photons(const VisiblePoint& point, const PointBsdf& glossy, double r2,
-                    const HashGrid& grid, const std::vector<PhotonHit>& hits, PassSums& out) {
+                    const HashGrid& grid, const std::vector<PhotonHit>& hits, PassSums& out,
+                    const GuideLearning* learn) {
   gather_kernel<kLaplacian>(
       point, r2, grid, hits,
-      [&](const PhotonHit& h) { return dvec3(h.flux * glossy.bsdf.eval(glossy.wo, h.wi)); }, out);
+      [&](const PhotonHit& h) { return dvec3(h.flux * glossy.bsdf.eval(glossy.wo, h.wi)); }, out,
+      learn);
 }
 
 template void gather_photons<true>(const VisiblePoint&, double, const HashGrid&,
-                                   const std::vector<PhotonHit>&, PassSums&);
+                                   const std::vector<PhotonHit>&, PassSums&, const GuideLearning*);
 template void gather_photons<false>(const VisiblePoint&, double, const HashGrid&,
-                                    const std::vector<PhotonHit>&, PassSums&);
+                                    const std::vector<PhotonHit>&, PassSums&, const GuideLearning*);
 template void gather_photons<true>(const VisiblePoint&, const PointBsdf&, double, const HashGrid&,
-                                   const std::vector<PhotonHit>&, PassSums&);
+                                   const std::vector<PhotonHit>&, PassSums&, const GuideLearning*);
 template void gather_photons<false>(const VisiblePoint&, const PointBsdf&, double, const HashGrid&,
-                                    const std::vector<PhotonHit>&, PassSums&);
+                                    const std::vector<PhotonHit>&, PassSums&, const GuideLearning*);
 
 void gather_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
                  const HashGrid& grid, const std::vector<PhotonHit>& hits, PointBsdfTable glossy,
-                 std::span<PassSums> out) {
+                 std::span<PassSums> out, GuideTally::Chunk* tally, const GuideInputs& guide) {
   std::fill(out.begin(), out.end(), PassSums{});
   PointBsdfCursor cursor(glossy, points.size());
   for (size_t k = 0; k < points.size(); ++k) {
     const VisiblePoint& p = points[k];
     if (!(max_component(p.f) > 0.0f)) continue;  // SPPM: a pixel without a visible point
+    GuideLearning learn;
+    if (tally) {
+      // A photon's share of the point's pass sample X_j is w f Phi / (pi R^2 M_e X); times the
+      // point's relative error e / L it is the error the photon stands for (section 14). The
+      // constants pi M_e are common to the pass and cancel in the guide's normalisation; the
+      // sample X_j is taken as its mean L, the share of e being e / L.
+      learn.chunk = tally;
+      learn.weight = relative_error(states[k], guide.passes_done, guide.photons_per_pass) *
+                     double(p.f.x + p.f.y + p.f.z) / states[k].r2;
+    }
+    const GuideLearning* l = tally ? &learn : nullptr;
     if (const PointBsdf* g = cursor.at(k))
-      gather_photons(p, *g, states[k].r2, grid, hits, out[k]);
+      gather_photons(p, *g, states[k].r2, grid, hits, out[k], l);
     else
-      gather_photons(p, states[k].r2, grid, hits, out[k]);
+      gather_photons(p, states[k].r2, grid, hits, out[k], l);
   }
 }
 

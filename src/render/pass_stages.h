@@ -15,6 +15,7 @@
 #include "render/camera_pass.h"
 #include "render/hash_grid.h"
 #include "render/next_event.h"
+#include "render/photon_guide.h"
 #include "render/photon_pass.h"
 #include "util/parallel.h"
 #include "util/rng.h"
@@ -41,14 +42,22 @@ void build_photon_grid(const std::vector<PhotonHit>& hits, std::span<const float
 // (ESTIMATOR.md sections 2-3). Without the Laplacian (the bench's "error estimation off"
 // variant) phi_lap_r2 is left alone. Lambertian points: the photon powers are summed and f
 // multiplied once.
+// With `learn`, each photon's error-weighted contribution goes to its guide cell
+// (photon_guide.h): its share of the point's pass sample times learn->weight.
+struct GuideLearning {
+  GuideTally::Chunk* chunk = nullptr;
+  double weight = 0.0;  // the point's relative error times mean(f) / R^2
+};
 template <bool kLaplacian = true>
 void gather_photons(const VisiblePoint& point, double r2, const HashGrid& grid,
-                    const std::vector<PhotonHit>& hits, PassSums& out);
+                    const std::vector<PhotonHit>& hits, PassSums& out,
+                    const GuideLearning* learn = nullptr);
 // The same for a point on a non-Lambertian surface: each photon's power times f(wo, wi_photon),
 // the path weight point.f once.
 template <bool kLaplacian = true>
 void gather_photons(const VisiblePoint& point, const PointBsdf& glossy, double r2,
-                    const HashGrid& grid, const std::vector<PhotonHit>& hits, PassSums& out);
+                    const HashGrid& grid, const std::vector<PhotonHit>& hits, PassSums& out,
+                    const GuideLearning* learn = nullptr);
 
 // The glossy side table of a span of points: entries sorted by PointBsdf::point, which counts
 // from the span's first point at `base` (entries outside the span are skipped).
@@ -60,10 +69,18 @@ struct PointBsdfTable {
 // Stage 3: out[k] = the sums of the photons `hits` brings to points[k] (phi, phi_lap_r2,
 // phi_half, count) at the pass's radius states[k].r2. A point with f = 0 (SPPM: no visible point
 // this pass) gathers nothing and so does not shrink its radius. Points in `glossy` evaluate
-// their Bsdf per photon.
+// their Bsdf per photon. With `tally` (--adaptive photons), every gathered photon's
+// error-weighted contribution goes to its guide cell, the point's relative error from its state
+// after `passes_done` passes (ESTIMATOR.md section 14).
+struct GuideInputs {
+  GuideTally* tally = nullptr;
+  uint64_t passes_done = 0;
+  double photons_per_pass = 1.0;
+};
 void gather_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
                  const HashGrid& grid, const std::vector<PhotonHit>& hits, PointBsdfTable glossy,
-                 std::span<PassSums> out);
+                 std::span<PassSums> out, GuideTally::Chunk* tally = nullptr,
+                 const GuideInputs& guide = {});
 
 // Stage 4, PPM: out[k].disc = the kernel's moments over the reachable part of points[k]'s disc
 // at the pass's radius (ESTIMATOR.md section 11); without `boundary` every disc counts as whole.
@@ -112,6 +129,7 @@ struct PassInputs {
   uint64_t seed = 0, pass = 0;
   bool next_event = true;
   const Cutoff* cutoff = nullptr;
+  GuideInputs guide;  // tally set: this pass learns the photon guide
   // Whether a chunk of the fold block starting at `first` should give up: only the first block
   // can (the later ones come after a fold).
   bool cut(size_t first) const { return first == 0 && cutoff && cutoff->reached(); }

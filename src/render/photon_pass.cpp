@@ -43,10 +43,23 @@ uint32_t lattice(float v, float lo, float scale) {
 PhotonTracer::PhotonTracer(const World& world, bool deposit_first_hit)
     : world_(world), deposit_first_hit_(deposit_first_hit) {}
 
-void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, std::vector<PhotonHit>& out,
-                         uint64_t& rays) const {
+void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, const EmissionGuide* guide,
+                         std::vector<PhotonHit>& out, uint64_t& rays) const {
   Rng rng(seed, pass, index, Stream::Photon);
-  const EmittedPhoton e = world_.lights().sample_photon(rng);
+  uint32_t cell = 0;
+  EmittedPhoton e;
+  if (guide) {
+    // The emission's numbers first, then the cell's: a guided photon draws them all whatever
+    // the emitter, so the path's later numbers do not depend on which one it picked.
+    PrimarySample u;
+    for (float& x : u.u) x = rng.next_float();
+    float density = 1.0f;
+    cell = guide->warp(rng.next_float(), u, world_.lights(), density);
+    e = world_.lights().sample_photon(u);
+    e.flux /= density;  // importance sampling in the primary sample space (photon_guide.h)
+  } else {
+    e = world_.lights().sample_photon(rng);
+  }
   vec3 origin = e.origin, dir = e.dir, flux = e.flux, origin_normal = e.normal;
   float origin_error = e.error;
   for (int bounce = 0; bounce < kMaxBounces; ++bounce) {
@@ -70,7 +83,7 @@ void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, std::vect
     // on with its flux: what the surface scatters is a times what reaches it, on average.
     if (!s.bsdf.is_delta() && !s.material->unlit && (bounce >= 1 || deposit_first_hit_)) {
       const float a = s.material->blended() ? world_.coverage(hit, s) : 1.0f;
-      out.push_back({s.position, wo, ng, a > 0.0f && a < 1.0f ? flux / a : flux});
+      out.push_back({s.position, wo, ng, a > 0.0f && a < 1.0f ? flux / a : flux, cell});
     }
     BsdfSample b;
     if (!s.bsdf.sample(wo, rng, Transport::Importance, b, flux)) return;
@@ -89,7 +102,8 @@ void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, std::vect
 }
 
 PhotonPassStats PhotonTracer::run(uint64_t seed, uint64_t pass, uint64_t first, uint64_t last,
-                                  std::vector<PhotonHit>& hits, const Cutoff* cutoff) {
+                                  std::vector<PhotonHit>& hits, const Cutoff* cutoff,
+                                  const EmissionGuide* guide) {
   const uint64_t count = last > first ? last - first : 0;
   const size_t chunks = size_t((count + kChunk - 1) / kChunk);
   if (chunk_hits_.size() < chunks) chunk_hits_.resize(chunks);
@@ -105,7 +119,7 @@ PhotonPassStats PhotonTracer::run(uint64_t seed, uint64_t pass, uint64_t first, 
     std::vector<PhotonHit>& out = chunk_hits_[k];
     out.clear();
     uint64_t local_rays = 0;
-    for (size_t i = begin; i < end; ++i) trace(seed, pass, first + i, out, local_rays);
+    for (size_t i = begin; i < end; ++i) trace(seed, pass, first + i, guide, out, local_rays);
     Bounds b;
     float max_flux = 0.0f;
     for (const PhotonHit& h : out) {

@@ -4,6 +4,7 @@
 // recorded.
 #pragma once
 
+#include "render/photon_guide.h"
 #include "util/timer.h"
 #include "world/world.h"
 
@@ -17,6 +18,7 @@ struct PhotonHit {
   vec3 wi{0.0f};      // unit, toward where the photon came from
   vec3 normal{0.0f};  // geometric normal of the hit surface, on wi's side
   vec3 flux{0.0f};    // power carried (before division by the photons per pass)
+  uint32_t cell = 0;  // the photon guide's cell it was emitted from (0 without a guide)
 };
 
 struct PhotonPassStats {
@@ -43,8 +45,10 @@ class PhotonTracer {
   // faster gather at 1 M photons per pass, and a faster grid build).
   // With a cutoff, each batch of kChunk photons first polls it; once it is reached the run
   // stops early and returns with `cut` set (the caller discards the pass).
+  // With a `guide`, photons are emitted from it (photon_guide.h) and each hit records its cell.
   PhotonPassStats run(uint64_t seed, uint64_t pass, uint64_t first, uint64_t last,
-                      std::vector<PhotonHit>& hits, const Cutoff* cutoff = nullptr);
+                      std::vector<PhotonHit>& hits, const Cutoff* cutoff = nullptr,
+                      const EmissionGuide* guide = nullptr);
 
   // Photons per batch: large enough to amortise scheduling, small enough to balance 2 cores.
   static constexpr size_t kChunk = 2048;
@@ -53,8 +57,8 @@ class PhotonTracer {
   static constexpr int kMaxBounces = 256;
 
  private:
-  void trace(uint64_t seed, uint64_t pass, uint64_t index, std::vector<PhotonHit>& out,
-             uint64_t& rays) const;
+  void trace(uint64_t seed, uint64_t pass, uint64_t index, const EmissionGuide* guide,
+             std::vector<PhotonHit>& out, uint64_t& rays) const;
 
   // Sorts the chunks' hits into `hits` (see run()).
   void order_hits(std::vector<PhotonHit>& hits);

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <optional>
 #include <string>
 
 namespace pb {
@@ -48,7 +49,10 @@ bool ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
       const std::span<const VisiblePoint> pts = points.subspan(at, m);
       const std::span<const PointState> st = std::span<const PointState>(states).subspan(at, m);
       const PointBsdfTable table{glossy, at};
-      gather_pass(pts, st, in.grid, in.hits, table, sums.subspan(b, m));
+      std::optional<GuideTally::Chunk> learn;
+      if (in.guide.tally) learn.emplace(*in.guide.tally, b / kStageChunk);
+      gather_pass(pts, st, in.grid, in.hits, table, sums.subspan(b, m), learn ? &*learn : nullptr,
+                  in.guide);
       const std::span<OwnerValues> own = owner.subspan(b, m);
       std::fill(own.begin(), own.end(), OwnerValues{});
       disc_pass(pts, st, in.boundary, clearance.empty() ? clearance : clearance.subspan(at, m),
@@ -56,6 +60,7 @@ bool ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
       if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, at, own);
     });
     if (cut.load()) return false;  // the first block: nothing folded yet
+    if (in.guide.tally) in.guide.tally->reduce_block((count + kStageChunk - 1) / kStageChunk);
     // A distributed render reduces sums[0, count) across machines here.
     fold_block(first, states, std::span<const PassSums>(sums).first(count),
                std::span<const OwnerValues>(owner).first(count), in.params, in.pass, radii, copy);

@@ -9,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 
 namespace pb {
 
@@ -70,6 +71,7 @@ Renderer::Renderer(Scene scene, const RenderOptions& options)
   boundary_ = BoundaryIndex(world_, std::nextafter(float(initial_radius_), INFINITY));
   method_->prepare(boundary_, initial_radius_);
   max_photon_power_ = world_.lights().max_photon_flux();
+  if (options_.adaptive_photons) guide_.emplace(world_.lights().emitter_count());
   PointState initial;
   initial.r2 = initial_radius_ * initial_radius_;
   states_.assign(method_->state_count(), initial);
@@ -98,8 +100,9 @@ FilmSettings Renderer::film_settings() const {
 bool Renderer::step(std::vector<PointState>* copy, const Cutoff* cutoff) {
   const uint64_t pass = work_.passes + 1;
   auto t = Clock::now();
+  const EmissionGuide* guide = guide_ ? &*guide_ : nullptr;
   const PhotonPassStats stats =
-      tracer_.run(options_.seed, pass, 0, options_.photons_per_pass, hits_, cutoff);
+      tracer_.run(options_.seed, pass, 0, options_.photons_per_pass, hits_, cutoff, guide);
   timings_.trace += seconds_since(t);
   if (stats.cut) return false;
 
@@ -112,6 +115,11 @@ bool Renderer::step(std::vector<PointState>* copy, const Cutoff* cutoff) {
 
     t = Clock::now();
     if (copy) copy->resize(n);
+    GuideInputs learn;
+    if (guide_) {
+      tally_.begin_pass(guide_->cells(), (kFoldBlock + kStageChunk - 1) / kStageChunk);
+      learn = {&tally_, work_.passes, double(options_.photons_per_pass)};
+    }
     const PassInputs in{world_,
                         grid_,
                         hits_,
@@ -120,7 +128,8 @@ bool Renderer::step(std::vector<PointState>* copy, const Cutoff* cutoff) {
                         options_.seed,
                         pass,
                         options_.direct == DirectMode::NextEvent,
-                        cutoff};
+                        cutoff,
+                        learn};
     const bool whole = method_->step(in, states_, radii_, copy ? copy->data() : nullptr);
     timings_.gather += seconds_since(t);
     if (!whole) return false;
@@ -130,6 +139,13 @@ bool Renderer::step(std::vector<PointState>* copy, const Cutoff* cutoff) {
   work_.rays += stats.rays;
   work_.photons += stats.paths;
   max_photon_power_ = std::max(max_photon_power_, double(stats.max_flux));
+  if (guide_ && n > 0) {
+    // The next pass's photons come from what this one learnt: their largest power is the
+    // lights' times the guide's largest weight (the sparse-photon bound's Phi_max, section 12).
+    guide_->learn(tally_.sums());
+    max_photon_power_ =
+        std::max(max_photon_power_, world_.lights().max_photon_flux() * guide_->max_weight());
+  }
   return true;
 }
 
@@ -140,6 +156,10 @@ RenderState Renderer::snapshot(std::vector<PointState> states) const {
   s.states = std::move(states);
   method_->save(s);
   s.max_photon_power = max_photon_power_;
+  if (guide_) {
+    s.guide = guide_->histogram();
+    s.guide_learnt = guide_->learnt();
+  }
   return s;
 }
 
@@ -151,6 +171,16 @@ void Renderer::restore(const RenderState& saved) {
   method_->restore(saved);
   states_ = saved.states;
   max_photon_power_ = saved.max_photon_power;
+  if (guide_) {
+    try {
+      guide_->restore(saved.guide, saved.guide_learnt);
+    } catch (const std::invalid_argument& e) {
+      throw StateError(e.what());
+    }
+  } else if (!saved.guide.empty()) {
+    throw StateError(
+        "the state holds a photon guide but this render has --adaptive without photons");
+  }
   for (size_t k = 0; k < states_.size(); ++k) radii_[k] = search_radius(states_[k].r2);
   work_ = saved.work;
   initial_radius_ = saved.initial_radius;

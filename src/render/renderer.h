@@ -19,6 +19,7 @@
 
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -112,6 +113,10 @@ class Renderer {
   std::vector<PointState> states_;
   EstimatorParams params_;
   PhotonTracer tracer_;
+  // --adaptive photons: the emission the next pass's photons are drawn from, and what the pass
+  // gathers to learn it (ESTIMATOR.md section 14).
+  std::optional<EmissionGuide> guide_;
+  GuideTally tally_;
   HashGrid grid_;
   BoundaryIndex boundary_;  // where surfaces end, for discs up to the initial radius
   bool boundary_on_ = true;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <optional>
 #include <string>
 
 namespace pb {
@@ -53,11 +54,15 @@ bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
       const size_t n_glossy = trace_visible_points(
           camera, at, std::span<const float>(radii).subspan(at, m), pts, scratch, own);
       const PointBsdfTable table{scratch.first(n_glossy), 0};  // indices into pts
-      gather_pass(pts, st, in.grid, in.hits, table, std::span(sums_).subspan(b, m));
+      std::optional<GuideTally::Chunk> learn;
+      if (in.guide.tally) learn.emplace(*in.guide.tally, b / kStageChunk);
+      gather_pass(pts, st, in.grid, in.hits, table, std::span(sums_).subspan(b, m),
+                  learn ? &*learn : nullptr, in.guide);
       if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, at, own);
       glossy_count_[b / kStageChunk] = uint32_t(n_glossy);
     });
     if (cut.load()) return false;  // the first block: nothing recorded or folded yet
+    if (in.guide.tally) in.guide.tally->reduce_block((count + kStageChunk - 1) / kStageChunk);
     // The pixels' side state, once the pass is known to go on (a chunk writes its own pixels).
     for_each_chunk(count, [&](size_t b, size_t m) {
       record_visible(first + b, std::span(points_).subspan(b, m), std::span(owner_).subspan(b, m),

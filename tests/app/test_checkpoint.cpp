@@ -57,6 +57,26 @@ TEST_F(Checkpoints, ResumeIsBitIdenticalWithSppm) {
   expect_resume_bit_identical(o, path("half.pbstate"));
 }
 
+// --adaptive photons: the photon guide's histogram goes through the state file, so the photons
+// after the resume are drawn from the guide the uninterrupted render had.
+TEST_F(Checkpoints, ResumeIsBitIdenticalWithGuidedPhotons) {
+  RenderOptions o = small_options();
+  o.method = Method::SPPM;
+  o.adaptive_photons = true;
+  expect_resume_bit_identical(o, path("half.pbstate"));
+  const SavedRender s = saved_after(o, 2);
+  EXPECT_EQ(s.render.guide_learnt, 2u);
+  save_state(path("g.pbstate"), s);
+  const SavedRender t = load_state(path("g.pbstate"));
+  EXPECT_EQ(t.render.guide, s.render.guide);
+  EXPECT_EQ(t.render.guide_learnt, 2u);
+  // A guided state does not resume a render without the guide.
+  o.adaptive_photons = false;
+  const Scene scene = load_gltf(o.scene);
+  Renderer plain(scene, o);
+  EXPECT_THROW(plain.restore(t.render), StateError);
+}
+
 void expect_resume_bit_identical(const RenderOptions& o, const std::string& state_path) {
   const Scene scene = load_gltf(o.scene);
   Renderer straight(scene, o);
