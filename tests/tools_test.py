@@ -137,6 +137,7 @@ def smoke(exe, tmp):
     check(not leftovers, f"temporary files left behind: {leftovers}")
     cornell_reference_margin(exe, tmp)
     adaptive_study(exe, tmp)
+    mitsuba_translation(tmp)
     gltf_reading(tmp)
 
 
@@ -165,6 +166,39 @@ def adaptive_study(exe, tmp):
         check(abs(actual - r["actual"]) <= 1e-9 * max(1.0, actual), f"{path}: actual differs")
         check(rows[0][f"{r['mode']}: passes"] == str(r["passes"]),
               f"table passes for {r['mode']}")
+
+
+def mitsuba_translation(tmp):
+    """tools.mitsuba_side_by_side's translation for the peer (Mitsuba itself never runs in CI):
+    the caustic's meshes go out as PLY files with every triangle, its materials as the peer
+    reads them; a glossy material is refused by name; and its fit is exact on a power law."""
+    from tools import mitsuba_side_by_side as mss
+    out = os.path.join(tmp, "mitsuba")
+    os.makedirs(out, exist_ok=True)
+    desc = json.load(open(mss.translate(os.path.join(REPO, "scenes", "caustic.gltf"), out, 32,
+                                        24), encoding="utf-8"))
+    kinds = sorted(m["material"]["kind"] for m in desc["meshes"])
+    check(kinds == ["dielectric", "diffuse", "diffuse"], f"caustic materials {kinds}")
+    scene = gltf_scene.load(os.path.join(REPO, "scenes", "caustic.gltf"))
+    want = [len(p.indices) // 3 for m in scene.meshes for p in m.primitives]
+    for m, n in zip(desc["meshes"], want):
+        with open(m["ply"], "rb") as f:
+            data = f.read()
+        head = data[:data.index(b"end_header\n")].decode("ascii")
+        faces = int(head.split("element face ")[1].split()[0])
+        check(faces == n, f"{m['ply']}: {faces} faces, the file has {n}")
+        vertices = int(head.split("element vertex ")[1].split()[0])
+        stride = 24 if m["smooth"] else 12
+        size = len(data) - len(head) - len("end_header\n")
+        check(size == vertices * stride + faces * 13, f"{m['ply']}: {size} bytes of data")
+    try:
+        mss.translate(os.path.join(REPO, "scenes", "glossy_plane.gltf"), out, 8, 8)
+        check(False, "a glossy material was translated")
+    except ToolError as e:
+        check("only Lambertian and dielectric" in str(e), f"glossy refusal: {e}")
+    rows = [{"seconds": 2.0 ** k, "error": 0.1 * 2.0 ** (-0.5 * k)} for k in range(5)]
+    check(abs(mss.fit(rows) + 0.5) < 1e-12, f"fit slope {mss.fit(rows)}")
+    check(abs(mss.seconds_at(rows, 0.1 * 2.0 ** -1.25) - 2.0 ** 2.5) < 1e-9, "seconds_at")
 
 
 def cornell_reference_margin(exe, tmp):

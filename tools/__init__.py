@@ -8,6 +8,11 @@
   python3 -m tools.views           PNG views of a photonbound EXR
   python3 -m tools.plot_logs       plots of convergence logs and of a sweep of targets
   python3 -m tools.hostile         the hostile corpus: each class of issue 36, run with limits
+  python3 -m tools.adaptive_study  passes and seconds to a target per --adaptive mode
+  python3 -m tools.mitsuba_side_by_side
+                                   relative error against seconds beside Mitsuba 3 (the peer
+                                   installed from PyPI when it runs, into a venv of its own;
+                                   tools/mitsuba_peer.py runs there; never in CI)
 
 Each takes --help. The modules they share, one job each, so that every tool does it the same
 way:
