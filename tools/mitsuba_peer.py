@@ -8,9 +8,10 @@ SCENE.json is what tools.mitsuba_side_by_side writes from a glTF file: PLY meshe
 material (diffuse, dielectric, area emitter), punctual lights and the camera. `render` renders
 N samples per pixel with the LLVM backend and a box pixel filter, in chunks of C samples per
 pixel with seeds S, S + 1, ... (one wavefront of N samples for every pixel would not fit in
-memory), averaged; it prints one JSON line: the seconds of the timed chunks and of the untimed
-warm-up render (one chunk) that compiles their kernels. `mask` writes 1 where every one of 4 x 4 rays through
-a pixel first meets a surface a light tracer can connect to the camera (not a delta BSDF), else 0.
+memory), averaged; it prints one JSON line: the seconds of the timed chunks and of the
+untimed warm-up render (one chunk) that compiles their kernels. `mask` writes 1 where every one
+of 4 x 4 rays through a pixel first meets a surface a light tracer can connect to the camera
+(not a delta BSDF), else 0.
 
 Imports Mitsuba, Dr.Jit and numpy only (and the standard library): not OpenImageIO.
 """
