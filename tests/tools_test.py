@@ -138,6 +138,7 @@ def smoke(exe, tmp):
     cornell_reference_margin(exe, tmp)
     adaptive_study(exe, tmp)
     mitsuba_translation(tmp)
+    cycles_reading(exe, tmp)
     gltf_reading(tmp)
 
 
@@ -199,6 +200,38 @@ def mitsuba_translation(tmp):
     rows = [{"seconds": 2.0 ** k, "error": 0.1 * 2.0 ** (-0.5 * k)} for k in range(5)]
     check(abs(mss.fit(rows) + 0.5) < 1e-12, f"fit slope {mss.fit(rows)}")
     check(abs(mss.seconds_at(rows, 0.1 * 2.0 ** -1.25) - 2.0 ** 2.5) < 1e-9, "seconds_at")
+
+
+def cycles_reading(exe, tmp):
+    """tools.cycles_side_by_side's reading of a render (Blender itself never runs in CI): the
+    view it gives Cycles is the one the metadata records, the sky is on only without a light,
+    an environment map is refused by name, and the ratios are taken over covered pixels only."""
+    from tools import cycles_side_by_side as cyc
+    path = os.path.join(tmp, "cyc.exr")
+    cli.render(exe, os.path.join(REPO, "scenes", "cornell.gltf"), path,
+               ["--resolution", "16x12", "--passes", "1", "--quiet", "--fov", "50",
+                "--look-from", "0,1,3", "--look-at", "0,1,0"])
+    meta = exr.read_exr(path).metadata
+    view = cyc.view_of(meta, path)
+    check(view["from"] == [0.0, 1.0, 3.0] and view["at"][2] < 3.0, f"view {view}")
+    check(abs(view["fov"] - 50.0) < 1e-5 and  # the camera keeps yfov as a float
+          (view["width"], view["height"]) == (16, 12),
+          f"view {view}")
+    check(cyc.has_light(gltf_scene.load(os.path.join(REPO, "scenes", "cornell.gltf"))),
+          "the Cornell box has a light")
+    check(not cyc.has_light(gltf_scene.load(os.path.join(REPO, "scenes", "unlit.gltf"))),
+          "unlit.gltf has no light")
+    try:
+        cyc.view_of(dict(meta, **{"photonbound:environment": "sky.exr"}), path)
+        check(False, "an environment map was accepted")
+    except ToolError as e:
+        check("not translated" in str(e), f"environment refusal: {e}")
+    ours = np.ones((2, 2, 3))
+    theirs = np.full((2, 2, 3), 0.5)
+    alpha = np.array([[1.0, 1.0], [0.0, 0.5]])
+    theirs[1, :, :] = 100.0  # uncovered pixels do not count
+    r = cyc.ratios(ours, theirs, alpha)
+    check(r["pixels"] == 2 and abs(r["R"] - 2.0) < 1e-12, f"ratios {r}")
 
 
 def cornell_reference_margin(exe, tmp):

@@ -13,6 +13,9 @@
                                    relative error against seconds beside Mitsuba 3 (the peer
                                    installed from PyPI when it runs, into a venv of its own;
                                    tools/mitsuba_peer.py runs there; never in CI)
+  python3 -m tools.cycles_side_by_side
+                                   a render beside Blender's Cycles from the same view, lights
+                                   and sky (Blender from Debian when it runs; never in CI)
 
 Each takes --help. The modules they share, one job each, so that every tool does it the same
 way:
