@@ -9,8 +9,8 @@ Lambertian), specular (name -> KHR_materials_specular's factor), one_sided (the 
 materials that are not doubleSided) and principled (keep Blender's import as it is). The file
 is imported by Blender's glTF importer with its lights in the importer's compatibility units
 (convert_lighting_mode COMPAT: a point light's W/sr as glTF gives them, photonbound's
-reading), the materials matched (match_materials), a camera is made for the view photonbound rendered, and
-Cycles renders it on the CPU with a box pixel filter, no clamping, no denoising, caustics on
+reading), the materials matched (match_materials), a camera is made for the view photonbound
+rendered, and Cycles renders it on the CPU with a box pixel filter, no clamping, no denoising, caustics on
 and 64 bounces of every kind; the EXR is scene-linear RGBA (alpha: the share of the pixel a
 surface covers).
 """
