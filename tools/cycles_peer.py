@@ -10,9 +10,9 @@ materials that are not doubleSided) and principled (keep Blender's import as it 
 is imported by Blender's glTF importer with its lights in the importer's compatibility units
 (convert_lighting_mode COMPAT: a point light's W/sr as glTF gives them, photonbound's
 reading), the materials matched (match_materials), a camera is made for the view photonbound
-rendered, and Cycles renders it on the CPU with a box pixel filter, no clamping, no denoising, caustics on
-and 64 bounces of every kind; the EXR is scene-linear RGBA (alpha: the share of the pixel a
-surface covers).
+rendered, and Cycles renders it on the CPU with a box pixel filter, no clamping, no denoising,
+caustics on and 64 bounces of every kind; the EXR is scene-linear RGBA (alpha: the share of
+the pixel a surface covers).
 """
 
 import json
