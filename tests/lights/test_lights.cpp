@@ -2,6 +2,7 @@
 // textured emitters (power, where photons start, next-event estimates) and double-sided ones.
 #include "bsdf/microfacet.h"
 #include "lights/lights.h"
+#include "sample_mean.h"
 #include "util/rng.h"
 
 #include <gtest/gtest.h>
@@ -101,17 +102,7 @@ Scene emissive_quad(const Material& mat, std::vector<Image> images = {}) {
   return s;
 }
 
-struct Mean {
-  double sum = 0, sum2 = 0;
-  int n = 0;
-  void add(double x) {
-    sum += x;
-    sum2 += x * x;
-    ++n;
-  }
-  double mean() const { return sum / n; }
-  double se() const { return std::sqrt(std::max(0.0, sum2 / n - mean() * mean()) / n); }
-};
+using test::Mean;
 
 TEST(TexturedEmitter, PhotonPowerIsTheIntegralOfTheTexturedRadiance) {
   // A 2 x 2 sRGB emissive texture, clamped and bilinear, times emissiveFactor (2, 1, 0.5): with

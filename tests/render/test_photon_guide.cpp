@@ -3,6 +3,7 @@
 // uniform share, and the learning sums do not depend on the threads.
 #include "lights/lights.h"
 #include "render/photon_guide.h"
+#include "sample_mean.h"
 #include "util/parallel.h"
 #include "util/rng.h"
 
@@ -33,17 +34,7 @@ Scene two_emitters() {
   return s;
 }
 
-struct Mean {
-  double sum = 0, sum2 = 0;
-  int n = 0;
-  void add(double x) {
-    sum += x;
-    sum2 += x * x;
-    ++n;
-  }
-  double mean() const { return sum / n; }
-  double se() const { return std::sqrt(std::max(0.0, sum2 / n - mean() * mean()) / n); }
-};
+using test::Mean;
 
 // Regions of a photon's emission: which emitter (by where it starts) and which octant it
 // leaves into.
