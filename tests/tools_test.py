@@ -228,7 +228,7 @@ def cycles_reading(exe, tmp):
         check("not translated" in str(e), f"environment refusal: {e}")
     ours = np.ones((2, 2, 3))
     theirs = np.full((2, 2, 3), 0.5)
-    alpha = np.array([[1.0, 1.0], [0.0, 0.5]])
+    alpha = np.array([[1.0, 1.0], [0.0, 0.4]])
     theirs[1, :, :] = 100.0  # uncovered pixels do not count
     r = cyc.ratios(ours, theirs, alpha)
     check(r["pixels"] == 2 and abs(r["R"] - 2.0) < 1e-12, f"ratios {r}")

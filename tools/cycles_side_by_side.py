@@ -21,7 +21,7 @@ uniform radiance 1 times --environment-scale when the scene has no light, none o
 (environment maps are not translated).
 
 It prints the ratio photonbound / Cycles per channel of the mean over the pixels a surface
-covers (Cycles' alpha 1), and writes to DIR (default: beside RENDER.exr, RENDER_cycles/):
+covers at least half of (Cycles' alpha, with the sky put back where it is below 1), and writes to DIR (default: beside RENDER.exr, RENDER_cycles/):
 cycles.exr, side_by_side.png (photonbound left, Cycles right, one exposure), difference.png
 (photonbound minus Cycles: red where photonbound is brighter, blue where darker, full colour at
 the largest difference's 99th percentile) and ratios.json.
@@ -76,9 +76,10 @@ def has_light(scene):
 
 
 def ratios(ours, cycles, alpha):
-    """Per channel: the mean of ours over the mean of Cycles' over the pixels a surface covers."""
+    """Per channel: the mean of ours over the mean of Cycles' over the pixels a surface covers
+    at least half of (Cycles' alpha); `cycles` has the sky composited back where alpha < 1."""
     import numpy as np
-    covered = alpha >= 0.999
+    covered = alpha >= 0.5
     if not covered.any():
         raise ToolError("Cycles' image has no pixel a surface covers")
     out = {}
@@ -146,14 +147,15 @@ def main():
     ours = np.stack([ours_exr.planes[c] for c in "RGB"], axis=-1).astype(np.float64)
     if ours.shape != cy.shape:
         raise ToolError(f"the images differ in size: {ours.shape} and {cy.shape}")
-    r = ratios(ours, cy, alpha)
-    # Cycles' transparent film leaves the sky out of its colour; put it back for the picture.
+    # Cycles' transparent film leaves the sky out of its colour (its alpha says how much of a
+    # pixel a surface covers: MASK and BLEND materials, edges); put the uniform sky back.
     sky = job["sky"]
     cy_shown = cy + (1.0 - alpha[..., None]) * sky
+    r = ratios(ours, cy_shown, alpha)
     scale = max(float(np.percentile(np.concatenate([ours, cy_shown]), 99)), 1e-12)
     save_png(os.path.join(out, "side_by_side.png"),
              np.clip(np.concatenate([ours, cy_shown], axis=1) / scale, 0, 1) ** (1 / 2.2))
-    diff = (ours - cy).mean(axis=2) * (alpha >= 0.999)
+    diff = (ours - cy_shown).mean(axis=2) * (alpha >= 0.5)
     top = max(float(np.percentile(np.abs(diff), 99)), 1e-12)
     d = np.clip(diff / top, -1, 1)
     save_png(os.path.join(out, "difference.png"),
