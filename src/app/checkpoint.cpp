@@ -176,6 +176,8 @@ void save_state(const std::string& path, const SavedRender& s) {
   w.u64(s.render.guide_learnt);
   w.u64(s.render.guide.size());
   w.raw(s.render.guide.data(), s.render.guide.size() * sizeof(double));
+  w.u64(s.render.path_history.size());
+  w.raw(s.render.path_history.data(), s.render.path_history.size() * sizeof(float));
   const std::vector<PointState>& states = s.render.states;
   w.u64(states.size());
   // The states go to the file straight from the snapshot, without a copy into the buffer.
@@ -246,6 +248,10 @@ SavedRender load_state(const std::string& path) {
     if (gc > r.remaining() / sizeof(double)) throw StateError(path + ": truncated state file");
     s.render.guide.resize(gc);
     r.raw(s.render.guide.data(), gc * sizeof(double));
+    const uint64_t ip = r.u64();
+    if (ip > r.remaining() / sizeof(float)) throw StateError(path + ": truncated state file");
+    s.render.path_history.resize(ip);
+    r.raw(s.render.path_history.data(), ip * sizeof(float));
     const uint64_t n = r.u64();
     if (n > r.remaining() / sizeof(PointState)) throw StateError(path + ": truncated state file");
     s.render.states.resize(n);

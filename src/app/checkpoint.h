@@ -25,8 +25,9 @@ namespace pb {
 // 4: glTF's metallic-roughness materials (a version 3 state was rendered with other ones), the
 // sparse-photon bound's SPPM kernel masses, largest photon power and glossy caps;
 // 5: PointState with the alternating sums of the noise replica (192 B); 6: with the two-scale
-// check's moments (208 B); 7: SPPM's glossy caps as f / c, not f.
-inline constexpr uint32_t kStateVersion = 8;
+// check's moments (208 B); 7: SPPM's glossy caps as f / c, not f; 8: the photon guide;
+// 9: the camera paths' history (--adaptive paths).
+inline constexpr uint32_t kStateVersion = 9;
 
 struct SavedRender {
   RenderOptions options;    // as rendered (scene path, everything that shapes the image)

@@ -87,6 +87,11 @@ std::vector<std::string> option_diagnostics(const RenderOptions& options) {
     lines.push_back(
         "photonbound: warning: --follow-roughness does nothing here: it needs --method sppm with "
         "next-event direct light");
+  // PPM's visible points are fixed by its one camera pass: there are no paths to add.
+  if (options.adaptive_paths && options.method == Method::PPM)
+    lines.push_back(
+        "photonbound: warning: --adaptive paths does nothing here: PPM traces its camera paths "
+        "once (--method sppm traces them every pass)");
   return lines;
 }
 

@@ -41,6 +41,11 @@ double relative_error(const PointState& s, uint64_t passes, double photons_per_p
   return std::isfinite(r) ? std::min(r, 1.0) : 1.0;
 }
 
+dvec3 pass_variance(const PointState& s, uint64_t passes, double photons_per_pass) {
+  if (passes < 2 || !(s.r2 > 0.0)) return dvec3(0.0);
+  return slope_and_spread(s, double(passes), photons_per_pass).s2;
+}
+
 double ppm_radius_update(double& n, double& r2, double m, double alpha, double min_r2) {
   const double r2_pass = r2;
   double shrink = 1.0;
@@ -101,7 +106,9 @@ void accumulate_pass(PointState& s, const PassSums& g, const OwnerValues& o,
   s.c_xx += dx * (x - s.mean_x);
   s.c_xr += dx * (r2_bias - s.mean_r2);
   s.c_rr += dr * (r2_bias - s.mean_r2);
-  s.photons += uint64_t(g.count);
+  // One path: the count itself. Several (section 15): the mean count times the paths, which
+  // rounding makes the exact sum of their counts again.
+  s.photons += o.paths == 1.0 ? uint64_t(g.count) : uint64_t(std::llround(g.count * o.paths));
   const double sign = (pass & 1u) ? 1.0 : -1.0;
   s.alt_x += sign * x;
   s.alt_r2 += sign * r2_bias;

@@ -29,6 +29,9 @@ struct OwnerValues {
   // the point's next-event estimate (0 with --direct photons).
   dvec3 direct{0.0};
   DiscMoments disc;  // the kernel's moments over the reachable part of the disc (section 11)
+  // Camera paths whose mean the pass sample is (--adaptive paths, section 15): the PassSums'
+  // count is then their mean count, and the state's photon total adds count x paths.
+  double paths = 1.0;
 };
 
 // Everything the estimator keeps for one point, in double (ESTIMATOR.md section 8).
@@ -98,6 +101,10 @@ double preferred_r2(const PointState& state, uint64_t passes, double photons_per
 // mean_c L_c, at most 1; 1 where it cannot be formed (fewer than 2 passes, no radiance). The
 // photon guide weighs what a photon brings to the point by it (ESTIMATOR.md section 14).
 double relative_error(const PointState& state, uint64_t passes, double photons_per_pass);
+
+// S^2 per channel: the variance of one pass's sample X_j after the retroactive bias correction
+// (section 4), 0 before 2 passes. The camera-path allocation (section 15) splits it.
+dvec3 pass_variance(const PointState& state, uint64_t passes, double photons_per_pass);
 
 // The PPM radius update (HOJ08; ESTIMATOR.md section 3) for m photons that could contribute:
 // R^2 *= (N + alpha m) / (N + m), N += alpha m, R^2 floored at min_r2. Returns the factor R^2

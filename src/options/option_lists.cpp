@@ -150,9 +150,10 @@ OptionSpec adaptive() {
                       "comma list of what follows each pixel's error estimates: radius (each "
                       "point's radius minimises its predicted error, never above the --alpha "
                       "schedule), photons (emission learnt from where past photons met the "
-                      "error), or none");
+                      "error), paths (more camera paths where the camera part is a pixel's noise; "
+                      "SPPM), or none");
   s.parse = [](RenderOptions& o, const std::string& t) {
-    bool radius = false, photons = false, none = false;
+    bool radius = false, photons = false, paths = false, none = false;
     for (const std::string& part : split(t, ',')) {
       if (part == "radius")
         radius = true;
@@ -161,25 +162,32 @@ OptionSpec adaptive() {
       else if (part == "none")
         none = true;
       else if (part == "paths")
-        fail("--adaptive", "'" + part + "' is not implemented yet; use radius, photons or none");
+        paths = true;
       else
-        fail("--adaptive", "'" + part + "' is not one of radius, photons, none");
+        fail("--adaptive", "'" + part + "' is not one of radius, photons, paths, none");
     }
-    if (none && (radius || photons)) fail("--adaptive", "none cannot be combined with others");
+    if (none && (radius || photons || paths))
+      fail("--adaptive", "none cannot be combined with others");
     o.adaptive_radius = radius;
     o.adaptive_photons = photons;
+    o.adaptive_paths = paths;
   };
   s.check = [](const RenderOptions&) {};
   s.format = [](const RenderOptions& o) -> std::string {
-    if (o.adaptive_radius && o.adaptive_photons) return "radius,photons";
-    return o.adaptive_radius ? "radius" : o.adaptive_photons ? "photons" : "none";
+    std::string parts;
+    if (o.adaptive_radius) parts += ",radius";
+    if (o.adaptive_photons) parts += ",photons";
+    if (o.adaptive_paths) parts += ",paths";
+    return parts.empty() ? "none" : parts.substr(1);
   };
   s.reset = [](RenderOptions& o) {
     o.adaptive_radius = RenderOptions{}.adaptive_radius;
     o.adaptive_photons = RenderOptions{}.adaptive_photons;
+    o.adaptive_paths = RenderOptions{}.adaptive_paths;
   };
-  s.accepted = {"radius", "none", "radius,radius", "photons", "photons,radius"};
-  s.rejected = {"", "paths", "radius,none", "none,photons", "radius,", "speed"};
+  s.accepted = {"radius",         "none",  "radius,radius",       "photons",
+                "photons,radius", "paths", "paths,radius,photons"};
+  s.rejected = {"", "radius,none", "none,photons", "none,paths", "radius,", "speed"};
   return s;
 }
 

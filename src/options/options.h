@@ -56,10 +56,11 @@ struct RenderOptions {
   uint64_t photons_per_pass = 100000;  // M_e
   double alpha = 0.7;
   // --adaptive: which parts of the render follow each pixel's own error estimates
-  // (ESTIMATOR.md sections 13 and 14); none = every point on the PPM schedule, every photon
+  // (ESTIMATOR.md sections 13-15); none = every point on the PPM schedule, every photon
   // emitted in proportion to power.
   bool adaptive_radius = false;
   bool adaptive_photons = false;
+  bool adaptive_paths = false;   // SPPM: section 15
   std::optional<double> radius;  // world units; default from the pixel footprint
   int max_depth = 8;
   double mirror_roughness = kDefaultMirrorRoughness;

@@ -48,8 +48,8 @@ struct CameraPath {
   bool left_chain = false;
   int depth = 0;
 
-  CameraPath(const CameraPathInputs& in, size_t pixel)
-      : rng(in.seed, in.pass, pixel, Stream::Camera) {
+  CameraPath(const CameraPathInputs& in, size_t pixel, uint32_t path)
+      : rng(in.seed, in.pass, path_item(pixel, path), Stream::Camera) {
     const int width = in.camera.width();
     const float jx = rng.next_float(), jy = rng.next_float();
     const int x = int(pixel % size_t(width)), y = int(pixel / size_t(width));
@@ -227,34 +227,41 @@ Step at_vertex(CameraPath& path, const CameraPathInputs& in, const Hit& hit, flo
 
 }  // namespace
 
+std::optional<PointBsdf> trace_visible_point(const CameraPathInputs& in, size_t pixel,
+                                             uint32_t path_index, float radius, VisiblePoint& point,
+                                             OwnerValues& out) {
+  CameraPath path(in, pixel, path_index);
+  std::optional<PointBsdf> g;
+  for (;; ++path.depth) {
+    Hit hit;
+    // BLEND surfaces are met by chance, by a key of the path's stream (World::ray_key).
+    const uint64_t key = in.world.ray_key(path.rng);
+    const bool found = path.depth == 0
+                           ? in.world.camera_hit(path.origin, path.dir, hit, nullptr, key)
+                           : in.world.trace(path.origin, path.origin_normal, path.origin_error,
+                                            path.dir, hit, key);
+    if (!found) {  // the environment (black without one), seen along the path
+      if (!path.after_lobe)
+        path.emission += dvec3(path.weight * in.world.lights().environment_radiance(path.dir));
+      break;
+    }
+    if (at_vertex(path, in, hit, radius, g) == Step::End) break;
+  }
+  point = path.point;
+  out = OwnerValues{path.emission, path.disc};
+  return g;
+}
+
 size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
                             std::span<VisiblePoint> points, std::span<PointBsdf> glossy,
                             std::span<OwnerValues> out) {
   size_t glossy_count = 0;
   for (size_t k = 0; k < points.size(); ++k) {
-    CameraPath path(in, first + k);
-    std::optional<PointBsdf> g;
-    for (;; ++path.depth) {
-      Hit hit;
-      // BLEND surfaces are met by chance, by a key of the path's stream (World::ray_key).
-      const uint64_t key = in.world.ray_key(path.rng);
-      const bool found = path.depth == 0
-                             ? in.world.camera_hit(path.origin, path.dir, hit, nullptr, key)
-                             : in.world.trace(path.origin, path.origin_normal, path.origin_error,
-                                              path.dir, hit, key);
-      if (!found) {  // the environment (black without one), seen along the path
-        if (!path.after_lobe)
-          path.emission += dvec3(path.weight * in.world.lights().environment_radiance(path.dir));
-        break;
-      }
-      if (at_vertex(path, in, hit, radii[k], g) == Step::End) break;
-    }
+    std::optional<PointBsdf> g = trace_visible_point(in, first + k, 0, radii[k], points[k], out[k]);
     if (g) {
       g->point = uint32_t(k);
       glossy[glossy_count++] = *g;
     }
-    points[k] = path.point;
-    out[k] = OwnerValues{path.emission, path.disc};
   }
   return glossy_count;
 }

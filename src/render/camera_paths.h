@@ -25,6 +25,7 @@
 #include "world/world.h"
 
 #include <cstdint>
+#include <optional>
 #include <span>
 
 namespace pb {
@@ -52,6 +53,17 @@ struct CameraPathInputs {
 // (point = k) goes to the front of `glossy` (room for points.size()), in pixel order. radii[k] is
 // pixel first + k's search radius this pass; out[k].disc its visible point's disc moments. Returns
 // the count of glossy points.
+// The random-number key of a pixel's camera path number `path` in a pass (--adaptive paths,
+// ESTIMATOR.md section 15): path 0 is keyed by the pixel alone, as before paths existed.
+inline uint64_t path_item(uint64_t pixel, uint32_t path) { return pixel + (uint64_t(path) << 40); }
+
+// One camera path of `pixel` (path number path_index): its visible point (f = 0: none) and
+// owner values as trace_visible_points below gives them; the PointBsdf of a non-Lambertian
+// point (its `point` member left 0).
+std::optional<PointBsdf> trace_visible_point(const CameraPathInputs& in, size_t pixel,
+                                             uint32_t path_index, float radius, VisiblePoint& point,
+                                             OwnerValues& out);
+
 size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
                             std::span<VisiblePoint> points, std::span<PointBsdf> glossy,
                             std::span<OwnerValues> out);

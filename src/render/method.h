@@ -44,6 +44,9 @@ struct RenderState {
   // (render/photon_guide.h); empty without.
   std::vector<double> guide;
   uint64_t guide_learnt = 0;
+  // --adaptive paths: per pixel, its PathHistory (render/path_allocation.h) as three floats;
+  // empty without.
+  std::vector<float> path_history;
 };
 
 class PhotonMethod {

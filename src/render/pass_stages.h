@@ -130,6 +130,9 @@ struct PassInputs {
   bool next_event = true;
   const Cutoff* cutoff = nullptr;
   GuideInputs guide;  // tally set: this pass learns the photon guide
+  // Photon-pass rays per emitted photon over the passes before this one (--adaptive paths
+  // prices a camera path against them, path_allocation.h).
+  double rays_per_photon = 2.0;
   // Whether a chunk of the fold block starting at `first` should give up: only the first block
   // can (the later ones come after a fold).
   bool cut(size_t first) const { return first == 0 && cutoff && cutoff->reached(); }

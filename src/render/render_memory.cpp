@@ -35,12 +35,17 @@ std::string MemoryEstimate::text() const {
   return t + ", " + bytes_text(baseline) + " for the program)";
 }
 
+// --adaptive paths (sppm.h, path_allocation.h): a pixel's number of paths (1 byte), its
+// history (12) and the allocation's variance model during a pass (24), counted, not measured.
+constexpr uint64_t kPathPixelBytes = 37;
+
 MemoryEstimate estimate_render_memory(const RenderOptions& o, uint64_t width, uint64_t height,
                                       const Scene* scene) {
   MemoryEstimate e;
   e.pixel_count = width * height;
   const uint64_t per_pixel = (o.method == Method::PPM ? kPpmPixelBytes : kSppmPixelBytes) +
-                             (o.checkpoint_every ? kCheckpointPixelBytes : 0);
+                             (o.checkpoint_every ? kCheckpointPixelBytes : 0) +
+                             (o.adaptive_paths && o.method == Method::SPPM ? kPathPixelBytes : 0);
   e.pixels = saturating_mul(e.pixel_count, per_pixel);
   e.photons = saturating_mul(o.photons_per_pass, kPhotonBytes);
   if (scene) {

@@ -34,7 +34,8 @@ std::unique_ptr<PhotonMethod> make_method(const World& world, const PinholeCamer
   const bool nee = options.direct == DirectMode::NextEvent;
   return std::make_unique<SppmMethod>(
       world, camera,
-      CameraPathSettings{options.max_depth, nee ? float(options.follow_roughness) : 0.0f});
+      CameraPathSettings{options.max_depth, nee ? float(options.follow_roughness) : 0.0f,
+                         options.adaptive_paths});
 }
 
 }  // namespace
@@ -129,7 +130,8 @@ bool Renderer::step(std::vector<PointState>* copy, const Cutoff* cutoff) {
                         pass,
                         options_.direct == DirectMode::NextEvent,
                         cutoff,
-                        learn};
+                        learn,
+                        work_.photons > 0 ? double(work_.rays) / double(work_.photons) : 2.0};
     const bool whole = method_->step(in, states_, radii_, copy ? copy->data() : nullptr);
     timings_.gather += seconds_since(t);
     if (!whole) return false;

@@ -1,7 +1,13 @@
 #include "render/sppm.h"
 
+#include "estimator/path_mean.h"
+#include "render/lobe_split.h"
+#include "render/next_event.h"
+#include "util/rng.h"
+
 #include <algorithm>
 #include <atomic>
+#include <cstring>
 #include <optional>
 #include <string>
 
@@ -30,6 +36,11 @@ SppmMethod::SppmMethod(const World& world, const PinholeCamera& camera, CameraPa
   sums_.resize(block);
   owner_.resize(block);
   glossy_count_.resize((block + kStageChunk - 1) / kStageChunk);
+  if (settings.adaptive_paths) {
+    paths_.assign(state_count_, 1);
+    history_.assign(state_count_, PathHistory{});
+    extra_.resize(block);
+  }
 }
 
 bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
@@ -37,6 +48,12 @@ bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
   const CameraPathInputs camera{in.world, camera_, settings_.max_depth, settings_.follow_roughness,
                                 in.seed,  in.pass, in.next_event,       in.boundary};
   const size_t n = states.size(), block = sums_.size();
+  // The paths of this pass, from the states of the passes before it (section 15).
+  if (settings_.adaptive_paths) {
+    PathCosts costs;
+    costs.rays_per_photon = in.rays_per_photon;
+    choose_paths(states, history_, in.pass - 1, in.params.photons_per_pass, costs, paths_);
+  }
   for (size_t first = 0; first < n; first += block) {
     const size_t count = std::min(block, n - first);
     // Stages 0, 3 and 4 chunk by chunk, so that a chunk's visible points are still in cache.
@@ -59,15 +76,33 @@ bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
       gather_pass(pts, st, in.grid, in.hits, table, std::span(sums_).subspan(b, m),
                   learn ? &*learn : nullptr, in.guide);
       if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, at, own);
+      if (settings_.adaptive_paths) extra_paths(in, camera, at, b, m, st, radii);
       glossy_count_[b / kStageChunk] = uint32_t(n_glossy);
     });
     if (cut.load()) return false;  // the first block: nothing recorded or folded yet
     if (in.guide.tally) in.guide.tally->reduce_block((count + kStageChunk - 1) / kStageChunk);
     // The pixels' side state, once the pass is known to go on (a chunk writes its own pixels).
     for_each_chunk(count, [&](size_t b, size_t m) {
+      if (settings_.adaptive_paths)
+        for (size_t k = b; k < b + m; ++k) {
+          const size_t pixel = first + k;
+          const ExtraPaths& e = extra_[k];
+          PathHistory& h = history_[pixel];
+          h.inv_paths += 1.0f / float(paths_[pixel]);
+          if (!e.combined) continue;
+          h.spread += e.spread;
+          h.dof += float(paths_[pixel] - 1);
+          visible_[pixel] =
+              uint32_t(std::min<uint64_t>(uint64_t(visible_[pixel]) + e.visible, UINT32_MAX));
+          min_mass_[pixel] = std::min(min_mass_[pixel], e.mass);
+          glossy_f_[pixel] = std::max(glossy_f_[pixel], e.ratio);
+        }
+      const std::span<const ExtraPaths> extra =
+          settings_.adaptive_paths ? std::span<const ExtraPaths>(extra_).subspan(b, m)
+                                   : std::span<const ExtraPaths>();
       record_visible(first + b, std::span(points_).subspan(b, m), std::span(owner_).subspan(b, m),
                      std::span(glossy_).subspan(b, glossy_count_[b / kStageChunk]),
-                     std::span<const PointState>(states).subspan(first + b, m));
+                     std::span<const PointState>(states).subspan(first + b, m), extra);
     });
     // A distributed render reduces sums_[0, count) across machines here.
     fold_block(first, states, std::span<const PassSums>(sums_).first(count),
@@ -79,12 +114,17 @@ bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
 void SppmMethod::record_visible(size_t first, std::span<const VisiblePoint> points,
                                 std::span<const OwnerValues> owner,
                                 std::span<const PointBsdf> glossy,
-                                std::span<const PointState> states) {
+                                std::span<const PointState> states,
+                                std::span<const ExtraPaths> extra) {
+  // The first path's kernel mass: a pixel of several paths folds a synthetic disc (PathMean).
+  const auto mass = [&](size_t k) {
+    return !extra.empty() && extra[k].combined ? double(extra[k].primary_mass) : owner[k].disc.mass;
+  };
   for (size_t k = 0; k < points.size(); ++k) {
     if (!(max_component(points[k].f) > 0.0f)) continue;
     const size_t pixel = first + k;
     if (visible_[pixel] != UINT32_MAX) ++visible_[pixel];  // saturating: far beyond use
-    min_mass_[pixel] = std::min(min_mass_[pixel], float(owner[k].disc.mass));
+    min_mass_[pixel] = std::min(min_mass_[pixel], float(mass(k)));
   }
   for (const PointBsdf& g : glossy) {  // only while the cap can still matter
     if (states[g.point].photons >= kMinPhotonsForBound) continue;
@@ -92,14 +132,61 @@ void SppmMethod::record_visible(size_t first, std::span<const VisiblePoint> poin
     // this pass's sample, so the largest ratio over the passes bounds every pass, where the
     // largest f and the smallest c, often of different points (a grazing view; a disc over a
     // crease), bound them up to 10-100 times looser (ESTIMATOR.md section 12).
-    const double c = std::max(owner[g.point].disc.mass, kMinKernelMass);
+    const double c = std::max(mass(g.point), kMinKernelMass);
     const float ratio = float(max_component(points[g.point].f * g.bsdf.max_f(g.wo)) / c);
     float& cap = glossy_f_[first + g.point];
     cap = std::max(cap, ratio);
   }
 }
 
+void SppmMethod::extra_paths(const PassInputs& in, const CameraPathInputs& camera, size_t at,
+                             size_t b, size_t m, std::span<const PointState> states,
+                             std::span<const float> radii) {
+  for (size_t k = 0; k < m; ++k) {
+    const size_t pixel = at + k;
+    ExtraPaths& e = extra_[b + k];
+    e = ExtraPaths{};
+    const uint32_t paths = paths_[pixel];
+    if (paths <= 1) continue;
+    const double r2 = states[k].r2;
+    e.combined = true;
+    e.primary_mass = float(owner_[b + k].disc.mass);
+    PathMean mean;
+    const double m_e = in.params.photons_per_pass;
+    mean.add(sums_[b + k], owner_[b + k], r2, m_e);
+    for (uint32_t t = 1; t < paths; ++t) {
+      VisiblePoint p;
+      OwnerValues o;
+      PassSums g;
+      const std::optional<PointBsdf> bsdf =
+          trace_visible_point(camera, pixel, t, radii[pixel], p, o);
+      if (max_component(p.f) > 0.0f) {
+        // Stages 3 and 4 for this one point, as gather_pass and next_event_pass do them.
+        if (bsdf)
+          gather_photons(p, *bsdf, r2, in.grid, in.hits, g);
+        else
+          gather_photons(p, r2, in.grid, in.hits, g);
+        if (in.next_event && !(bsdf && is_base_part(bsdf->bsdf))) {
+          Rng rng(in.seed, in.pass, path_item(pixel, t), Stream::DirectLight);
+          o.direct += direct_light(in.world, p, bsdf ? &*bsdf : nullptr, rng);
+        }
+        ++e.visible;
+        e.mass = std::min(e.mass, float(o.disc.mass));
+        if (bsdf && states[k].photons < kMinPhotonsForBound) {
+          const double c = std::max(o.disc.mass, kMinKernelMass);
+          e.ratio = std::max(e.ratio, float(max_component(p.f * bsdf->bsdf.max_f(bsdf->wo)) / c));
+        }
+      }
+      mean.add(g, o, r2, m_e);
+    }
+    e.spread = float(mean.spread());
+    mean.finish(r2, sums_[b + k], owner_[b + k]);
+  }
+}
+
 void SppmMethod::save(RenderState& s) const {
+  s.path_history.resize(history_.size() * 3);
+  std::memcpy(s.path_history.data(), history_.data(), history_.size() * sizeof(PathHistory));
   s.visible = visible_;
   s.min_mass = min_mass_;
   s.glossy_f = glossy_f_;
@@ -115,6 +202,11 @@ void SppmMethod::restore(const RenderState& saved) {
   if (saved.glossy_f.size() != glossy_f_.size())
     throw StateError("the state holds " + std::to_string(saved.glossy_f.size()) +
                      " SPPM glossy caps but this render has " + std::to_string(glossy_f_.size()));
+  if (saved.path_history.size() != history_.size() * 3)
+    throw StateError("the state holds " + std::to_string(saved.path_history.size() / 3) +
+                     " camera-path histories but this render has " +
+                     std::to_string(history_.size()) + " (--adaptive paths)");
+  std::memcpy(history_.data(), saved.path_history.data(), history_.size() * sizeof(PathHistory));
   visible_ = saved.visible;
   min_mass_ = saved.min_mass;
   glossy_f_ = saved.glossy_f;

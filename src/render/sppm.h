@@ -5,6 +5,7 @@
 
 #include "render/camera_paths.h"
 #include "render/method.h"
+#include "render/path_allocation.h"
 #include "world/world.h"
 
 #include <vector>
@@ -15,6 +16,7 @@ namespace pb {
 struct CameraPathSettings {
   int max_depth = 8;
   float follow_roughness = 0.0f;  // 0 without next-event direct light (camera_paths.h)
+  bool adaptive_paths = false;    // --adaptive paths (ESTIMATOR.md section 15)
 };
 
 class SppmMethod final : public PhotonMethod {
@@ -31,12 +33,28 @@ class SppmMethod final : public PhotonMethod {
                      const RenderState* saved) const override;
 
  private:
+  // --adaptive paths (ESTIMATOR.md section 15): what a pixel's paths beyond the first add to
+  // its side state, kept until the pass is known to go on.
+  struct ExtraPaths {
+    float primary_mass = 1.0f;  // the first path's kernel mass (its owner values are replaced)
+    float mass = 1.0f;          // the smallest over the other paths' visible points
+    float ratio = 0.0f;         // their largest glossy f / c
+    float spread = 0.0f;        // PathMean::spread of the pass
+    uint32_t visible = 0;       // the other paths with a visible point
+    bool combined = false;      // the pixel had more than one path this pass
+  };
+
   // Stage 0's side of a chunk's visible points for the film (ESTIMATOR.md section 12): counts
   // each pixel's passes with a visible point, keeps the smallest kernel mass of its visible
   // points and the largest f a glossy visible point of it may have (throughput x Bsdf::max_f).
   void record_visible(size_t first, std::span<const VisiblePoint> points,
                       std::span<const OwnerValues> owner, std::span<const PointBsdf> glossy,
-                      std::span<const PointState> states);
+                      std::span<const PointState> states, std::span<const ExtraPaths> extra);
+
+  // Traces the paths 1 .. K - 1 of the chunk's pixels [at, at + m) (block offset b), gathers
+  // and samples them, and replaces sums_ and owner_ by the mean over all K paths (PathMean).
+  void extra_paths(const PassInputs& in, const CameraPathInputs& camera, size_t at, size_t b,
+                   size_t m, std::span<const PointState> states, std::span<const float> radii);
 
   const PinholeCamera& camera_;
   CameraPathSettings settings_;
@@ -52,6 +70,11 @@ class SppmMethod final : public PhotonMethod {
   std::vector<PassSums> sums_;
   std::vector<OwnerValues> owner_;
   std::vector<uint32_t> glossy_count_;  // per chunk of the block: its glossy entries
+  // --adaptive paths: the camera paths of each pixel this pass (chosen before it from the
+  // states), each pixel's history, and one block's extra paths' side state.
+  std::vector<uint8_t> paths_;
+  std::vector<PathHistory> history_;
+  std::vector<ExtraPaths> extra_;
 };
 
 }  // namespace pb

@@ -59,6 +59,18 @@ TEST_F(Cli, WarnsWhenTheStartingRadiusIsOfTheSceneSize) {
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
 }
 
+// PPM traces its camera paths once, so --adaptive paths cannot add any: it says so and renders.
+TEST_F(Cli, WarnsWhereAdaptivePathsDoesNothing) {
+  const std::string base = "render " + quote(scene("cornell.gltf")) + " -o " + quote(out()) +
+                           " --passes 2 --resolution 8x8 --photons-per-pass 1000 --quiet";
+  Outcome r = run(base + " --method ppm --adaptive paths");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: --adaptive paths does nothing here"), std::string::npos) << r.err;
+  r = run(base + " --adaptive paths");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+}
+
 TEST_F(Cli, BadOptionValuesExitWithUsageError) {
   const std::string base =
       "render " + quote(scene("cornell.gltf")) + " -o " + quote(out()) + " --passes 1 ";

@@ -104,12 +104,9 @@ TEST(SlowBounds, EdgeBandOfTheBoxWithABlock) {
 // relative error after 64 passes is at most 1.5x the interior's: the absolute ratio measures the
 // brightness of the light's rim and the corners, not a darkening, so brightness is divided out
 // (measured: 1.42 pooled, 1.42 and 1.47 for one and two seeds; absolute ratio 3.97).
-TEST(SlowBounds, CoverageOnCornellBoxAgainstItsReference) {
+void expect_cornell_coverage(const RenderOptions& o) {
   const reference::Truth truth =
       reference::load(std::string(PHOTONBOUND_REFERENCES) + "/cornell_64x64_sppm_reference.exr");
-  RenderOptions o = test::quick_options("cornell.gltf", 64, 256);
-  o.method = Method::SPPM;
-  o.photons_per_pass = 10000;
   reference::PooledCoverage pc =
       reference::pooled_coverage(o, 4, truth, {16, 64, 256}, {0.5, 0.9, 0.95});
   using S = reference::Sums;
@@ -129,6 +126,25 @@ TEST(SlowBounds, CoverageOnCornellBoxAgainstItsReference) {
   const double ratio = pc.at(1, 1, 0).mean(&S::rel) / pc.at(1, 2, 0).mean(&S::rel);
   std::printf("cornell, 64 passes: mean relative error edge / interior %.2f\n", ratio);
   EXPECT_LE(ratio, 1.5);
+}
+
+RenderOptions cornell_options() {
+  RenderOptions o = test::quick_options("cornell.gltf", 64, 256);
+  o.method = Method::SPPM;
+  o.photons_per_pass = 10000;
+  return o;
+}
+
+TEST(SlowBounds, CoverageOnCornellBoxAgainstItsReference) {
+  expect_cornell_coverage(cornell_options());
+}
+
+// Issue 39's calibration with every adaptive part on (ESTIMATOR.md sections 13-15): the
+// radius, the guided photons and several camera paths where the camera part is the noise.
+TEST(SlowBounds, CoverageOnCornellBoxWithEveryAdaptivePart) {
+  RenderOptions o = cornell_options();
+  o.adaptive_radius = o.adaptive_photons = o.adaptive_paths = true;
+  expect_cornell_coverage(o);
 }
 
 // Three targets halving in turn, three seeds each, with the default rule (mean-error: the

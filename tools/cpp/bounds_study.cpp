@@ -24,11 +24,12 @@ double normal_cdf_one() { return 0.8413447460685429; }  // `bounds_study TABLE s
 RenderOptions study_options(const std::string& scene, int size, uint64_t passes) {
   RenderOptions o = test::quick_options(scene, size, passes);
   o.method = g_method;
-  // PB_STUDY_ADAPTIVE=radius,photons (or either): the tables with ESTIMATOR.md section 13's
-  // radius and section 14's photon guide.
+  // PB_STUDY_ADAPTIVE=radius,photons,paths (or any of them): the tables with ESTIMATOR.md
+  // section 13's radius, section 14's photon guide and section 15's camera paths.
   if (const char* a = std::getenv("PB_STUDY_ADAPTIVE")) {
     o.adaptive_radius = std::string(a).find("radius") != std::string::npos;
     o.adaptive_photons = std::string(a).find("photons") != std::string::npos;
+    o.adaptive_paths = std::string(a).find("paths") != std::string::npos;
   }
   return o;
 }

@@ -1,0 +1,68 @@
+// How many camera paths each pixel gets in the next SPPM pass (--adaptive paths, ESTIMATOR.md
+// section 15). A pixel's pass sample has the variance V_cam / K + V_ph for K paths: the camera
+// part (pixel jitter, a branch drawn at glass, the next-event sample) falls with K, the photon
+// part (its paths mostly share the photons of one disc) does not. Paths cost time, so the
+// numbers minimise the image's mean sd per unit of time, sum_p sd_p x sqrt(T), over a model of
+// a pass's cost T in units of one photon.
+#pragma once
+
+#include "estimator/estimator.h"
+
+#include <cstdint>
+#include <span>
+
+namespace pb {
+
+inline constexpr int kMaxPaths = 16;
+
+// What a pass costs, in units of one photon-pass ray (with its share of storing and sorting
+// the hits). Measured on the caustic at 128x96 (ESTIMATOR.md section 15): a camera path with
+// its next-event sample costs 3.3 photon rays, each photon its gather finds 0.1 more, a
+// pixel's fold 1.
+struct PathCosts {
+  double per_path = 3.3;
+  double per_gathered = 0.1;
+  double per_pixel = 1.0;
+  double rays_per_photon = 2.0;  // photon-pass rays per emitted photon (past passes)
+};
+
+// What a pixel's past passes say about its paths (kept in the state file).
+struct PathHistory {
+  float inv_paths = 0.0f;  // sum_j 1 / K_j
+  float spread = 0.0f;     // sum over passes of PathMean::spread()
+  float dof = 0.0f;        // its degrees of freedom, sum_j (K_j - 1)
+};
+static_assert(sizeof(PathHistory) == 3 * sizeof(float), "the state file stores three floats");
+
+// Below this many degrees of freedom of the within-pass spread, V_cam comes from the pass
+// variance less the photon model's part instead.
+inline constexpr float kMinSpreadDof = 4.0f;
+
+// E[w^2] / E[w]^2 of the kernel weight w over a uniform disc (ESTIMATOR.md section 2): the
+// photon part's per-pass variance is L_ph^2 kPhotonNoise / m for m photons of equal power in a
+// disc (Poisson). (49/2) integral_0^1 k(t)^2 t dt = 287/132.
+inline constexpr double kPhotonNoise = 287.0 / 132.0;
+
+// The two parts of a pixel's per-pass variance (summed over the channels) for one path, and
+// what one of its paths costs, from its state after `passes` passes and its history.
+struct PathVariance {
+  double camera = 0.0;  // V_cam
+  double photon = 0.0;  // V_ph at the radius of the next pass
+  double cost = 1.0;    // a path's cost in photon rays
+};
+PathVariance path_variance(const PointState& state, uint64_t passes, double photons_per_pass,
+                           const PathHistory& history, const PathCosts& costs);
+
+// The number of paths (1 to kMaxPaths) that minimises the image's mean sd per time for one
+// pixel, given g = T / S (S the image's summed sd, T a pass's cost): K^2 sd(K) = V_cam g / cost,
+// to the nearest integer.
+int paths_for(const PathVariance& v, double g);
+
+// paths[p] for every pixel from states[p] and history[p] (the next pass's numbers): 1 before
+// kAdaptiveMinPasses passes. The image-wide g is found by a few rounds that alternate it with
+// the numbers; sums are taken in a fixed order, so the result does not depend on the threads.
+void choose_paths(std::span<const PointState> states, std::span<const PathHistory> history,
+                  uint64_t passes, double photons_per_pass, const PathCosts& costs,
+                  std::span<uint8_t> paths);
+
+}  // namespace pb
