@@ -1,7 +1,7 @@
 """Adaptive against uniform: passes and seconds to a target error, per --adaptive mode.
 
   python3 -m tools.adaptive_study OUTDIR [--scenes caustic,indirect,cornell,plane,box,door]
-                                  [--modes none,radius,photons,radius+photons]
+                                  [--modes none,radius,photons,paths,radius+paths]
                                   [--targets T1,T2,...] [--resolution WxH]
                                   [--time-limit S] [--reference-passes N] [--photonbound EXE]
 
