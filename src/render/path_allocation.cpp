@@ -58,7 +58,7 @@ void choose_paths(std::span<const PointState> states, std::span<const PathHistor
                   std::span<uint8_t> paths) {
   const size_t n = states.size();
   std::fill(paths.begin(), paths.end(), uint8_t(1));
-  if (passes < kAdaptiveMinPasses || n == 0) return;
+  if (passes < kPathsMinPasses || n == 0) return;
   std::vector<PathVariance> v(n);
   constexpr size_t kChunk = 4096;
   const size_t chunks = (n + kChunk - 1) / kChunk;

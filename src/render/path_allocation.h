@@ -15,6 +15,13 @@ namespace pb {
 
 inline constexpr int kMaxPaths = 16;
 
+// One path everywhere before this many passes: the variances have too few degrees of freedom to
+// allocate by, and a render that the first stop test ends (--min-passes, 16 by default) would
+// pay for paths it cannot use (measured: the Cornell box at 256x256 to 0.01, 0.90x the seconds
+// with paths from pass 5; ESTIMATOR.md section 15). A constant, not --min-passes: a resume may
+// change that option, and the image must not change with it.
+inline constexpr uint64_t kPathsMinPasses = 16;
+
 // What a pass costs, in units of one photon-pass ray (with its share of storing and sorting
 // the hits). Measured on the caustic at 128x96 (ESTIMATOR.md section 15): a camera path with
 // its next-event sample costs 3.3 photon rays, each photon its gather finds 0.1 more, a
@@ -59,7 +66,7 @@ PathVariance path_variance(const PointState& state, uint64_t passes, double phot
 int paths_for(const PathVariance& v, double g);
 
 // paths[p] for every pixel from states[p] and history[p] (the next pass's numbers): 1 before
-// kAdaptiveMinPasses passes. The image-wide g is found by a few rounds that alternate it with
+// kPathsMinPasses passes. The image-wide g is found by a few rounds that alternate it with
 // the numbers; sums are taken in a fixed order, so the result does not depend on the threads.
 void choose_paths(std::span<const PointState> states, std::span<const PathHistory> history,
                   uint64_t passes, double photons_per_pass, const PathCosts& costs,

@@ -69,15 +69,15 @@ TEST_F(Checkpoints, ResumeIsBitIdenticalWithGuidedPhotons) {
 }
 
 // --adaptive paths: each pixel's path history (PathHistory) goes through the state file, so the
-// paths after the resume are the uninterrupted render's; resumed after pass 6, when pixels have
+// paths after the resume are the uninterrupted render's; resumed after pass 19, when pixels have
 // had several paths.
 TEST_F(Checkpoints, ResumeIsBitIdenticalWithAdaptivePaths) {
   RenderOptions o = small_options();
   o.method = Method::SPPM;
   o.adaptive_paths = true;
-  o.passes = 10;
-  expect_resume_bit_identical(o, path("paths.pbstate"), 6);
-  const SavedRender s = saved_after(o, 6);
+  o.passes = 22;
+  expect_resume_bit_identical(o, path("paths.pbstate"), 19);
+  const SavedRender s = saved_after(o, 19);
   float dof = 0.0f;
   for (size_t k = 2; k < s.render.path_history.size(); k += 3) dof += s.render.path_history[k];
   EXPECT_GT(dof, 0.0f);  // some pixel had several paths before the state was written
