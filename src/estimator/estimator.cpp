@@ -106,9 +106,7 @@ void accumulate_pass(PointState& s, const PassSums& g, const OwnerValues& o,
   s.c_xx += dx * (x - s.mean_x);
   s.c_xr += dx * (r2_bias - s.mean_r2);
   s.c_rr += dr * (r2_bias - s.mean_r2);
-  // One path: the count itself. Several (section 15): the mean count times the paths, which
-  // rounding makes the exact sum of their counts again.
-  s.photons += o.paths == 1.0 ? uint64_t(g.count) : uint64_t(std::llround(g.count * o.paths));
+  s.photons += uint64_t(o.first_count < 0.0 ? g.count : o.first_count);
   const double sign = (pass & 1u) ? 1.0 : -1.0;
   s.alt_x += sign * x;
   s.alt_r2 += sign * r2_bias;

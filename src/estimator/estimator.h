@@ -29,9 +29,13 @@ struct OwnerValues {
   // the point's next-event estimate (0 with --direct photons).
   dvec3 direct{0.0};
   DiscMoments disc;  // the kernel's moments over the reachable part of the disc (section 11)
-  // Camera paths whose mean the pass sample is (--adaptive paths, section 15): the PassSums'
-  // count is then their mean count, and the state's photon total adds count x paths.
-  double paths = 1.0;
+  // Several camera paths whose mean the pass sample is (--adaptive paths, section 15): the
+  // PassSums' count is their mean count (for the radius update), and the state's photon total
+  // adds the first path's count alone. A pixel's paths share the pass's photons: one photon
+  // near the pixel is gathered by all of them, so their sum would count it K times, and the
+  // sparse-photon bound and kMinPhotonsForBound take counts of independent arrivals. Negative:
+  // one path, whose count is the PassSums'.
+  double first_count = -1.0;
 };
 
 // Everything the estimator keeps for one point, in double (ESTIMATOR.md section 8).

@@ -12,6 +12,7 @@ void PathMean::add(const PassSums& g, const OwnerValues& o, double r2, double ph
   raw_.phi_half += g.phi_half;
   raw_.count += g.count;
   direct_ += o.direct;
+  if (paths_ == 0) first_count_ = g.count;
   ++paths_;
   // The corrections of accumulate_pass (ESTIMATOR.md section 11), per path.
   dvec3 phi = g.phi, lap = g.phi_lap_r2 / r2;
@@ -41,7 +42,7 @@ void PathMean::finish(double r2, PassSums& g, OwnerValues& o) const {
   const double inv = 1.0 / double(std::max(paths_, 1));
   o = OwnerValues{};
   o.direct = direct_ * inv;
-  o.paths = double(paths_);
+  o.first_count = first_count_;
   g.count = raw_.count * inv;
   if (full_) {  // linear in the sums: their mean, and the disc stays whole
     g.phi = raw_.phi * inv;

@@ -20,7 +20,8 @@ class PathMean {
   // the pass's photons, so it measures the camera part of the variance (section 15).
   double spread() const;
   // Sums and owner values whose accumulate_pass at r2 folds the paths' mean: the sample X_j,
-  // the Laplacian sample, R_b^2 and the count are the means of the paths' own (section 15).
+  // the Laplacian sample, R_b^2 and the count are the means of the paths' own (section 15); the
+  // photon total takes the first path's count (OwnerValues::first_count).
   // Where every disc is whole the raw sums are averaged and the two-scale sample (section 11c)
   // is kept; otherwise the disc handed on is a synthetic cut one of mass 1 that applies no
   // further correction, and the pass has no two-scale sample.
@@ -33,6 +34,7 @@ class PathMean {
   dvec3 direct_{0.0};       // sum of D
   double r2_bias_ = 0.0;    // sum of the effective R_b^2
   dvec3 x_{0.0}, x2_{0.0};  // sums of the paths' samples X_k and of their squares
+  double first_count_ = 0.0;  // the first path's M (what the state's photon total adds)
   int paths_ = 0;
   bool full_ = true;
 };

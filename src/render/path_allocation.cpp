@@ -18,9 +18,8 @@ PathVariance path_variance(const PointState& s, uint64_t passes, double photons_
   const double i = double(passes);
   const dvec3 s2 = pass_variance(s, passes, photons_per_pass);
   const double total = s2.x + s2.y + s2.z;
-  // Photons per path and pass, averaged over the passes: the state's count is over all paths,
-  // and i / inv_paths is the harmonic mean of the paths a pass had (close to their mean).
-  const double per_path = double(s.photons) / (i * i / double(h.inv_paths));
+  // Photons per path and pass, averaged over the passes (the state counts the first path's).
+  const double per_path = double(s.photons) / i;
   const dvec3 lph = photon_radiance(s, passes, photons_per_pass);
   const double photon_mean = glm::dot(lph, lph) * kPhotonNoise / per_path;
   // The next pass's radius holds R^2 / mean R^2 of the photons and so much more photon noise.

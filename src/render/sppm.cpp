@@ -92,8 +92,6 @@ bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
           if (!e.combined) continue;
           h.spread += e.spread;
           h.dof += float(paths_[pixel] - 1);
-          visible_[pixel] =
-              uint32_t(std::min<uint64_t>(uint64_t(visible_[pixel]) + e.visible, UINT32_MAX));
           min_mass_[pixel] = std::min(min_mass_[pixel], e.mass);
           glossy_f_[pixel] = std::max(glossy_f_[pixel], e.ratio);
         }
@@ -170,7 +168,6 @@ void SppmMethod::extra_paths(const PassInputs& in, const CameraPathInputs& camer
           Rng rng(in.seed, in.pass, path_item(pixel, t), Stream::DirectLight);
           o.direct += direct_light(in.world, p, bsdf ? &*bsdf : nullptr, rng);
         }
-        ++e.visible;
         e.mass = std::min(e.mass, float(o.disc.mass));
         if (bsdf && states[k].photons < kMinPhotonsForBound) {
           const double c = std::max(o.disc.mass, kMinKernelMass);

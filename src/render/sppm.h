@@ -40,7 +40,6 @@ class SppmMethod final : public PhotonMethod {
     float mass = 1.0f;          // the smallest over the other paths' visible points
     float ratio = 0.0f;         // their largest glossy f / c
     float spread = 0.0f;        // PathMean::spread of the pass
-    uint32_t visible = 0;       // the other paths with a visible point
     bool combined = false;      // the pixel had more than one path this pass
   };
 
