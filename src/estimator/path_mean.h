@@ -28,12 +28,12 @@ class PathMean {
   void finish(double r2, PassSums& sums, OwnerValues& owner) const;
 
  private:
-  PassSums raw_;            // sums of the raw PassSums (used while every disc is whole)
-  dvec3 phi_{0.0};          // sum of phi / c
-  dvec3 lap_{0.0};          // sum of the corrected Laplacian samples (per R^2, as accumulate)
-  dvec3 direct_{0.0};       // sum of D
-  double r2_bias_ = 0.0;    // sum of the effective R_b^2
-  dvec3 x_{0.0}, x2_{0.0};  // sums of the paths' samples X_k and of their squares
+  PassSums raw_;              // sums of the raw PassSums (used while every disc is whole)
+  dvec3 phi_{0.0};            // sum of phi / c
+  dvec3 lap_{0.0};            // sum of the corrected Laplacian samples (per R^2, as accumulate)
+  dvec3 direct_{0.0};         // sum of D
+  double r2_bias_ = 0.0;      // sum of the effective R_b^2
+  dvec3 x_{0.0}, x2_{0.0};    // sums of the paths' samples X_k and of their squares
   double first_count_ = 0.0;  // the first path's M (what the state's photon total adds)
   int paths_ = 0;
   bool full_ = true;
