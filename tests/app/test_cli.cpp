@@ -59,8 +59,9 @@ TEST_F(Cli, WarnsWhenTheStartingRadiusIsOfTheSceneSize) {
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
 }
 
-// PPM traces its camera paths once, so --adaptive paths cannot add any: it says so and renders.
-TEST_F(Cli, WarnsWhereAdaptivePathsDoesNothing) {
+// PPM traces its camera paths once, so --adaptive paths cannot add any: it says so and renders;
+// with a target it warns that the mean-error stop is not calibrated with paths.
+TEST_F(Cli, WarnsWhereAdaptivePathsDoesNothingOrIsUncalibrated) {
   const std::string base = "render " + quote(scene("cornell.gltf")) + " -o " + quote(out()) +
                            " --passes 2 --resolution 8x8 --photons-per-pass 1000 --quiet";
   Outcome r = run(base + " --method ppm --adaptive paths");
@@ -69,6 +70,10 @@ TEST_F(Cli, WarnsWhereAdaptivePathsDoesNothing) {
   r = run(base + " --adaptive paths");
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
+  // Its mean-error stop is not calibrated at tight targets: a target says so.
+  r = run(base + " --adaptive paths --target-error 0.5");
+  EXPECT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("mean-error stop is not calibrated"), std::string::npos) << r.err;
 }
 
 TEST_F(Cli, BadOptionValuesExitWithUsageError) {
