@@ -21,7 +21,8 @@ uniform radiance 1 times --environment-scale when the scene has no light, none o
 (environment maps are not translated).
 
 It prints the ratio photonbound / Cycles per channel of the mean over the pixels a surface
-covers at least half of (Cycles' alpha, with the sky put back where it is below 1), and writes to DIR (default: beside RENDER.exr, RENDER_cycles/):
+covers at least half of (Cycles' alpha, with the sky put back where it is below 1), and
+writes to DIR (default: beside RENDER.exr, RENDER_cycles/):
 cycles.exr, side_by_side.png (photonbound left, Cycles right, one exposure), difference.png
 (photonbound minus Cycles: red where photonbound is brighter, blue where darker, full colour at
 the largest difference's 99th percentile) and ratios.json.
