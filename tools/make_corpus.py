@@ -388,7 +388,8 @@ def alpha_mask(d):
     mat = d.material("Leaf", pbr, alphaMode="MASK", alphaCutoff=0.5)
     d.object("Leaf", quad((0, 1.6, -0.3), (0.9, 0, 0), (0, 0, -0.9)), mat)
     # Blender's "Alpha Blend" mode: coverage 0.4.
-    veil = d.material("Veil", {**principled((0.8, 0.3, 0.3)), "baseColorFactor": [0.8, 0.3, 0.3, 0.4]},
+    veil = d.material("Veil", {**principled((0.8, 0.3, 0.3)),
+                               "baseColorFactor": [0.8, 0.3, 0.3, 0.4]},
                       alphaMode="BLEND")
     d.object("Veil", quad((1.4, 0.5, -1.0), (0.3, 0, 0), (0, 0.5, 0)), veil)
 
