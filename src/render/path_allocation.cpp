@@ -54,11 +54,12 @@ int paths_for(const PathVariance& v, double g) {
 
 void choose_paths(std::span<const PointState> states, std::span<const PathHistory> history,
                   uint64_t passes, double photons_per_pass, const PathCosts& costs,
-                  std::span<uint8_t> paths) {
+                  std::span<uint8_t> paths, PathScratch& scratch) {
   const size_t n = states.size();
   std::fill(paths.begin(), paths.end(), uint8_t(1));
   if (passes < kPathsMinPasses || n == 0) return;
-  std::vector<PathVariance> v(n);
+  std::vector<PathVariance>& v = scratch.variance;
+  v.resize(n);
   constexpr size_t kChunk = 4096;
   const size_t chunks = (n + kChunk - 1) / kChunk;
   parallel_for(chunks, 1, [&](size_t b, size_t e) {
@@ -68,7 +69,10 @@ void choose_paths(std::span<const PointState> states, std::span<const PathHistor
   });
   // Alternate g with the numbers, from one path everywhere; three rounds settle it (the
   // numbers are integers and g moves little once the sum of sds does).
-  std::vector<double> part_sd(chunks), part_cost(chunks);
+  std::vector<double>& part_sd = scratch.chunk_sd;
+  std::vector<double>& part_cost = scratch.chunk_cost;
+  part_sd.resize(chunks);
+  part_cost.resize(chunks);
   for (int round = 0; round < 3; ++round) {
     parallel_for(chunks, 1, [&](size_t b, size_t e) {
       for (size_t c = b; c < e; ++c) {

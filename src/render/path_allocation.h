@@ -10,6 +10,7 @@
 
 #include <cstdint>
 #include <span>
+#include <vector>
 
 namespace pb {
 
@@ -65,11 +66,17 @@ PathVariance path_variance(const PointState& state, uint64_t passes, double phot
 // to the nearest integer.
 int paths_for(const PathVariance& v, double g);
 
+// What choose_paths works in, kept across passes so that a steady pass allocates nothing.
+struct PathScratch {
+  std::vector<PathVariance> variance;
+  std::vector<double> chunk_sd, chunk_cost;
+};
+
 // paths[p] for every pixel from states[p] and history[p] (the next pass's numbers): 1 before
 // kPathsMinPasses passes. The image-wide g is found by a few rounds that alternate it with
 // the numbers; sums are taken in a fixed order, so the result does not depend on the threads.
 void choose_paths(std::span<const PointState> states, std::span<const PathHistory> history,
                   uint64_t passes, double photons_per_pass, const PathCosts& costs,
-                  std::span<uint8_t> paths);
+                  std::span<uint8_t> paths, PathScratch& scratch);
 
 }  // namespace pb

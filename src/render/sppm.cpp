@@ -52,7 +52,8 @@ bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
   if (settings_.adaptive_paths) {
     PathCosts costs;
     costs.rays_per_photon = in.rays_per_photon;
-    choose_paths(states, history_, in.pass - 1, in.params.photons_per_pass, costs, paths_);
+    choose_paths(states, history_, in.pass - 1, in.params.photons_per_pass, costs, paths_,
+                 path_scratch_);
   }
   for (size_t first = 0; first < n; first += block) {
     const size_t count = std::min(block, n - first);

@@ -74,6 +74,7 @@ class SppmMethod final : public PhotonMethod {
   std::vector<uint8_t> paths_;
   std::vector<PathHistory> history_;
   std::vector<ExtraPaths> extra_;
+  PathScratch path_scratch_;
 };
 
 }  // namespace pb

@@ -30,10 +30,11 @@ void operator delete[](void* p, std::size_t) noexcept { std::free(p); }
 namespace pb {
 namespace {
 
-long allocations_in_one_pass(Method method, DirectMode direct) {
+long allocations_in_one_pass(Method method, DirectMode direct, bool paths = false) {
   RenderOptions o = test::quick_options("cornell.gltf", 64, 8);
   o.method = method;
   o.direct = direct;
+  o.adaptive_paths = paths;
   o.photons_per_pass = 20000;
   const Scene scene = load_gltf(o.scene);
   Renderer r(scene, o);
@@ -43,8 +44,9 @@ long allocations_in_one_pass(Method method, DirectMode direct) {
   r.step();
   g_counting = false;
   EXPECT_GT(g_allocations.load(), 0) << "the first pass sizes its buffers";
-  // Warm: the photon count of a pass varies, so the hit buffers may still grow for a few passes.
-  for (int k = 0; k < 5; ++k) r.step();
+  // Warm: the photon count of a pass varies, so the hit buffers may still grow for a few passes;
+  // --adaptive paths sizes its scratch at its first allocation (kPathsMinPasses).
+  for (int k = 0; k < (paths ? 20 : 5); ++k) r.step();
   long most = 0;
   for (int k = 0; k < 3; ++k) {
     g_allocations = 0;
@@ -59,6 +61,7 @@ long allocations_in_one_pass(Method method, DirectMode direct) {
 TEST(Allocation, SppmPassAllocatesNothingOnceWarm) {
   EXPECT_EQ(allocations_in_one_pass(Method::SPPM, DirectMode::NextEvent), 0);
   EXPECT_EQ(allocations_in_one_pass(Method::SPPM, DirectMode::Photons), 0);
+  EXPECT_EQ(allocations_in_one_pass(Method::SPPM, DirectMode::NextEvent, true), 0);
 }
 
 TEST(Allocation, PpmPassAllocatesNothingOnceWarm) {

@@ -61,11 +61,12 @@ TEST(PathAllocation, OnePathBeforeTheModelHasPasses) {
   }
   std::vector<PathHistory> history(10, PathHistory{3.0f, 0.0f, 0.0f});
   std::vector<uint8_t> paths(10, 7);
-  choose_paths(states, history, kPathsMinPasses - 1, 1000.0, PathCosts{}, paths);
+  PathScratch scratch;
+  choose_paths(states, history, kPathsMinPasses - 1, 1000.0, PathCosts{}, paths, scratch);
   for (uint8_t k : paths) EXPECT_EQ(k, 1);
   // With passes enough, a large spread within passes asks for more paths, none for none.
   history[3] = PathHistory{3.0f, 400.0f, 8.0f};
-  choose_paths(states, history, kPathsMinPasses, 1000.0, PathCosts{}, paths);
+  choose_paths(states, history, kPathsMinPasses, 1000.0, PathCosts{}, paths, scratch);
   EXPECT_GT(paths[3], 1);
   const PathVariance quiet =
       path_variance(states[0], 8, 1000.0, PathHistory{8.0f, 0.0f, 8.0f}, PathCosts{});
