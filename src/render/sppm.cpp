@@ -184,7 +184,8 @@ void SppmMethod::extra_paths(const PassInputs& in, const CameraPathInputs& camer
 
 void SppmMethod::save(RenderState& s) const {
   s.path_history.resize(history_.size() * 3);
-  std::memcpy(s.path_history.data(), history_.data(), history_.size() * sizeof(PathHistory));
+  if (!history_.empty())  // memcpy takes no null pointer, even for no bytes
+    std::memcpy(s.path_history.data(), history_.data(), history_.size() * sizeof(PathHistory));
   s.visible = visible_;
   s.min_mass = min_mass_;
   s.glossy_f = glossy_f_;
@@ -204,7 +205,8 @@ void SppmMethod::restore(const RenderState& saved) {
     throw StateError("the state holds " + std::to_string(saved.path_history.size() / 3) +
                      " camera-path histories but this render has " +
                      std::to_string(history_.size()) + " (--adaptive paths)");
-  std::memcpy(history_.data(), saved.path_history.data(), history_.size() * sizeof(PathHistory));
+  if (!history_.empty())
+    std::memcpy(history_.data(), saved.path_history.data(), history_.size() * sizeof(PathHistory));
   visible_ = saved.visible;
   min_mass_ = saved.min_mass;
   glossy_f_ = saved.glossy_f;
