@@ -59,27 +59,31 @@ double ppm_radius_update(double& n, double& r2, double m, double alpha, double m
   return r2 / r2_pass;
 }
 
-void accumulate_pass(PointState& s, const PassSums& g, const OwnerValues& o,
-                     const EstimatorParams& params, uint64_t pass) {
-  const double r2_pass = s.r2;  // R_j: the radius every deposit of this pass was made with
-  const double inv_area = 1.0 / (kPiD * r2_pass * params.photons_per_pass);
-
+CorrectedSums corrected_sums(const PassSums& g, const DiscMoments& disc, double r2_pass) {
   // Where the disc reaches past the end of the surface (section 11): the kernel sum is divided
   // by the kernel's mass c on the surface; the Laplacian sample loses the truncated Laplacian
   // kernel's response l0 L / R^2 to the constant part and is rescaled by its second moment; and
   // the bias, (R^2 / 4c) tr(M2) Lap for an isotropic Hessian, is 0.5 k2 Lap R_b^2 with the
   // effective R_b^2 = R^2 tr(M2) / (2 k2 c), which the moments stream in place of R_j^2. The
   // whole disc (every interior point) takes the plain path, bit for bit.
-  dvec3 phi = g.phi, lap = g.phi_lap_r2 / r2_pass;  // w_lap carries 1 / R_j^2
-  double r2_bias = r2_pass;
-  if (!o.disc.full) {
-    const double c = std::max(o.disc.mass, kMinKernelMass);
-    phi = g.phi / c;
+  CorrectedSums r{g.phi, g.phi_lap_r2 / r2_pass, r2_pass};  // w_lap carries 1 / R_j^2
+  if (!disc.full) {
+    const double c = std::max(disc.mass, kMinKernelMass);
+    r.phi = g.phi / c;
     // A disc cut to a sliver leaves the Laplacian kernel little sensitivity to curvature:
     // its second moment is kept at least a sixteenth of the whole disc's.
-    lap = (lap - (o.disc.lap_mass / r2_pass) * phi) * (4.0 / std::max(o.disc.lap_second, 0.25));
-    r2_bias = r2_pass * o.disc.second / (2.0 * kernel::kSecondMoment * c);
+    r.lap = (r.lap - (disc.lap_mass / r2_pass) * r.phi) * (4.0 / std::max(disc.lap_second, 0.25));
+    r.r2_bias = r2_pass * disc.second / (2.0 * kernel::kSecondMoment * c);
   }
+  return r;
+}
+
+void accumulate_pass(PointState& s, const PassSums& g, const OwnerValues& o,
+                     const EstimatorParams& params, uint64_t pass) {
+  const double r2_pass = s.r2;  // R_j: the radius every deposit of this pass was made with
+  const double inv_area = 1.0 / (kPiD * r2_pass * params.photons_per_pass);
+
+  const auto [phi, lap, r2_bias] = corrected_sums(g, o.disc, r2_pass);
 
   // Per-pass sample X_j = D_j + phi_j / (pi R_j^2 M_e) (section 4), streamed into bivariate
   // Welford moments with R_j^2: C_xy += (x - mean_x_old)(y - mean_y_new).

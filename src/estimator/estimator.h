@@ -115,6 +115,16 @@ dvec3 pass_variance(const PointState& state, uint64_t passes, double photons_per
 // actually changed by, which tau and tauLap must follow exactly.
 double ppm_radius_update(double& n, double& r2, double m, double alpha, double min_r2);
 
+// One pass's kernel sums at a point whose disc is `disc`, at the pass's R^2, corrected for the
+// part of the disc beyond the surface (section 11): phi / c, the Laplacian sample (per R^2) and
+// the effective R_b^2 the bias streams in place of R^2. A whole disc passes them through.
+struct CorrectedSums {
+  dvec3 phi{0.0};
+  dvec3 lap{0.0};
+  double r2_bias = 0.0;
+};
+CorrectedSums corrected_sums(const PassSums& sums, const DiscMoments& disc, double r2_pass);
+
 // Folds pass number `pass` (1-based) into the state: its photons' sums and its owner's values.
 // state.r2 must be the radius the pass used.
 void accumulate_pass(PointState& state, const PassSums& sums, const OwnerValues& owner,

@@ -15,15 +15,8 @@ void PathMean::add(const PassSums& g, const OwnerValues& o, double r2, double ph
   if (paths_ == 0) first_count_ = g.count;
   ++paths_;
   // The corrections of accumulate_pass (ESTIMATOR.md section 11), per path.
-  dvec3 phi = g.phi, lap = g.phi_lap_r2 / r2;
-  double r2_bias = r2;
-  if (!o.disc.full) {
-    full_ = false;
-    const double c = std::max(o.disc.mass, kMinKernelMass);
-    phi = g.phi / c;
-    lap = (lap - (o.disc.lap_mass / r2) * phi) * (4.0 / std::max(o.disc.lap_second, 0.25));
-    r2_bias = r2 * o.disc.second / (2.0 * kernel::kSecondMoment * c);
-  }
+  full_ = full_ && o.disc.full;
+  const auto [phi, lap, r2_bias] = corrected_sums(g, o.disc, r2);
   phi_ += phi;
   lap_ += lap;
   r2_bias_ += r2_bias;

@@ -14,7 +14,6 @@ class PathMean {
  public:
   // One path's sums and owner values at the pixel's radius r2 of the pass, M_e photons emitted.
   void add(const PassSums& sums, const OwnerValues& owner, double r2, double photons_per_pass);
-  int paths() const { return paths_; }
   // sum over the channels and paths of (X_k - mean X)^2, X_k each path's own sample: with
   // paths() - 1 degrees of freedom, the spread of the pixel's paths within the pass. They share
   // the pass's photons, so it measures the camera part of the variance (section 15).

@@ -172,12 +172,16 @@ void gather_pass(std::span<const VisiblePoint> points, std::span<const PointStat
       learn.weight = relative_error(states[k], guide.passes_done, guide.photons_per_pass) *
                      double(p.f.x + p.f.y + p.f.z) / states[k].r2;
     }
-    const GuideLearning* l = tally ? &learn : nullptr;
-    if (const PointBsdf* g = cursor.at(k))
-      gather_photons(p, *g, states[k].r2, grid, hits, out[k], l);
-    else
-      gather_photons(p, states[k].r2, grid, hits, out[k], l);
+    gather_point(p, cursor.at(k), states[k].r2, grid, hits, out[k], tally ? &learn : nullptr);
   }
+}
+
+void gather_point(const VisiblePoint& p, const PointBsdf* glossy, double r2, const HashGrid& grid,
+                  const std::vector<PhotonHit>& hits, PassSums& out, const GuideLearning* learn) {
+  if (glossy)
+    gather_photons(p, *glossy, r2, grid, hits, out, learn);
+  else
+    gather_photons(p, r2, grid, hits, out, learn);
 }
 
 void disc_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
@@ -198,11 +202,15 @@ void next_event_pass(const World& world, std::span<const VisiblePoint> points,
   PointBsdfCursor cursor(glossy, points.size());
   for (size_t k = 0; k < points.size(); ++k) {
     if (!(max_component(points[k].f) > 0.0f)) continue;
-    const PointBsdf* g = cursor.at(k);
-    if (g && is_base_part(g->bsdf)) continue;  // its camera path counted its direct light
-    Rng rng(seed, pass, first + k, Stream::DirectLight);
-    out[k].direct += direct_light(world, points[k], g, rng);
+    out[k].direct += next_event_at(world, points[k], cursor.at(k), seed, pass, first + k);
   }
+}
+
+dvec3 next_event_at(const World& world, const VisiblePoint& point, const PointBsdf* glossy,
+                    uint64_t seed, uint64_t pass, uint64_t item) {
+  if (glossy && is_base_part(glossy->bsdf)) return dvec3(0.0);  // its camera path counted it
+  Rng rng(seed, pass, item, Stream::DirectLight);
+  return direct_light(world, point, glossy, rng);
 }
 
 void fold_pass(std::span<PointState> states, std::span<const PassSums> sums,

@@ -59,6 +59,12 @@ void gather_photons(const VisiblePoint& point, const PointBsdf& glossy, double r
                     const HashGrid& grid, const std::vector<PhotonHit>& hits, PassSums& out,
                     const GuideLearning* learn = nullptr);
 
+// The gather of one point, on its Bsdf where it has one (glossy non-null) and as a Lambertian
+// point otherwise: the two overloads above, chosen.
+void gather_point(const VisiblePoint& point, const PointBsdf* glossy, double r2,
+                  const HashGrid& grid, const std::vector<PhotonHit>& hits, PassSums& out,
+                  const GuideLearning* learn = nullptr);
+
 // The glossy side table of a span of points: entries sorted by PointBsdf::point, which counts
 // from the span's first point at `base` (entries outside the span are skipped).
 struct PointBsdfTable {
@@ -93,6 +99,10 @@ void disc_pass(std::span<const VisiblePoint> points, std::span<const PointState>
 // Stage 4: adds one next-event sample (ESTIMATOR.md section 4) to out[k].direct for every
 // point with f > 0, Rng keyed by (seed, pass, first + k, DirectLight). A point on a GGX lobe's
 // diffuse base (is_base_part, render/lobe_split.h) is skipped: its camera path took its sample.
+// One point's next-event sample (stage 4), Rng keyed by (seed, pass, item, DirectLight); 0 for a
+// point on a GGX lobe's diffuse base, whose camera path took its sample.
+dvec3 next_event_at(const World& world, const VisiblePoint& point, const PointBsdf* glossy,
+                    uint64_t seed, uint64_t pass, uint64_t item);
 void next_event_pass(const World& world, std::span<const VisiblePoint> points,
                      PointBsdfTable glossy, uint64_t seed, uint64_t pass, size_t first,
                      std::span<OwnerValues> out);

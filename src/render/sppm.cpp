@@ -1,17 +1,23 @@
 #include "render/sppm.h"
 
 #include "estimator/path_mean.h"
-#include "render/lobe_split.h"
-#include "render/next_event.h"
-#include "util/rng.h"
 
 #include <algorithm>
 #include <atomic>
-#include <cstring>
 #include <optional>
 #include <string>
 
 namespace pb {
+
+namespace {
+
+// f / c of a glossy visible point of kernel mass `mass`: one photon adds at most
+// w(0) f Phi_max / (c pi R^2 M_e) to the pass sample (ESTIMATOR.md section 12).
+float glossy_ratio(const VisiblePoint& point, const PointBsdf& g, double mass) {
+  return float(max_component(point.f * g.bsdf.max_f(g.wo)) / std::max(mass, kMinKernelMass));
+}
+
+}  // namespace
 
 SppmMethod::SppmMethod(const World& world, const PinholeCamera& camera, CameraPathSettings settings)
     : camera_(camera), settings_(settings) {
@@ -131,10 +137,8 @@ void SppmMethod::record_visible(size_t first, std::span<const VisiblePoint> poin
     // this pass's sample, so the largest ratio over the passes bounds every pass, where the
     // largest f and the smallest c, often of different points (a grazing view; a disc over a
     // crease), bound them up to 10-100 times looser (ESTIMATOR.md section 12).
-    const double c = std::max(mass(g.point), kMinKernelMass);
-    const float ratio = float(max_component(points[g.point].f * g.bsdf.max_f(g.wo)) / c);
     float& cap = glossy_f_[first + g.point];
-    cap = std::max(cap, ratio);
+    cap = std::max(cap, glossy_ratio(points[g.point], g, mass(g.point)));
   }
 }
 
@@ -161,19 +165,13 @@ void SppmMethod::extra_paths(const PassInputs& in, const CameraPathInputs& camer
           trace_visible_point(camera, pixel, t, radii[pixel], p, o);
       if (max_component(p.f) > 0.0f) {
         // Stages 3 and 4 for this one point, as gather_pass and next_event_pass do them.
-        if (bsdf)
-          gather_photons(p, *bsdf, r2, in.grid, in.hits, g);
-        else
-          gather_photons(p, r2, in.grid, in.hits, g);
-        if (in.next_event && !(bsdf && is_base_part(bsdf->bsdf))) {
-          Rng rng(in.seed, in.pass, path_item(pixel, t), Stream::DirectLight);
-          o.direct += direct_light(in.world, p, bsdf ? &*bsdf : nullptr, rng);
-        }
+        const PointBsdf* glossy = bsdf ? &*bsdf : nullptr;
+        gather_point(p, glossy, r2, in.grid, in.hits, g);
+        if (in.next_event)
+          o.direct += next_event_at(in.world, p, glossy, in.seed, in.pass, path_item(pixel, t));
         e.mass = std::min(e.mass, float(o.disc.mass));
-        if (bsdf && states[k].photons < kMinPhotonsForBound) {
-          const double c = std::max(o.disc.mass, kMinKernelMass);
-          e.ratio = std::max(e.ratio, float(max_component(p.f * bsdf->bsdf.max_f(bsdf->wo)) / c));
-        }
+        if (glossy && states[k].photons < kMinPhotonsForBound)
+          e.ratio = std::max(e.ratio, glossy_ratio(p, *glossy, o.disc.mass));
       }
       mean.add(g, o, r2, m_e);
     }
@@ -183,9 +181,9 @@ void SppmMethod::extra_paths(const PassInputs& in, const CameraPathInputs& camer
 }
 
 void SppmMethod::save(RenderState& s) const {
-  s.path_history.resize(history_.size() * 3);
-  if (!history_.empty())  // memcpy takes no null pointer, even for no bytes
-    std::memcpy(s.path_history.data(), history_.data(), history_.size() * sizeof(PathHistory));
+  s.path_history.clear();
+  for (const PathHistory& h : history_)
+    s.path_history.insert(s.path_history.end(), {h.inv_paths, h.spread, h.dof});
   s.visible = visible_;
   s.min_mass = min_mass_;
   s.glossy_f = glossy_f_;
@@ -205,8 +203,10 @@ void SppmMethod::restore(const RenderState& saved) {
     throw StateError("the state holds " + std::to_string(saved.path_history.size() / 3) +
                      " camera-path histories but this render has " +
                      std::to_string(history_.size()) + " (--adaptive paths)");
-  if (!history_.empty())
-    std::memcpy(history_.data(), saved.path_history.data(), history_.size() * sizeof(PathHistory));
+  for (size_t p = 0; p < history_.size(); ++p) {
+    const float* h = saved.path_history.data() + 3 * p;
+    history_[p] = PathHistory{h[0], h[1], h[2]};
+  }
   visible_ = saved.visible;
   min_mass_ = saved.min_mass;
   glossy_f_ = saved.glossy_f;
