@@ -90,7 +90,7 @@ double normal_quantile(double p) {
 
 // ESTIMATOR.md section 6b: the prior of the bias, by summed-area tables over the window.
 std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, int width,
-                              int height) {
+                              int height, double noise_factor) {
   const SummedArea<dvec3> b2(width, height, [&](size_t p) {
     const BiasEstimate e = pixel(p);
     return e.use ? e.bias * e.bias : dvec3(0.0);
@@ -110,8 +110,8 @@ std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, 
         const size_t yb = std::min(y + kPriorWindow + 1, size_t(height));
         const double count = n.box(xa, ya, xb, yb);
         if (count > 0.0)
-          tau2[y * size_t(width) + x] =
-              glm::max(dvec3(0.0), (b2.box(xa, ya, xb, yb) - v.box(xa, ya, xb, yb)) / count);
+          tau2[y * size_t(width) + x] = glm::max(
+              dvec3(0.0), (b2.box(xa, ya, xb, yb) - noise_factor * v.box(xa, ya, xb, yb)) / count);
       }
   });
   return tau2;

@@ -78,6 +78,11 @@ CorrectedSums corrected_sums(const PassSums& g, const DiscMoments& disc, double 
   return r;
 }
 
+double scale_c2_unit(const PointState& s) {
+  const double m = std::fabs(s.mean_x.x) + std::fabs(s.mean_x.y) + std::fabs(s.mean_x.z);
+  return m > 0.0 && std::isfinite(m * m) && m * m > 0.0 ? m * m : 1.0;
+}
+
 void accumulate_pass(PointState& s, const PassSums& g, const OwnerValues& o,
                      const EstimatorParams& params, uint64_t pass) {
   const double r2_pass = s.r2;  // R_j: the radius every deposit of this pass was made with
@@ -93,6 +98,11 @@ void accumulate_pass(PointState& s, const PassSums& g, const OwnerValues& o,
   // mean 0; the R^4 terms the model leaves out give it a mean, with a noise of its own that the
   // samples measure. Where the disc is cut by an edge the half disc's kernel mass would be
   // needed too: those passes are left out.
+  const double scale_unit_before = scale_c2_unit(s);
+  const double inv_i = 1.0 / double(pass);
+  const dvec3 dx = x - s.mean_x;
+  const double dr = r2_bias - s.mean_r2;
+  s.mean_x += dx * inv_i;
   if (o.disc.full) {
     const dvec3 y3 =
         (g.phi - 4.0 * g.phi_half - 0.375 * kernel::kSecondMoment * g.phi_lap_r2) * inv_area;
@@ -100,12 +110,9 @@ void accumulate_pass(PointState& s, const PassSums& g, const OwnerValues& o,
     ++s.scale_passes;
     const double dy = y - s.scale_mean;
     s.scale_mean += dy / double(s.scale_passes);
-    s.scale_c2 += float(dy * (y - s.scale_mean));
+    const double c2 = double(s.scale_c2) * scale_unit_before + dy * (y - s.scale_mean);
+    s.scale_c2 = float(c2 / scale_c2_unit(s));
   }
-  const double inv_i = 1.0 / double(pass);
-  const dvec3 dx = x - s.mean_x;
-  const double dr = r2_bias - s.mean_r2;
-  s.mean_x += dx * inv_i;
   s.mean_r2 += dr * inv_i;
   s.c_xx += dx * (x - s.mean_x);
   s.c_xr += dx * (r2_bias - s.mean_r2);
@@ -169,6 +176,28 @@ dvec3 photon_radiance(const PointState& s, uint64_t passes, double photons_per_p
   return s.tau / (kPiD * s.r2 * double(passes) * photons_per_pass);
 }
 
+namespace {
+
+// Section 11c's measured fourth-order term in the bias (section 6c): E[Y_j] = (15/16) c4 R_j^4,
+// so (16/15) mean(Y) estimates the part of the estimate's bias that a R^2 leaves out, with the
+// variance (16/15)^2 s_Y^2 / n. Y is summed over the channels; each channel takes the photon
+// part's share of it (the two kernels see the same photons, whose colour is tau's).
+void add_fourth_order(const PointState& s, double n, PointEstimate& e) {
+  constexpr double kScale = 16.0 / 15.0;
+  const double b4 = kScale * s.scale_mean;
+  const double v4 = kScale * kScale * scale_spread(s) / ((n - 1.0) * n);
+  if (!std::isfinite(b4) || !std::isfinite(v4)) return;
+  const dvec3 tau = glm::abs(s.tau);
+  const double total = tau.x + tau.y + tau.z;
+  for (int c = 0; c < 3; ++c) {
+    const double share = total > 0.0 ? tau[c] / total : 1.0 / 3.0;
+    e.fourth[c] = b4 * share;
+    e.fourth_variance[c] = v4 * share * share;
+  }
+}
+
+}  // namespace
+
 PointEstimate estimate(const PointState& s, uint64_t passes, double photons_per_pass) {
   PointEstimate e;
   if (passes == 0) return e;
@@ -214,8 +243,9 @@ PointEstimate estimate(const PointState& s, uint64_t passes, double photons_per_
   }
   if (s.scale_passes >= 3 && s.scale_c2 > 0.0f && s.photons >= kMinPhotonsForBound) {
     const double n = double(s.scale_passes);
-    const double t = s.scale_mean / std::sqrt(double(s.scale_c2) / ((n - 1.0) * n));
+    const double t = s.scale_mean / std::sqrt(scale_spread(s) / ((n - 1.0) * n));
     e.scale_z = t * (kSlopeZ / t_at_three_sd(s.scale_passes - 1));
+    if (passes >= 2) add_fourth_order(s, n, e);
   }
   return e;
 }

@@ -62,10 +62,18 @@ struct PointState {
   // Y_j = X_j(R_j) - X_j(R_j / 2) - 0.75 R_j^2 a_j summed over the channels, zero in expectation
   // while the bias is a R^2; only passes whose whole disc lies on the surface are counted.
   double scale_mean = 0.0;
-  float scale_c2 = 0.0f;  // a test statistic's spread: float keeps the state at 208 bytes
+  // Its spread, in units of scale_c2_unit() (the square of mean_x's channel sum): a float keeps
+  // the state at 208 bytes, and in those units it neither overflows nor underflows however
+  // bright the light (the spread is also the variance of the fourth-order bias, section 6c,
+  // which must scale with the light as the other moments do). scale_spread() is the raw M2.
+  float scale_c2 = 0.0f;
   uint32_t scale_passes = 0;
 };
 static_assert(sizeof(PointState) == 208, "the per-point memory budget counts on 208 bytes");
+
+// The unit the two-scale spread is kept in, and the spread itself (sum_j (Y_j - mean Y)^2).
+double scale_c2_unit(const PointState& s);
+inline double scale_spread(const PointState& s) { return double(s.scale_c2) * scale_c2_unit(s); }
 
 // The smallest kernel mass a boundary correction divides by: a point whose disc is almost all
 // off its surface (the tip of a sliver) is not amplified beyond 1000x.
@@ -137,6 +145,11 @@ struct PointEstimate {
   dvec3 variance{0.0};  // S^2 / i: variance of the mean after the retroactive bias correction
   // Variance of the bias estimate B_i itself (section 6b): the Laplacian estimate is noisy.
   dvec3 bias_variance{0.0};
+  // The bias's fourth-order part a R^2 leaves out, measured by the two scales (section 6c):
+  // (16/15) mean(Y) in the photon part's colour, and the variance of that estimate. 0 before
+  // section 11c's test can be formed. The film adds both to B and Var B.
+  dvec3 fourth{0.0};
+  dvec3 fourth_variance{0.0};
   // A replica of the noise of L_i - B_i: sum_j (-1)^j X'_j / i, of the same variance and the
   // same covariance with other points' replicas as the noise itself (section 7).
   dvec3 replica{0.0};

@@ -11,11 +11,17 @@ namespace pb {
 
 namespace {
 
+double sq(double x) { return x * x; }
+
 struct PixelResult {
   dvec3 radiance{0.0}, bias{0.0}, variance{0.0};
   dvec3 bias_variance{0.0};  // of the bias estimate (ESTIMATOR.md section 6b)
-  dvec3 sparse{0.0};         // bound of the photon part of states with few photons (section 12)
-  dvec3 replica{0.0};        // a replica of the noise (sum_k W_k of the states', section 7)
+  // The two scales' fourth-order bias and its variance (section 6c; 0 with --bias-model
+  // laplacian), shrunk by a prior of their own: float, since develop() holds every pixel's.
+  // Its sd rather than its variance: a float's range holds a bias of 1e30 and its square not.
+  vec3 fourth{0.0f}, fourth_sd{0.0f};
+  dvec3 sparse{0.0};   // bound of the photon part of states with few photons (section 12)
+  dvec3 replica{0.0};  // a replica of the noise (sum_k W_k of the states', section 7)
   double photons = 0.0;
   uint32_t slope_tested = 0, slope_disagree = 0;  // state-channels of the model check (11b)
   uint32_t scale_tested = 0, scale_disagree = 0;  // states of the two-scale check (11c)
@@ -60,11 +66,21 @@ double kernel_mass(const PixelLayout& layout, size_t k) {
   return layout.mass.empty() ? 1.0 : std::max(double(layout.mass[k]), kMinKernelMass);
 }
 
+// Section 6c: a state's fourth-order bias into the pixel's, unless --bias-model laplacian.
+void add_fourth(PixelResult& r, const PointEstimate& e, BiasModel model) {
+  if (model != BiasModel::TwoScale) return;
+  r.fourth += vec3(e.fourth);
+  for (int c = 0; c < 3; ++c)
+    r.fourth_sd[c] = float(std::sqrt(sq(double(r.fourth_sd[c])) + e.fourth_variance[c]));
+}
+
 PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& states, size_t pixel,
-                    uint64_t passes, double photons_per_pass, double confidence) {
+                    uint64_t passes, const FilmSettings& settings) {
+  const double photons_per_pass = settings.photons_per_pass, confidence = settings.confidence;
   PixelResult r;
   if (layout.pixel_begin.empty()) {
     const PointEstimate e = estimate(states[pixel], passes, photons_per_pass);
+    add_fourth(r, e, settings.bias_model);
     r.radiance = e.radiance;
     r.bias = e.bias;
     r.variance = e.variance;
@@ -97,6 +113,7 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
   r.exact = true;
   for (uint32_t k = layout.pixel_begin[pixel]; k < layout.pixel_begin[pixel + 1]; ++k) {
     const PointEstimate e = estimate(states[k], passes, photons_per_pass);
+    add_fourth(r, e, settings.bias_model);
     r.radiance += e.radiance;
     r.bias += e.bias;
     r.variance += e.variance;
@@ -122,8 +139,7 @@ std::vector<PixelResult> combine_pixels(const PixelLayout& layout,
   const size_t pixels = size_t(layout.width) * size_t(layout.height);
   std::vector<PixelResult> results(pixels);
   parallel_for(pixels, 1024, [&](size_t begin, size_t end) {
-    for (size_t p = begin; p < end; ++p)
-      results[p] = combine(layout, states, p, passes, s.photons_per_pass, s.confidence);
+    for (size_t p = begin; p < end; ++p) results[p] = combine(layout, states, p, passes, s);
   });
   return results;
 }
@@ -162,6 +178,28 @@ std::vector<dvec3> prior_of(const std::vector<PixelResult>& results, int width, 
         return BiasEstimate{r.bias, r.bias_variance, r.known && !r.exact};
       },
       width, height);
+}
+
+// ESTIMATOR.md section 6c: the fourth-order part shrunk by a prior of its own (over the same
+// window), in place: each pixel keeps w4 B4 and sqrt(w4 V4). Where it is noise (a smooth radiance,
+// tau4 ~ 0) it then neither moves the bias nor dilutes the Laplacian's. Done before the
+// second-order prior, so that develop() never holds two priors at once.
+void shrink_fourth(std::vector<PixelResult>& results, int width, int height) {
+  const std::vector<dvec3> tau4 = bias_prior(
+      [&](size_t p) {
+        const PixelResult& r = results[p];
+        const dvec3 sd(r.fourth_sd);
+        return BiasEstimate{dvec3(r.fourth), sd * sd, r.known && !r.exact};
+      },
+      width, height, kFourthNoiseFactor);
+  for (size_t p = 0; p < results.size(); ++p)
+    for (int c = 0; c < 3; ++c) {
+      PixelResult& r = results[p];
+      const double w4 =
+          r.fourth[c] == 0.0f ? 0.0 : bias_shrinkage(tau4[p][c], sq(double(r.fourth_sd[c])));
+      r.fourth[c] = float(r.fourth[c] * w4);
+      r.fourth_sd[c] = float(r.fourth_sd[c] * std::sqrt(w4));
+    }
 }
 
 // What the bounds add up to over the image (ESTIMATOR.md section 7).
@@ -207,11 +245,14 @@ dvec3 channel_bounds(const PixelResult& r, const dvec3& tau2, const BoundRule& r
     if (r.exact) continue;
     const double vb = r.bias_variance[c];
     const double w = bias_shrinkage(tau2[c], vb);
-    bound[c] = rule.quantile(w * r.bias[c], std::sqrt(r.variance[c] + w * vb)) + r.sparse[c];
+    // Section 6c: with the fourth-order part, already shrunk by its own prior.
+    const double bias = w * r.bias[c] + r.fourth[c];
+    const double bias_var = w * vb + sq(double(r.fourth_sd[c]));
+    bound[c] = rule.quantile(bias, std::sqrt(r.variance[c] + bias_var)) + r.sparse[c];
     // The same model, for the image's mean error: |w B + noise| with the noise's variance
     // (the t's), plus the sparse-photon term as it stands (an upper limit).
-    const ChannelError e = channel_error(w * r.bias[c], r.variance[c] * rule.t_var + w * vb,
-                                         r.sparse[c], denominator[c], r.replica[c], r.variance[c]);
+    const ChannelError e = channel_error(bias, r.variance[c] * rule.t_var + bias_var, r.sparse[c],
+                                         denominator[c], r.replica[c], r.variance[c]);
     tally.model.error += e.mean;
     pixel_error_sd += e.sd;
     if (e.replicated) {
@@ -230,7 +271,7 @@ void write_pixel(FilmImage& image, size_t p, const PixelResult& r, const dvec3& 
   for (int c = 0; c < 3; ++c) {
     image.radiance[3 * p + c] = float(r.radiance[c]);
     image.bound[3 * p + c] = float(bound[c]);
-    image.bias[3 * p + c] = float(r.bias[c]);
+    image.bias[3 * p + c] = float(r.bias[c] + r.fourth[c]);
     image.noise[3 * p + c] = known ? float(noise[c]) : INFINITY;
     image.variance[3 * p + c] = float(r.variance[c]);
   }
@@ -252,11 +293,12 @@ void bound_pixel(const PixelResult& r, const dvec3& tau2, const BoundRule& rule,
             ? glm::max(r.radiance, dvec3(std::max(rule.relative_floor, 1e-300)))
             : dvec3(1.0);
     bound = channel_bounds(r, tau2, rule, denominator, p, tally);
-    const dvec3 metric = bound / denominator, bias_metric = glm::abs(r.bias) / denominator;
+    const dvec3 bias = r.bias + dvec3(r.fourth);
+    const dvec3 metric = bound / denominator, bias_metric = glm::abs(bias) / denominator;
     tally.bound_sum += metric.x + metric.y + metric.z;
     tally.bias_metric_sum += bias_metric.x + bias_metric.y + bias_metric.z;
     tally.noise_sum += noise.x + noise.y + noise.z;
-    tally.bias_sum += std::fabs(r.bias.x) + std::fabs(r.bias.y) + std::fabs(r.bias.z);
+    tally.bias_sum += std::fabs(bias.x) + std::fabs(bias.y) + std::fabs(bias.z);
     ++tally.known;
     if (s.target > 0.0 && max_component(metric) <= s.target) ++tally.below;
     tally.pixel_bounds[p] = float(max_component(metric));
@@ -336,12 +378,13 @@ const std::vector<float>& FilmImage::plane(Channel id) const {
 // ESTIMATOR.md sections 5-7: combine, check the model, take the prior, bound and predict.
 FilmSummary develop(const PixelLayout& layout, const std::vector<PointState>& states,
                     uint64_t passes, const FilmSettings& s, FilmImage* image) {
-  const std::vector<PixelResult> results = combine_pixels(layout, states, passes, s);
+  std::vector<PixelResult> results = combine_pixels(layout, states, passes, s);
   const size_t pixels = results.size();
   FilmSummary sum;
   sum.relative_floor = relative_floor(results);
   if (image) prepare_image(*image, layout.width, layout.height);
   check_model(results, sum);
+  if (s.bias_model == BiasModel::TwoScale) shrink_fourth(results, layout.width, layout.height);
   const std::vector<dvec3> tau2 = prior_of(results, layout.width, layout.height);
   const BoundRule rule(passes, s, sum.relative_floor);
   Tally tally(pixels);

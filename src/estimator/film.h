@@ -67,6 +67,7 @@ struct FilmSettings {
   ErrorMetric metric = ErrorMetric::Absolute;
   double target = 0.0;         // 0 = no target
   double stop_fraction = 0.9;  // the share of pixels pixel_quantile_bound is taken at
+  BiasModel bias_model = BiasModel::TwoScale;
 };
 
 // Each PPM point's W_k f (render/camera_pass.h, VisiblePoint::f) read in place from the

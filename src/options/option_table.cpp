@@ -114,6 +114,11 @@ std::vector<OptionSpec> make_table() {
   t.push_back(real(base("--confidence", "confidence", "C", bounds, K::Adjust,
                         "confidence 1 - beta of the error bounds"),
                    &RenderOptions::confidence, {0, 1, true, true, "", ""}));
+  t.push_back(choice(base("--bias-model", "bias_model", "two-scale|laplacian", bounds, K::Adjust,
+                          "the bias in the bounds: the Laplacian's a R^2 plus the fourth-order "
+                          "part the two kernel scales measure, or HJJ10's a R^2 alone"),
+                     &RenderOptions::bias_model,
+                     {{"two-scale", BiasModel::TwoScale}, {"laplacian", BiasModel::Laplacian}}));
   t.push_back(integer(base("--min-passes", "min_passes", "N", bounds, K::Adjust,
                            "passes before the first stop test"),
                       &RenderOptions::min_passes, {2, 1000000000000ULL}));

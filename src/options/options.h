@@ -62,6 +62,9 @@ struct RenderOptions {
   bool adaptive_photons = false;
   bool adaptive_paths = false;   // SPPM: section 15
   std::optional<double> radius;  // world units; default from the pixel footprint
+  // --bias-model (ESTIMATOR.md section 6c): the bounds' bias with the two scales' fourth-order
+  // part, or the Laplacian's second-order part alone (HJJ10). Never changes the image.
+  BiasModel bias_model = BiasModel::TwoScale;
   int max_depth = 8;
   double mirror_roughness = kDefaultMirrorRoughness;
   // SPPM with next-event direct light: camera paths follow GGX lobes below this roughness

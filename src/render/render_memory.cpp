@@ -9,11 +9,12 @@ namespace pb {
 namespace {
 
 // Peak resident bytes, measured with /usr/bin/time -v on scenes/cornell.gltf, 1 pass, above the
-// 140 MiB the program takes with a 16x16 image: SPPM 564 bytes per pixel (1024^2 and 2048^2
-// agree), PPM 715 (its visible points and their pass), a pass of photons 166 bytes per photon
-// emitted (1e5 and 1e6 photons). Rounded up a little; a checkpoint copies each 208-byte state.
-constexpr uint64_t kSppmPixelBytes = 600;
-constexpr uint64_t kPpmPixelBytes = 750;
+// 140 MiB the program takes with a 16x16 image: SPPM 626 bytes per pixel at 1024^2, PPM 778 (its
+// visible points and their pass; both with the two-scale bias's prior, ESTIMATOR.md section 6c,
+// 24 more than --bias-model laplacian), a pass of photons 166 bytes per photon emitted (1e5 and
+// 1e6 photons). Rounded up a little; a checkpoint copies each 208-byte state.
+constexpr uint64_t kSppmPixelBytes = 640;
+constexpr uint64_t kPpmPixelBytes = 800;
 constexpr uint64_t kCheckpointPixelBytes = 208;
 constexpr uint64_t kPhotonBytes = 170;
 // A triangle's share of the World (positions, normals, precomputed face normals) and Embree's

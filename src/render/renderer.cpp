@@ -95,6 +95,7 @@ FilmSettings Renderer::film_settings() const {
   s.metric = options_.metric;
   s.target = options_.target_error.value_or(0.0);
   s.stop_fraction = options_.stop_fraction;
+  s.bias_model = options_.bias_model;
   return s;
 }
 

@@ -38,10 +38,10 @@ class Memory : public pb::test::TempDirTest {
 };
 
 TEST_F(Memory, AResolutionBeyondTheLimitIsRefusedBeforeTheSceneLoads) {
-  // 16384^2 pixels at about 600 bytes each: 150 GiB. It ran for 9 s and ended with a bare
+  // 16384^2 pixels at about 640 bytes each: 160 GiB. It ran for 9 s and ended with a bare
   // "std::bad_alloc"; --max-memory is given so that the machine's size does not matter.
   expect_refused(render("--resolution 16384x16384 --max-memory 64G"),
-                 {"photonbound: the render needs about 150 GiB (150 GiB for 268435456 pixels",
+                 {"photonbound: the render needs about 160 GiB (160 GiB for 268435456 pixels",
                   "over the 64 GiB of --max-memory; lower --resolution or --photons-per-pass"});
 }
 

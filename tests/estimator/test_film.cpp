@@ -120,4 +120,44 @@ TEST(MeanErrorPrediction, PartlySharedNoiseIsBoundedFromAbove) {
   EXPECT_LT(s.sd / s.sd_actual, 1.6);
 }
 
+// The bias prior (ESTIMATOR.md sections 6b, 6c) on a 64 x 64 field of estimates B with
+// Var B = 1. Pure noise (B ~ N(0, 1), independent): tau^2 = max(0, mean(B^2) - k) is positive
+// wherever the window's mean of chi-square(1) values exceeds k: about half of the pixels at
+// k = 1. At k = 1.5 an interior window (81 pixels, sd 0.157) exceeds it with the normal tail
+// beyond 3.2 sds, 0.07%; the windows at the border hold 25-72 pixels (sd up to 0.28, 1.8 sds in
+// the corners), and they are a quarter of the image: measured 0.68% in all. 2% leaves 3x that and
+// is still 20x below k = 1's share. A real bias of 3 (B = 3 + N(0, 1)): tau^2 about 9 + 1 - k,
+// so w = tau^2 / (tau^2 + 1) > 0.85 everywhere at either k (0.89 in expectation at k = 1.5).
+TEST(BiasPrior, AWindowOfNoiseCountsAsBiasOnlyBeyondTheNoiseFactor) {
+  constexpr int n = 64;
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> z;
+  std::vector<double> noise(n * n), biased(n * n);
+  for (size_t p = 0; p < noise.size(); ++p) {
+    noise[p] = z(rng);
+    biased[p] = 3.0 + z(rng);
+  }
+  auto prior = [&](const std::vector<double>& b, double k) {
+    return bias_prior(
+        [&](size_t p) {
+          return BiasEstimate{dvec3(b[p]), dvec3(1.0), true};
+        },
+        n, n, k);
+  };
+  auto share_positive = [&](const std::vector<dvec3>& tau2) {
+    double positive = 0.0;
+    for (const dvec3& t : tau2) positive += t.x > 0.0;
+    return positive / double(tau2.size());
+  };
+  const double at_one = share_positive(prior(noise, 1.0));
+  const double at_factor = share_positive(prior(noise, kFourthNoiseFactor));
+  std::printf("noise: tau^2 > 0 in %.3f of the pixels at k = 1, %.4f at k = %.1f\n", at_one,
+              at_factor, kFourthNoiseFactor);
+  EXPECT_GT(at_one, 0.3);
+  EXPECT_LT(at_one, 0.7);
+  EXPECT_LT(at_factor, 0.02);
+  for (double k : {1.0, kFourthNoiseFactor})
+    for (const dvec3& t : prior(biased, k)) EXPECT_GT(bias_shrinkage(t.x, 1.0), 0.85);
+}
+
 }  // namespace
