@@ -26,7 +26,8 @@ namespace pb {
 // sparse-photon bound's SPPM kernel masses, largest photon power and glossy caps;
 // 5: PointState with the alternating sums of the noise replica (192 B); 6: with the two-scale
 // check's moments (208 B); 7: SPPM's glossy caps as f / c, not f; 8: the photon guide;
-// 9: the camera paths' history (--adaptive paths); 10: the two-scale spread in double (216 B).
+// 9: the camera paths' history (--adaptive paths); 10: the two-scale spread in units of the state's
+// mean (section 6c).
 inline constexpr uint32_t kStateVersion = 10;
 
 struct SavedRender {

@@ -147,7 +147,8 @@ struct PointEstimate {
   dvec3 bias_variance{0.0};
   // The bias's fourth-order part a R^2 leaves out, measured by the two scales (section 6c):
   // (16/15) mean(Y) in the photon part's colour, and the variance of that estimate. 0 before
-  // section 11c's test can be formed. The film adds both to B and Var B.
+  // section 11c's test can be formed. The film shrinks them by a prior of their own and adds
+  // them to B and Var B (film.cpp, shrink_fourth).
   dvec3 fourth{0.0};
   dvec3 fourth_variance{0.0};
   // A replica of the noise of L_i - B_i: sum_j (-1)^j X'_j / i, of the same variance and the
