@@ -1,0 +1,47 @@
+// The film's first phase (ESTIMATOR.md sections 5, 6b, 6c, 10, 11b, 11c, 12): every pixel's
+// sums of its states, the model checks' counts, and the fourth-order bias shrunk by its prior.
+// Internal to film.cpp, which bounds and summarises them.
+#pragma once
+
+#include "estimator/film.h"
+
+#include <vector>
+
+namespace pb {
+
+inline double squared(double x) { return x * x; }
+
+struct PixelResult {
+  dvec3 radiance{0.0}, bias{0.0}, variance{0.0};
+  dvec3 bias_variance{0.0};  // of the bias estimate (ESTIMATOR.md section 6b)
+  // The two scales' fourth-order bias and its variance (section 6c; 0 with --bias-model
+  // laplacian), shrunk by a prior of their own: float, since develop() holds every pixel's.
+  // Its sd rather than its variance: a float's range holds a bias of 1e30 and its square not.
+  vec3 fourth{0.0f}, fourth_sd{0.0f};
+  dvec3 sparse{0.0};   // bound of the photon part of states with few photons (section 12)
+  dvec3 replica{0.0};  // a replica of the noise (sum_k W_k of the states', section 7)
+  double photons = 0.0;
+  uint32_t slope_tested = 0, slope_disagree = 0;  // state-channels of the model check (11b)
+  uint32_t scale_tested = 0, scale_disagree = 0;  // states of the two-scale check (11c)
+  float radius = 0.0f;
+  bool exact = false;  // PPM: no point, so nothing random (background, exact emission)
+  // SPPM: no visible point in any pass, so no photon part: the bias model does not enter its
+  // bound (the emission and background its jittered paths saw), and a refuted model leaves it.
+  bool photon_free = false;
+  bool known = true;
+};
+
+// ESTIMATOR.md sections 5 and 10: every pixel's sums of its states.
+std::vector<PixelResult> combine_pixels(const PixelLayout& layout,
+                                        const std::vector<PointState>& states, uint64_t passes,
+                                        const FilmSettings& s);
+// ESTIMATOR.md section 7: the relative metric's floor, from the image's mean radiance.
+double relative_floor(const std::vector<PixelResult>& results);
+// ESTIMATOR.md sections 11b and 11c: the shares of disagreeing states, and whether they refute.
+void check_model(const std::vector<PixelResult>& results, FilmSummary& sum);
+// ESTIMATOR.md section 6b: the bias prior over the known pixels with a random state.
+std::vector<dvec3> prior_of(const std::vector<PixelResult>& results, int width, int height);
+// ESTIMATOR.md section 6c: each pixel's fourth-order part shrunk in place by its own prior.
+void shrink_fourth(std::vector<PixelResult>& results, int width, int height);
+
+}  // namespace pb
