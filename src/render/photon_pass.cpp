@@ -1,6 +1,7 @@
 #include "render/photon_pass.h"
 
 #include "bsdf/bsdf.h"
+#include "bsdf/scattering.h"
 #include "util/counting_sort.h"
 #include "util/parallel.h"
 #include "util/rng.h"
@@ -88,8 +89,13 @@ void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, const Emi
     BsdfSample b;
     if (!s.bsdf.sample(wo, rng, Transport::Importance, b, flux)) return;
     const vec3 next = b.wi;
-    // The shading-normal correction of adjoint transport (bsdf.h).
-    const vec3 factor = b.weight * adjoint_shading_factor(wo, next, ng, ns);
+    // The shading-normal correction of adjoint transport (bsdf.h), with the normal the draw
+    // was made about: a mirror whose reflection about ns would point below the true surface
+    // reflects about ng instead (bsdf_delta.cpp), and for that branch ns means nothing. With it
+    // the factor is |wo.ns| / |wi.ns|, unbounded: on a normal-mapped Blender export single
+    // photons carried 1.6e4 times the emitted power (ESTIMATOR.md section 12).
+    const bool about_ng = b.delta && next == reflect(wo, ng);
+    const vec3 factor = about_ng ? b.weight : b.weight * adjoint_shading_factor(wo, next, ng, ns);
     // Russian roulette keeps the carried power roughly constant (survival = max throughput).
     const float q = std::min(1.0f, max_component(factor));
     if (!(q > 0.0f) || rng.next_float() >= q) return;

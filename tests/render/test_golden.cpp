@@ -7,6 +7,7 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <iterator>
 
 namespace pb {
 namespace {
@@ -20,7 +21,8 @@ struct Golden {
   uint64_t photons;
   DirectMode direct;
   double alpha;
-  // The same source gives other bits on other CPUs (below): one checksum per machine checked.
+  // The same source gives other bits on other CPUs (below): one checksum per machine checked;
+  // 0: not recorded for that CPU.
   uint64_t checksum_avx2, checksum_xeon;
   // The same with --bias-model two-scale (the default since section 6c), which changes every
   // bound and no radiance: the checksums above are taken with --bias-model laplacian. 0: not
@@ -44,12 +46,16 @@ struct Golden {
 // instructions (rcpps) Embree's traversal refines, whose bits are the vendor's. Either CPU's
 // checksum passes: a refactor that moves any image moves both. Since the two-scale bias
 // (ESTIMATOR.md section 6c) the pairs are taken with --bias-model laplacian, whose bounds are
-// the earlier ones bit for bit, and the default's bounds have a checksum of their own.
+// the earlier ones bit for bit, and the default's bounds have a checksum of their own. Renewed
+// for the three Cornell boxes when the photon pass stopped applying the shading-normal factor
+// to a mirror branch drawn about the true normal (photon_pass.cpp; the mirror sphere's rim):
+// only an AVX-512 Xeon was at hand, so their AVX2 checksums are 0, not recorded, and an AVX2
+// machine prints its value for them; the five other images check either CPU as before.
 const Golden kGolden[] = {
     {"cornell_nee", Method::PPM, "cornell.gltf", 24, 5, 4000, DirectMode::NextEvent, 0.7,
-     0x646e5bad648da41cULL, 0x3b01127cc15a56e8ULL, 0, 0x2eacb6bad3f61597ULL},
+     0, 0xa21b74ed3a4c2237ULL, 0, 0xcfe134bcf5e1c9b4ULL},
     {"cornell_photons", Method::PPM, "cornell.gltf", 20, 4, 3000, DirectMode::Photons, 0.8,
-     0xe94ffddab361af6fULL, 0x99ddb649eaf79527ULL, 0, 0xe21f468b6d598c10ULL},
+     0, 0x6c7bb25996601a73ULL, 0, 0xf882b64a9e6cf136ULL},
     {"glass_slab", Method::PPM, "glass_slab.gltf", 20, 4, 3000, DirectMode::Photons, 0.7,
      0xb2eb6018f5e51523ULL, 0xe265b6a785d75ae2ULL, 0, 0xb2dc7bc152409c84ULL},
     {"spot", Method::PPM, "spot.gltf", 16, 3, 2000, DirectMode::NextEvent, 0.7,
@@ -57,7 +63,7 @@ const Golden kGolden[] = {
     {"closed_box", Method::PPM, "closed_box.gltf", 16, 4, 2000, DirectMode::NextEvent, 0.9,
      0xb9b97883a6e21822ULL, 0xc109a352d5bb0354ULL, 0, 0x2a65ef36025add4aULL},
     {"sppm_cornell", Method::SPPM, "cornell.gltf", 24, 5, 4000, DirectMode::NextEvent, 0.7,
-     0xc024ad57db520dc2ULL, 0x85107aff0d2beee7ULL, 0, 0xa5bb64c71de31e3cULL},
+     0, 0xdb56737add212301ULL, 0, 0xcbe7a18dbbb10a15ULL},
     {"sppm_box", Method::SPPM, "closed_box.gltf", 16, 4, 2000, DirectMode::NextEvent, 0.9,
      0x4220db98874c0aa2ULL, 0xdb42c34b8251179eULL, 0, 0x076d8e84b3887d8fULL},
     {"plane", Method::PPM, "plane_point.gltf", 16, 4, 2000, DirectMode::Photons, 0.7,
@@ -89,21 +95,42 @@ uint64_t checksum_of(const Golden& g, BiasModel bias_model) {
 
 // PB_GOLDEN_PRINT=1 prints the checksums, for a deliberate update.
 TEST(Golden, ImagesAreBitIdenticalToTheStoredChecksums) {
-  for (const Golden& g : kGolden) {
-    const uint64_t h = checksum_of(g, BiasModel::Laplacian);
-    const uint64_t h4 = checksum_of(g, BiasModel::TwoScale);
+  constexpr size_t n = std::size(kGolden);
+  uint64_t h[n], h4[n];
+  for (size_t k = 0; k < n; ++k) {
+    h[k] = checksum_of(kGolden[k], BiasModel::Laplacian);
+    h4[k] = checksum_of(kGolden[k], BiasModel::TwoScale);
     if (std::getenv("PB_GOLDEN_PRINT"))
-      std::printf("    %s 0x%016llxULL 0x%016llxULL\n", g.name, (unsigned long long)h,
-                  (unsigned long long)h4);
-    EXPECT_TRUE(h == g.checksum_avx2 || h == g.checksum_xeon)
-        << g.name << ": 0x" << std::hex << h << " is neither stored checksum";
-    // The default bias model's bounds (section 6c), where this CPU's are recorded.
-    const uint64_t want = h == g.checksum_xeon ? g.two_scale_xeon : g.two_scale_avx2;
+      std::printf("    %s 0x%016llxULL 0x%016llxULL\n", kGolden[k].name,
+                  (unsigned long long)h[k], (unsigned long long)h4[k]);
+  }
+  // Which CPU's set this machine computes, told by the images whose two checksums are recorded
+  // and differ; a machine that matches neither set fails here.
+  bool xeon = false, avx2 = false;
+  for (size_t k = 0; k < n; ++k) {
+    const Golden& g = kGolden[k];
+    if (g.checksum_avx2 == 0 || g.checksum_xeon == 0 || g.checksum_avx2 == g.checksum_xeon)
+      continue;
+    xeon = xeon || h[k] == g.checksum_xeon;
+    avx2 = avx2 || h[k] == g.checksum_avx2;
+  }
+  ASSERT_TRUE(xeon != avx2) << "this CPU computes neither stored set of checksums (or both)";
+  for (size_t k = 0; k < n; ++k) {
+    const Golden& g = kGolden[k];
+    const uint64_t want = xeon ? g.checksum_xeon : g.checksum_avx2;
+    const uint64_t want4 = xeon ? g.two_scale_xeon : g.two_scale_avx2;
     if (want != 0)
-      EXPECT_EQ(h4, want) << g.name << ": 0x" << std::hex << h4 << " with --bias-model two-scale";
+      EXPECT_EQ(h[k], want) << g.name << ": 0x" << std::hex << h[k];
+    else
+      std::printf("%s: no checksum is recorded for this CPU (0x%016llx)\n", g.name,
+                  (unsigned long long)h[k]);
+    // The default bias model's bounds (section 6c), where this CPU's are recorded.
+    if (want4 != 0)
+      EXPECT_EQ(h4[k], want4) << g.name << ": 0x" << std::hex << h4[k]
+                              << " with --bias-model two-scale";
     else
       std::printf("%s: no two-scale checksum is recorded for this CPU (0x%016llx)\n", g.name,
-                  (unsigned long long)h4);
+                  (unsigned long long)h4[k]);
   }
 }
 
