@@ -269,14 +269,38 @@ bool Lights::sample_environment(const vec3& normal, float p_pick, Rng& rng,
     const float cos = glm::dot(out.wi, normal);
     if (!(cos > 0.0f)) return false;
     out.li = environment_->radiance(out.wi) * (kPi / (cos * p_pick));
+    out.environment_pdf = p_pick * cos / kPi;
   } else {
     float pdf = 0.0f;
     const float u3 = rng.next_float(), u4 = rng.next_float();
     out.wi = environment_->sample(u1, u2, u3, u4, pdf);
     if (!(pdf > 0.0f)) return false;
     out.li = environment_->radiance(out.wi) / (pdf * p_pick);
+    out.environment_pdf = p_pick * pdf;
   }
   return max_component(out.li) > 0.0f && is_finite(out.li);
+}
+
+float Lights::choice_probability(size_t k, const vec3& receiver) const {
+  if (emitter_count() > kLocalSelectionMax) return probability_[k];
+  // The same sums, in the same order, as sample_direct's.
+  float weights[kLocalSelectionMax];
+  float sum = 0.0f;
+  for (size_t j = 0; j < emitter_count(); ++j) sum += (weights[j] = local_weight(j, receiver));
+  if (!(sum > 0.0f) || !std::isfinite(sum)) return 0.0f;
+  return weights[k] / sum;
+}
+
+float Lights::environment_pdf(const vec3& receiver, const vec3& normal, const vec3& wi) const {
+  const size_t k = punctual_.size() + triangles_.size();
+  if (!environment_ || k >= emitter_count()) return 0.0f;
+  const float p_pick = choice_probability(k, receiver);
+  if (!(p_pick > 0.0f)) return 0.0f;
+  if (environment_->uniform()) {
+    const float cos = glm::dot(wi, normal);
+    return cos > 0.0f ? p_pick * cos / kPi : 0.0f;
+  }
+  return p_pick * environment_->pdf(wi);
 }
 
 bool Lights::sample_direct(const vec3& receiver, const vec3& normal, Rng& rng,

@@ -41,6 +41,9 @@ struct DirectSample {
   // by rounding (World::occluded): the sample's error bound on an emissive triangle, 0 for
   // punctual lights.
   float margin = 0.0f;
+  // Drawn from the environment: the solid-angle density of that draw, its choice included
+  // (next-event MIS against the Bsdf's own draws, render/next_event.cpp); 0 otherwise.
+  float environment_pdf = 0.0f;
 };
 
 // Direction from p uniform in the solid angle the triangle (v0, v1, v2) subtends, from two
@@ -96,6 +99,11 @@ class Lights {
   // sample cannot contribute (back side of a one-sided emitter, outside a cone).
   bool sample_direct(const vec3& receiver, const vec3& normal, Rng& rng, DirectSample& out) const;
 
+  // The density with which sample_direct draws wi through the environment for this receiver
+  // (its choice of the environment times the environment's solid-angle density about `normal`);
+  // 0 without an environment.
+  float environment_pdf(const vec3& receiver, const vec3& normal, const vec3& wi) const;
+
   // Radiance of the environment seen along dir (camera rays that leave the scene); 0 without one.
   vec3 environment_radiance(const vec3& dir) const {
     return environment_ ? environment_->radiance(dir) : vec3(0.0f);
@@ -143,6 +151,8 @@ class Lights {
   size_t pick(float u) const;
   // Next-event choice weight of emitter k at a receiver (used for small emitter sets).
   float local_weight(size_t k, const vec3& receiver) const;
+  // The probability that sample_direct chooses emitter k for this receiver.
+  float choice_probability(size_t k, const vec3& receiver) const;
   // Up to this many emitters, the choice is by radiance x solid angle at the receiver; beyond,
   // by power, which is heavy-tailed where a weak emitter is close: with the 24 emitting
   // triangles of closed_block.gltf chosen by power, the 90% bound covered 80% after 16 passes

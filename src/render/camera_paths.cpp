@@ -39,6 +39,11 @@ struct CameraPath {
   // The ray leaves a followed GGX lobe: the light it finds directly (an emitter, the
   // environment) is that vertex's direct light, which its next-event sample has counted.
   bool after_lobe = false;
+  // When the followed lobe's draws are the environment's other strategy (next_event.h): their
+  // density (the lobe's choice times its pdf) and the vertex they left, whose environment light
+  // sample kept the rest; 0 otherwise.
+  float lobe_density = 0.0f;
+  vec3 lobe_origin{0.0f}, lobe_normal{0.0f};
   // The path went past --max-depth by roulette (a pass-over or a followed lobe): it goes on by
   // roulette through delta branches too, up to kPassOverDepth beyond, instead of being cut
   // where the limit would cut a path that reached it.
@@ -92,15 +97,24 @@ LobeChoice follow_lobe(CameraPath& path, const CameraPathInputs& in, const Surfa
   const bool sharp_glass = s.bsdf.has_rough_glass() && !glass_direct;
   const PointBsdf whole{0, wo, sharp_glass ? s.bsdf.without_glass() : s.bsdf};
   path.point.f = w;
+  const float p_lobe = lobe_probability(s.bsdf, wo, in.follow_roughness);
+  const Bsdf lobe_bsdf = p_lobe > 0.0f ? lobe_part(s.bsdf, in.follow_roughness) : Bsdf();
+  // The lobe's draws are the other strategy for the environment's light (next_event.h), with
+  // density min(p_lobe, 1) x its pdf: the light sample keeps the balance heuristic's share of
+  // the lobe's part, and a followed path that leaves the scene adds the rest.
+  const bool mis = in.next_event && p_lobe > 0.0f && !sharp_glass &&
+                   environment_mis_applies(in.world, lobe_bsdf, s.bsdf);
+  const EnvironmentMis lobe_mis{&lobe_bsdf, wo, std::min(p_lobe, 1.0f), false};
   if (in.next_event) {
-    path.emission += direct_light(in.world, path.point, &whole, path.rng);
+    path.emission +=
+        direct_light(in.world, path.point, &whole, path.rng, mis ? &lobe_mis : nullptr);
     // Through the surface: diffuse transmission, and rough glass when broad.
     if (glass_direct || s.bsdf.transmits_diffusely())
       path.emission += direct_light_through(in.world, s, wo, w, glass_direct, path.rng);
   }
-  const float p_lobe = lobe_probability(s.bsdf, wo, in.follow_roughness);
   if (p_lobe >= 1.0f || (p_lobe > 0.0f && path.rng.next_float() < p_lobe)) {
-    const PointBsdf lobe{0, wo, lobe_part(s.bsdf, in.follow_roughness)};
+    const PointBsdf lobe{0, wo, lobe_bsdf};
+    const vec3 vertex = path.point.position, vertex_normal = path.point.shading;
     path.weight = w / p_lobe;
     path.point = VisiblePoint{};  // no visible point here
     // At or beyond --max-depth the followed path goes on by Russian roulette, as a pass-over
@@ -114,6 +128,9 @@ LobeChoice follow_lobe(CameraPath& path, const CameraPathInputs& in, const Surfa
     // The light this path finds directly was counted by the next-event sample, unless it left
     // through sharp rough glass, which that sample left out.
     path.after_lobe = in.next_event && !(sharp_glass && b.glass);
+    path.lobe_density = mis && !b.delta ? lobe_mis.share * b.pdf : 0.0f;
+    path.lobe_origin = vertex;
+    path.lobe_normal = vertex_normal;
     path.left_chain = true;
     return LobeChoice::Followed;
   }
@@ -204,6 +221,7 @@ Step at_vertex(CameraPath& path, const CameraPathInputs& in, const Hit& hit, flo
   // "Unlit"); its Bsdf is black, so the path ends there without a visible point.
   if (s.material->unlit && !path.left_chain) path.emission += dvec3(path.weight * s.painted);
   path.after_lobe = false;
+  path.lobe_density = 0.0f;
   const float p_delta = s.bsdf.delta_probability(wo);
   bool stop = p_delta < 1.0f;
   if (stop && p_delta > 0.0f) {
@@ -241,8 +259,16 @@ std::optional<PointBsdf> trace_visible_point(const CameraPathInputs& in, size_t 
                            : in.world.trace(path.origin, path.origin_normal, path.origin_error,
                                             path.dir, hit, key);
     if (!found) {  // the environment (black without one), seen along the path
-      if (!path.after_lobe)
+      if (!path.after_lobe) {
         path.emission += dvec3(path.weight * in.world.lights().environment_radiance(path.dir));
+      } else if (path.lobe_density > 0.0f && glm::dot(path.dir, path.lobe_normal) > 0.0f) {
+        // The lobe's share of its vertex's environment light (balance heuristic).
+        const float p_l =
+            in.world.lights().environment_pdf(path.lobe_origin, path.lobe_normal, path.dir);
+        if (p_l > 0.0f)
+          path.emission += dvec3(path.weight * in.world.lights().environment_radiance(path.dir) *
+                                 (path.lobe_density / (path.lobe_density + p_l)));
+      }
       break;
     }
     if (at_vertex(path, in, hit, radius, g) == Step::End) break;

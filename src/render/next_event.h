@@ -11,10 +11,34 @@ namespace pb {
 
 // One light sample with a shadow ray: D_j = f Li cos / pdf (ESTIMATOR.md section 4); with
 // `glossy`, f = point.f x f(wo, wi_light).
-dvec3 direct_light(const World& world, const VisiblePoint& point, const PointBsdf* glossy,
-                   Rng& rng);
+// The other strategy of multiple importance sampling for the environment's part of the direct
+// light (next_event.cpp): directions drawn from `bsdf` (seen from wo) with `share` x its pdf().
+// With `draw`, direct_light draws one itself (a gather point); without, the caller's path is that
+// draw (a followed lobe: camera_paths.cpp weighs what it finds of the environment).
+struct EnvironmentMis {
+  const Bsdf* bsdf = nullptr;
+  vec3 wo{0.0f};
+  float share = 1.0f;
+  bool draw = true;
+  float density(const vec3& wi) const { return share * bsdf->pdf(wo, wi); }
+};
+// Lobes below this roughness take the environment's light by multiple importance sampling.
+inline constexpr float kMisRoughness = 0.7f;
+// Whether the draws of `draws` (a whole Bsdf, or SPPM's followed part of `whole`) may be the
+// environment's other strategy: its pdf() describes them (no delta branch, nothing through the
+// surface), `whole` has a lobe below kMisRoughness, and there is an environment.
+bool environment_mis_applies(const World& world, const Bsdf& draws, const Bsdf& whole);
+// One light sample with a shadow ray; with `mis`, an environment sample keeps the balance
+// heuristic's share p_l / (p_l + p_b) of the part of f that mis->bsdf is (all of f for a gather
+// point, the followed lobe's part at a followed lobe).
+dvec3 direct_light(const World& world, const VisiblePoint& point, const PointBsdf* glossy, Rng& rng,
+                   const EnvironmentMis* mis);
+inline dvec3 direct_light(const World& world, const VisiblePoint& point, const PointBsdf* glossy,
+                          Rng& rng) {
+  return direct_light(world, point, glossy, rng, nullptr);
+}
 inline dvec3 direct_light(const World& world, const VisiblePoint& point, Rng& rng) {
-  return direct_light(world, point, nullptr, rng);
+  return direct_light(world, point, nullptr, rng, nullptr);
 }
 // One light sample through the surface at s (Bsdf::eval_transmission: diffuse transmission, and
 // rough glass with `glass`), seen from wo, from the other side, times the path weight.

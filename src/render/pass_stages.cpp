@@ -210,6 +210,13 @@ dvec3 next_event_at(const World& world, const VisiblePoint& point, const PointBs
                     uint64_t seed, uint64_t pass, uint64_t item) {
   if (glossy && is_base_part(glossy->bsdf)) return dvec3(0.0);  // its camera path counted it
   Rng rng(seed, pass, item, Stream::DirectLight);
+  // A glossy point gathered whole (not SPPM's restricted base): its Bsdf's own draws are the
+  // environment's other strategy (next_event.h).
+  if (glossy && !glossy->bsdf.is_restricted() &&
+      environment_mis_applies(world, glossy->bsdf, glossy->bsdf)) {
+    const EnvironmentMis mis{&glossy->bsdf, glossy->wo, 1.0f, true};
+    return direct_light(world, point, glossy, rng, &mis);
+  }
   return direct_light(world, point, glossy, rng);
 }
 
