@@ -151,6 +151,8 @@ class Lights {
   size_t pick(float u) const;
   // Next-event choice weight of emitter k at a receiver (used for small emitter sets).
   float local_weight(size_t k, const vec3& receiver) const;
+  // Every emitter's local_weight for this receiver, and their sum (at most kLocalSelectionMax).
+  float local_weights(const vec3& receiver, float* weights) const;
   // The probability that sample_direct chooses emitter k for this receiver.
   float choice_probability(size_t k, const vec3& receiver) const;
   // Up to this many emitters, the choice is by radiance x solid angle at the receiver; beyond,
