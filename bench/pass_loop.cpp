@@ -32,7 +32,14 @@ void gather_on(const pb::World& world, const pb::CameraPassResult& eye, const pb
                const std::vector<pb::PhotonHit>& hits, const pb::EstimatorParams& params,
                uint64_t pass, std::vector<pb::PointState>& states, std::vector<float>& radii,
                std::vector<pb::PassSums>& sums, std::vector<pb::OwnerValues>& owner) {
-  const pb::PassInputs in{world, grid, hits, params, nullptr, kSeed, pass, true};
+  const pb::PassInputs in{.world = world,
+                          .grid = grid,
+                          .hits = hits,
+                          .params = params,
+                          .boundary = nullptr,
+                          .seed = kSeed,
+                          .pass = pass,
+                          .next_event = true};
   pb::ppm_pass(in, eye.points, {}, {}, states, radii, sums, owner, nullptr);
 }
 

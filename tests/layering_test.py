@@ -29,6 +29,7 @@ LIBRARIES = {
     "oneapi/tbb": "TBB::tbb",
     "glm/": "glm::glm",
     "gtest/": "GTest",
+    "mpi.h": "MPI::MPI_CXX",
 }
 
 

@@ -10,6 +10,7 @@ packages=(
   libembree-dev libopenimageio-dev libopenexr-dev libjpeg-dev libglm-dev libtinygltf-dev
   libdraco-dev libmeshoptimizer-dev nlohmann-json3-dev
   libtbb-dev libboost-dev libgtest-dev
+  libopenmpi-dev openmpi-bin
   python3-numpy python3-matplotlib python3-openimageio
   python3
   "$@"

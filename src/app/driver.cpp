@@ -88,6 +88,7 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
   double develop_seconds = 0.0;  // this pass's develop
   auto develop = [&] {
     const auto start = Clock::now();
+    renderer_.collect();  // a distributed render: every rank's states, here
     report.summary = renderer_.develop();
     developed = true;
     develop_seconds = seconds_since(start);
@@ -163,7 +164,10 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
     for (PassObserver* obs : observers) obs->after_pass(info);
   }
   for (PassObserver* obs : observers) obs->finish();
-  if (!developed) report.summary = renderer_.develop();
+  if (!developed) {
+    renderer_.collect();
+    report.summary = renderer_.develop();
+  }
   report.work = renderer_.work();
   report.seconds = state_.seconds;
   return report;

@@ -7,6 +7,7 @@
 #include "app/driver.h"
 #include "app/outputs.h"
 #include "app/progress.h"
+#include "dist/mpi_exchange.h"
 #include "estimator/channels.h"
 #include "gltf/gltf_loader.h"
 #include "io/image_io.h"
@@ -34,10 +35,19 @@
 namespace {
 
 std::atomic<bool> g_stop{false};
+// The MPI session (dist/): one process unless started by mpirun with several ranks.
+pb::MpiSession* g_mpi = nullptr;
 
-// First Ctrl-C (or SIGTERM, SIGHUP): discard the pass in progress (Driver::run) and write the
-// image and state of the last whole one. Second: leave at once,
-// removing the temporary files being written and the lock files first (file_io.h's registry).
+// "photonbound: error: " or, in a distributed render, which rank failed.
+std::string error_prefix() {
+  if (!g_mpi || !g_mpi->distributed()) return "photonbound: error: ";
+  return "photonbound: error (rank " + std::to_string(g_mpi->rank()) + " of " +
+         std::to_string(g_mpi->ranks()) + "): ";
+}
+
+// First Ctrl-C (or SIGTERM, SIGHUP, SIGUSR1): discard the pass in progress (Driver::run) and write
+// the image and state of the last whole one. Second: leave at once, removing the temporary files
+// being written and the lock files first (file_io.h's registry).
 extern "C" void on_signal(int sig) {
   if (g_stop.exchange(true)) {
     pb::unlink_registered_files();
@@ -98,14 +108,18 @@ void print_lines(const std::vector<std::string>& lines) {
 
 // The scene, completed for rendering (its warnings and notes printed); with `saved`, checked to
 // be the scene and options that render was made with.
-pb::Scene load_scene(const pb::RenderOptions& options, const pb::SavedRender* saved) {
+// `quiet`: a distributed render's other ranks, whose warnings rank 0 has printed.
+pb::Scene load_scene(const pb::RenderOptions& options, const pb::SavedRender* saved,
+                     bool quiet = false) {
   pb::Scene scene = pb::load_gltf(
       options.scene, pb::LoadPolicy{options.asset_dirs, pb::memory_budget(options),
                                     options.texture_formats == pb::TextureFormats::Any});
-  for (const std::string& w : scene.warnings)
-    std::cerr << "photonbound: warning: " << options.scene << ": " << w << "\n";
-  for (const std::string& n : pb::complete_scene(scene, options))
-    std::cerr << "photonbound: note: " << n << "\n";
+  const std::vector<std::string> notes = pb::complete_scene(scene, options);
+  if (!quiet) {
+    for (const std::string& w : scene.warnings)
+      std::cerr << "photonbound: warning: " << options.scene << ": " << w << "\n";
+    for (const std::string& n : notes) std::cerr << "photonbound: note: " << n << "\n";
+  }
   if (saved) {
     const std::vector<std::string> diff = pb::differences(*saved, options, scene.content_hash);
     if (!diff.empty()) {
@@ -164,12 +178,14 @@ struct Observers {
 
 std::string start_line(const pb::RenderOptions& options, const pb::Renderer& renderer, int threads,
                        bool resumed) {
+  const pb::Exchange* exchange = renderer.exchange();
   std::ostringstream line;
   line << "photonbound: "
        << (options.method == pb::Method::PPM
                ? std::to_string(renderer.camera_pass().points.size()) + " visible points"
                : std::to_string(renderer.states().size()) + " pixels (SPPM)")
        << ", " << threads << (threads == 1 ? " thread" : " threads")
+       << (exchange ? " on each of " + std::to_string(exchange->ranks()) + " MPI ranks" : "")
        << (resumed ? ", resumed" : "");
   return line.str();
 }
@@ -185,18 +201,49 @@ void finish_render(const pb::RenderOptions& options, const pb::Renderer& rendere
                                      report.work.passes));
   if (keep_state || report.stop == pb::StopReason::Interrupted)
     pb::save_state(state_path, {options, scene_hash, renderer.snapshot(), schedule});
+  const pb::Exchange* ex = renderer.exchange();
+  if (ex && options.progress != pb::ProgressMode::Never && report.work.passes > 0) {
+    const double passes = double(report.work.passes);
+    std::cerr << "photonbound: " << ex->ranks() << " MPI ranks; per pass, rank 0 received "
+              << double(ex->hits.bytes) / passes / 1e6 << " MB of photon hits in "
+              << 1e3 * ex->hits.seconds / passes << " ms and "
+              << double(ex->states.bytes) / passes / 1e6 << " MB of radii and states in "
+              << 1e3 * ex->states.seconds / passes << " ms (waits for slower ranks included)\n";
+  }
   if (options.progress != pb::ProgressMode::Never)
     std::cerr << "photonbound: stopped (" << pb::stop_text(report.stop) << ") after "
               << report.work.passes << " passes, " << report.seconds << " s; "
               << pb::stop_figures(options, report.summary) << "; wrote " << options.output << "\n";
 }
 
+// A distributed render's rank other than 0: the same scene and state, its share of every pass
+// as rank 0 commands; no output, no lock, no line printed (rank 0 does all of that).
+int follow(const pb::RenderOptions& options, const pb::SavedRender* saved, pb::Exchange& exchange) {
+  pb::check_render_memory(options, nullptr);
+  pb::Scene scene = load_scene(options, saved, true);
+  pb::check_render_memory(options, &scene);
+  pb::ThreadLimit threads(options.threads);
+  pb::Renderer renderer(std::move(scene), options);
+  if (saved) renderer.restore(saved->render);
+  renderer.distribute(&exchange);
+  renderer.follow();
+  return 0;
+}
+
 // Renders `options`; with `saved`, continues that render (already checked to match).
 int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
+  const std::unique_ptr<pb::Exchange> exchange = g_mpi->exchange();
+  // mpirun forwards SIGUSR1 to every rank (not Ctrl-C, on which it kills them all after 1 s):
+  // rank 0 takes it as a Ctrl-C, the others leave the decision to rank 0.
+  if (exchange && exchange->rank() != 0) {
+    std::signal(SIGUSR1, SIG_IGN);
+    return follow(options, saved, *exchange);
+  }
   // Installed first: a Ctrl-C while the scene loads still ends with an image and a state.
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   std::signal(SIGHUP, on_signal);  // a closed terminal: the same, not a death with nothing written
+  std::signal(SIGUSR1, on_signal);
   const bool keep_state = options.checkpoint_every || !options.state_path.empty();
   const std::string state_path = pb::state_path_for(options);
   // Fail before hours of rendering, not after; and never write over an input.
@@ -217,6 +264,7 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   pb::ThreadLimit threads(options.threads);
   pb::Renderer renderer(std::move(scene), options);
   if (saved) renderer.restore(saved->render);
+  renderer.distribute(exchange.get());
   print_lines(pb::preflight_diagnostics(options, renderer));
   check_reference_size(options, reference, renderer);
 
@@ -227,6 +275,7 @@ int render(const pb::RenderOptions& options, const pb::SavedRender* saved) {
   pb::Driver driver(renderer, saved ? saved->schedule : pb::DriverState{});
   const pb::RenderReport report = driver.run(&g_stop, observers.list);
   finish_render(options, renderer, report, driver.state(), scene_hash, keep_state, state_path);
+  renderer.release_followers();
   return 0;
 }
 
@@ -285,9 +334,7 @@ int preview(const pb::PreviewOptions& o) {
   return 0;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int run(int argc, char** argv) {
   try {
     const pb::Command cmd = pb::parse_command_line(argc, argv);
     switch (cmd.kind) {
@@ -297,9 +344,13 @@ int main(int argc, char** argv) {
       case pb::Command::Kind::HelpTable:
         std::cout << pb::markdown_option_table();
         return 0;
-      case pb::Command::Kind::Version:
-        std::cout << "photonbound " << PHOTONBOUND_VERSION << "\n";
+      case pb::Command::Kind::Version: {
+        const std::string mpi = pb::mpi_library_version();
+        std::cout << "photonbound " << PHOTONBOUND_VERSION << "\n"
+                  << (mpi.empty() ? "built without MPI: renders run in one process\n"
+                                  : "distributed renders with mpirun (" + mpi + ")\n");
         return 0;
+      }
       case pb::Command::Kind::Render:
         return render(cmd.render);
       case pb::Command::Kind::Resume:
@@ -310,16 +361,35 @@ int main(int argc, char** argv) {
         return preview(cmd.preview);
     }
   } catch (const pb::UsageError& e) {
-    std::cerr << "photonbound: " << e.what() << "\n";
+    // Every rank parses the same command line: one message is enough.
+    if (!g_mpi->distributed() || g_mpi->rank() == 0)
+      std::cerr << "photonbound: " << e.what() << "\n";
     return 2;
   } catch (const std::bad_alloc&) {
     // What the up-front estimates (render_memory.h) did not foresee.
-    std::cerr << "photonbound: error: out of memory (an allocation failed); lower --resolution "
+    std::cerr << error_prefix()
+              << "out of memory (an allocation failed); lower --resolution "
                  "or --photons-per-pass, or use smaller textures\n";
     return 1;
   } catch (const std::exception& e) {
-    std::cerr << "photonbound: error: " << e.what() << "\n";
+    std::cerr << error_prefix() << e.what() << "\n";
     return 1;
   }
   return 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  try {
+    pb::MpiSession mpi(argc, argv);
+    g_mpi = &mpi;
+    const int code = run(argc, argv);
+    // One rank's failure ends every rank (none waits in a collective for it).
+    if (code != 0 && mpi.distributed()) mpi.abort(code);
+    return code;
+  } catch (const std::exception& e) {  // MPI failed to start
+    std::cerr << "photonbound: error: " << e.what() << "\n";
+    return 1;
+  }
 }

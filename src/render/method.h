@@ -49,6 +49,13 @@ struct RenderState {
   std::vector<float> path_history;
 };
 
+// One array of the method's side state with an item per state (a distributed render brings
+// the items of every rank's states to rank 0, renderer.h collect()).
+struct SideArray {
+  void* data = nullptr;
+  size_t item_bytes = 0;
+};
+
 class PhotonMethod {
  public:
   virtual ~PhotonMethod() = default;
@@ -70,6 +77,8 @@ class PhotonMethod {
   // The method's side state into a snapshot, and back (StateError when it does not fit).
   virtual void save(RenderState& s) const = 0;
   virtual void restore(const RenderState& s) = 0;
+  // The side state's per-state arrays (none by default).
+  virtual std::vector<SideArray> side_arrays() { return {}; }
   // Which of `states` make up each pixel (estimator/film.h), with the method's side state of a
   // snapshot (`saved`) or, without one, its current side state. The renderer adds the photon
   // cap and the footprint, which do not depend on the method.

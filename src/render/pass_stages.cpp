@@ -231,10 +231,15 @@ void fold_pass(std::span<PointState> states, std::span<const PassSums> sums,
   if (copy) store_fence();  // the streamed stores are visible before the writer reads them
 }
 
+bool Share::owns(size_t first_state) const {
+  return ranks <= 1 || (first_state / kStageChunk) % size_t(ranks) == size_t(rank);
+}
+
 void fold_block(size_t first, std::span<PointState> states, std::span<const PassSums> sums,
                 std::span<const OwnerValues> owner, const EstimatorParams& params, uint64_t pass,
-                std::span<float> radii, PointState* copy) {
+                std::span<float> radii, PointState* copy, Share share) {
   for_each_chunk(sums.size(), [&](size_t b, size_t m) {
+    if (!share.owns(first + b)) return;
     fold_pass(states.subspan(first + b, m), sums.subspan(b, m), owner.subspan(b, m), params, pass,
               radii.subspan(first + b, m), copy ? copy + first + b : nullptr);
   });

@@ -7,8 +7,9 @@
 //   3. gather                 gather_pass: photons within each radius  -> PassSums (phi, lap, M)
 //   4. owner values           disc_pass (PPM), next_event_pass         -> OwnerValues (D, disc)
 //   5. fold                   fold_pass: sums and values into states   -> states, radii
-// Stage 3 runs on any set of photon hits, and its PassSums (estimator.h) add over disjoint sets:
-// a pass split across machines reduces a block's PassSums array between 4 and 5.
+// Stage 3 runs on any set of photon hits, and its PassSums (estimator.h) add over disjoint sets.
+// A pass split across processes (exchange.h) shares stage 1 by photon range and stages 0 and
+// 3-5 by chunks of states (Share), each rank gathering from every rank's hits.
 #pragma once
 
 #include "estimator/estimator.h"
@@ -32,6 +33,15 @@ namespace pb {
 // The float radius a point with squared radius r2 queries the grid with. The grid is built for
 // these same values (Renderer keeps one per point), so both must come from here.
 inline float search_radius(double r2) { return float(std::sqrt(r2)); }
+
+// Which chunks of kStageChunk states (counted from state 0) this process computes in a
+// distributed render (render/exchange.h): chunk c belongs to rank c mod ranks, so that every
+// rank gets a share of every region of the image (a block of sky costs a tenth of a block of
+// glass). One process owns every chunk.
+struct Share {
+  int rank = 0, ranks = 1;
+  bool owns(size_t first_state) const;
+};
 
 // Stage 2: the grid over the hits' positions for queries of the given radii. `positions` is
 // scratch, reused across passes.
@@ -117,9 +127,10 @@ void fold_pass(std::span<PointState> states, std::span<const PassSums> sums,
 // Stage 5 over a fold block: the block [first, first + sums.size()) of the states, from the
 // block's sums and owner values (indexed from 0), in parallel by chunks; `copy` (sized to all
 // states) or null.
+// Only the chunks `share` owns are folded.
 void fold_block(size_t first, std::span<PointState> states, std::span<const PassSums> sums,
                 std::span<const OwnerValues> owner, const EstimatorParams& params, uint64_t pass,
-                std::span<float> radii, PointState* copy);
+                std::span<float> radii, PointState* copy, Share share = {});
 
 // Points per fold block: the pass sums of a block are gathered (stages 3-4) into one array,
 // then folded (stage 5). 16384 points keep the block's sums and owner values (2.4 MB) and states
@@ -139,10 +150,12 @@ struct PassInputs {
   uint64_t seed = 0, pass = 0;
   bool next_event = true;
   const Cutoff* cutoff = nullptr;
-  GuideInputs guide;  // tally set: this pass learns the photon guide
+  GuideInputs guide{};  // tally set: this pass learns the photon guide
   // Photon-pass rays per emitted photon over the passes before this one (--adaptive paths
   // prices a camera path against them, path_allocation.h).
   double rays_per_photon = 2.0;
+  // The chunks of states this process computes (the others are other ranks').
+  Share share{};
   // Whether a chunk of the fold block starting at `first` should give up: only the first block
   // can (the later ones come after a fold).
   bool cut(size_t first) const { return first == 0 && cutoff && cutoff->reached(); }

@@ -109,9 +109,9 @@ void PhotonTracer::trace(uint64_t seed, uint64_t pass, uint64_t index, const Emi
 
 PhotonPassStats PhotonTracer::run(uint64_t seed, uint64_t pass, uint64_t first, uint64_t last,
                                   std::vector<PhotonHit>& hits, const Cutoff* cutoff,
-                                  const EmissionGuide* guide) {
+                                  const EmissionGuide* guide, const Combine* combine) {
   const uint64_t count = last > first ? last - first : 0;
-  const size_t chunks = size_t((count + kChunk - 1) / kChunk);
+  size_t chunks = size_t((count + kChunk - 1) / kChunk);
   if (chunk_hits_.size() < chunks) chunk_hits_.resize(chunks);
   chunk_bounds_.resize(chunks);
   chunk_max_.resize(chunks);
@@ -141,6 +141,7 @@ PhotonPassStats PhotonTracer::run(uint64_t seed, uint64_t pass, uint64_t first, 
     stats.cut = true;
     return stats;
   }
+  if (combine) chunks = combine_chunks(chunks, *combine);
   chunk_offset_.assign(chunks + 1, 0);
   for (size_t k = 0; k < chunks; ++k)
     chunk_offset_[k + 1] = chunk_offset_[k] + chunk_hits_[k].size();
@@ -153,6 +154,35 @@ PhotonPassStats PhotonTracer::run(uint64_t seed, uint64_t pass, uint64_t first, 
   stats.paths = count;
   for (size_t k = 0; k < chunks; ++k) stats.max_flux = std::max(stats.max_flux, chunk_max_[k]);
   return stats;
+}
+
+size_t PhotonTracer::combine_chunks(size_t chunks, const Combine& combine) {
+  std::vector<PhotonHit>& all = combined_;
+  all.clear();
+  for (size_t k = 0; k < chunks; ++k)
+    all.insert(all.end(), chunk_hits_[k].begin(), chunk_hits_[k].end());
+  combine(all);
+  // Back into chunks of kChunk hits, so that ordering them runs in parallel as before.
+  const size_t n = (all.size() + kChunk - 1) / kChunk;
+  if (chunk_hits_.size() < n) chunk_hits_.resize(n);
+  chunk_bounds_.resize(n);
+  chunk_max_.resize(n);
+  parallel_for(n, 1, [&](size_t b, size_t e) {
+    for (size_t k = b; k < e; ++k) {
+      const auto from = all.begin() + ptrdiff_t(k * kChunk);
+      const auto to = all.begin() + ptrdiff_t(std::min(all.size(), (k + 1) * kChunk));
+      chunk_hits_[k].assign(from, to);
+      Bounds bounds;
+      float max_flux = 0.0f;
+      for (const PhotonHit& h : chunk_hits_[k]) {
+        bounds.extend(h.position);
+        max_flux = std::max(max_flux, max_component(h.flux));
+      }
+      chunk_bounds_[k] = bounds;
+      chunk_max_[k] = max_flux;
+    }
+  });
+  return n;
 }
 
 void PhotonTracer::order_hits(std::vector<PhotonHit>& hits) {

@@ -9,6 +9,7 @@
 #include "world/world.h"
 
 #include <cstdint>
+#include <functional>
 #include <vector>
 
 namespace pb {
@@ -46,9 +47,14 @@ class PhotonTracer {
   // With a cutoff, each batch of kChunk photons first polls it; once it is reached the run
   // stops early and returns with `cut` set (the caller discards the pass).
   // With a `guide`, photons are emitted from it (photon_guide.h) and each hit records its cell.
+  // With `combine` (a distributed render, exchange.h), the range's hits are handed to it in
+  // photon order before they are ordered, and it returns the whole pass's in photon order: the
+  // hits ordered are then those of the whole pass, in the same order as one process's, and
+  // max_flux is theirs (rays and paths stay the range's).
+  using Combine = std::function<void(std::vector<PhotonHit>&)>;
   PhotonPassStats run(uint64_t seed, uint64_t pass, uint64_t first, uint64_t last,
                       std::vector<PhotonHit>& hits, const Cutoff* cutoff = nullptr,
-                      const EmissionGuide* guide = nullptr);
+                      const EmissionGuide* guide = nullptr, const Combine* combine = nullptr);
 
   // Photons per batch: large enough to amortise scheduling, small enough to balance 2 cores.
   static constexpr size_t kChunk = 2048;
@@ -62,6 +68,9 @@ class PhotonTracer {
 
   // Sorts the chunks' hits into `hits` (see run()).
   void order_hits(std::vector<PhotonHit>& hits);
+  // Replaces the chunks' hits by what `combine` makes of them (see run()); returns their
+  // chunk count.
+  size_t combine_chunks(size_t chunks, const Combine& combine);
 
   const World& world_;
   bool deposit_first_hit_;
@@ -73,6 +82,7 @@ class PhotonTracer {
   std::vector<uint32_t> chunk_of_;             // chunk of each global hit index
   std::vector<uint64_t> keys_, keys_scratch_;  // Morton code << 32 | global hit index
   std::vector<uint32_t> histogram_;
+  std::vector<PhotonHit> combined_;  // a distributed pass's hits, before ordering
 };
 
 }  // namespace pb

@@ -46,6 +46,7 @@ bool ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
         return;
       }
       const size_t at = first + b;
+      if (!in.share.owns(at)) return;  // another rank's
       const std::span<const VisiblePoint> pts = points.subspan(at, m);
       const std::span<const PointState> st = std::span<const PointState>(states).subspan(at, m);
       const PointBsdfTable table{glossy, at};
@@ -61,9 +62,9 @@ bool ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
     });
     if (cut.load()) return false;  // the first block: nothing folded yet
     if (in.guide.tally) in.guide.tally->reduce_block((count + kStageChunk - 1) / kStageChunk);
-    // A distributed render reduces sums[0, count) across machines here.
     fold_block(first, states, std::span<const PassSums>(sums).first(count),
-               std::span<const OwnerValues>(owner).first(count), in.params, in.pass, radii, copy);
+               std::span<const OwnerValues>(owner).first(count), in.params, in.pass, radii, copy,
+               in.share);
   }
   return true;
 }

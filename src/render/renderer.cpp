@@ -99,12 +99,64 @@ FilmSettings Renderer::film_settings() const {
   return s;
 }
 
+void Renderer::distribute(Exchange* exchange) {
+  if (exchange && exchange->ranks() > 1) {
+    if (options_.adaptive_photons || options_.adaptive_paths)
+      throw std::invalid_argument(
+          "--adaptive photons and --adaptive paths do not run distributed yet (they need every "
+          "state on every rank); run them in one process, or without mpirun");
+    exchange_ = exchange;
+  } else {
+    exchange_ = nullptr;
+  }
+}
+
+void Renderer::collect() {
+  if (!exchange_ || collected_ == work_.passes) return;
+  if (exchange_->rank() == 0) exchange_->command(FollowerCommand::Collect);
+  exchange_->share_owned(states_.data(), sizeof(PointState), states_.size(), false);
+  for (const SideArray& a : method_->side_arrays())
+    exchange_->share_owned(a.data, a.item_bytes, states_.size(), false);
+  collected_ = work_.passes;
+}
+
+void Renderer::follow() {
+  while (true) {
+    switch (exchange_->command(FollowerCommand::End)) {
+      case FollowerCommand::Pass:
+        step();
+        break;
+      case FollowerCommand::Collect:
+        collect();
+        break;
+      case FollowerCommand::End:
+        return;
+    }
+  }
+}
+
+void Renderer::release_followers() {
+  if (exchange_ && exchange_->rank() == 0) exchange_->command(FollowerCommand::End);
+}
+
 bool Renderer::step(std::vector<PointState>* copy, const Cutoff* cutoff) {
   const uint64_t pass = work_.passes + 1;
   auto t = Clock::now();
   const EmissionGuide* guide = guide_ ? &*guide_ : nullptr;
-  const PhotonPassStats stats =
-      tracer_.run(options_.seed, pass, 0, options_.photons_per_pass, hits_, cutoff, guide);
+  uint64_t first = 0, last = options_.photons_per_pass;
+  PhotonTracer::Combine combine;
+  if (exchange_) {
+    if (exchange_->rank() == 0) exchange_->command(FollowerCommand::Pass);
+    cutoff = nullptr;  // the ranks could not agree where a pass was cut
+    exchange_->photon_range(options_.photons_per_pass, first, last);
+    combine = [this](std::vector<PhotonHit>& hits) { exchange_->all_hits(hits); };
+  }
+  PhotonPassStats stats = tracer_.run(options_.seed, pass, first, last, hits_, cutoff, guide,
+                                      exchange_ ? &combine : nullptr);
+  if (exchange_) {
+    stats.rays = exchange_->sum(stats.rays);
+    stats.paths = exchange_->sum(stats.paths);
+  }
   timings_.trace += seconds_since(t);
   if (stats.cut) return false;
 
@@ -122,18 +174,24 @@ bool Renderer::step(std::vector<PointState>* copy, const Cutoff* cutoff) {
       tally_.begin_pass(guide_->cells(), (kFoldBlock + kStageChunk - 1) / kStageChunk);
       learn = {&tally_, work_.passes, double(options_.photons_per_pass)};
     }
-    const PassInputs in{world_,
-                        grid_,
-                        hits_,
-                        params_,
-                        boundary_on_ ? &boundary_ : nullptr,
-                        options_.seed,
-                        pass,
-                        options_.direct == DirectMode::NextEvent,
-                        cutoff,
-                        learn,
-                        work_.photons > 0 ? double(work_.rays) / double(work_.photons) : 2.0};
-    const bool whole = method_->step(in, states_, radii_, copy ? copy->data() : nullptr);
+    PassInputs in{world_,
+                  grid_,
+                  hits_,
+                  params_,
+                  boundary_on_ ? &boundary_ : nullptr,
+                  options_.seed,
+                  pass,
+                  options_.direct == DirectMode::NextEvent,
+                  cutoff,
+                  learn,
+                  work_.photons > 0 ? double(work_.rays) / double(work_.photons) : 2.0,
+                  Share{}};
+    if (exchange_) in.share = Share{exchange_->rank(), exchange_->ranks()};
+    // A distributed pass copies after collecting (below): the copy needs every rank's states.
+    const bool whole =
+        method_->step(in, states_, radii_, copy && !exchange_ ? copy->data() : nullptr);
+    // Every rank builds the next grid for every state's radius.
+    if (exchange_) exchange_->share_owned(radii_.data(), sizeof(float), radii_.size(), true);
     timings_.gather += seconds_since(t);
     if (!whole) return false;
   }
@@ -142,6 +200,10 @@ bool Renderer::step(std::vector<PointState>* copy, const Cutoff* cutoff) {
   work_.rays += stats.rays;
   work_.photons += stats.paths;
   max_photon_power_ = std::max(max_photon_power_, double(stats.max_flux));
+  if (exchange_ && copy && exchange_->rank() == 0) {
+    collect();
+    *copy = states_;
+  }
   if (guide_ && n > 0) {
     // The next pass's photons come from what this one learnt: their largest power is the
     // lights' times the guide's largest weight (the sparse-photon bound's Phi_max, section 12).
@@ -187,6 +249,7 @@ void Renderer::restore(const RenderState& saved) {
   for (size_t k = 0; k < states_.size(); ++k) radii_[k] = search_radius(states_[k].r2);
   work_ = saved.work;
   initial_radius_ = saved.initial_radius;
+  collected_ = work_.passes;  // every rank restored the same states
 }
 
 PixelLayout Renderer::layout(const std::vector<PointState>& states, const RenderState* saved,

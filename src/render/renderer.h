@@ -11,6 +11,7 @@
 #include "options/options.h"
 #include "render/camera_choice.h"
 #include "render/camera_pass.h"
+#include "render/exchange.h"
 #include "render/hash_grid.h"
 #include "render/method.h"
 #include "render/photon_pass.h"
@@ -63,6 +64,23 @@ class Renderer {
   bool step(std::vector<PointState>* copy = nullptr, const Cutoff* cutoff = nullptr);
   uint64_t passes() const { return work_.passes; }
   const WorkCounters& work() const { return work_; }
+
+  // A render split over processes (exchange.h): from now on this process traces its share of
+  // every pass's photons and computes the states it owns. Every rank calls step() for every
+  // pass: rank 0 through the driver, the others through follow(). A cutoff then never cuts a
+  // pass (the ranks could not agree where): passes end whole, and the driver stops between
+  // them. Throws std::invalid_argument for what does not run distributed yet (--adaptive
+  // photons and paths need every state on every rank).
+  void distribute(Exchange* exchange);
+  // Rank 0: brings every state and the method's side state to this process from the ranks
+  // that computed them, once per pass (a no-op in one process and after the first call).
+  // Called before anything reads the states: develop, snapshot, image.
+  void collect();
+  // The other ranks: runs passes and collects as rank 0 commands, until it ends the render.
+  void follow();
+  // Rank 0: tells the others the render is over (at the end, or never if an error ends it).
+  void release_followers();
+  const Exchange* exchange() const { return exchange_; }
 
   // The state and the way back. restore() throws StateError when the state does not fit this
   // scene and camera. snapshot(states) is the state with `states` in place of the current ones
@@ -127,6 +145,8 @@ class Renderer {
   WorkCounters work_;
   double initial_radius_ = 0.0;
   PhaseTimings timings_;
+  Exchange* exchange_ = nullptr;  // distributed: the other ranks; null in one process
+  uint64_t collected_ = 0;        // the pass whose states rank 0 last collected
 };
 
 }  // namespace pb

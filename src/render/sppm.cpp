@@ -71,6 +71,7 @@ bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
         return;
       }
       const size_t at = first + b;
+      if (!in.share.owns(at)) return;  // another rank's pixels
       const std::span<VisiblePoint> pts = std::span(points_).subspan(b, m);
       const std::span<OwnerValues> own = std::span(owner_).subspan(b, m);
       const std::span<PointBsdf> scratch = std::span(glossy_).subspan(b, m);
@@ -90,6 +91,7 @@ bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
     if (in.guide.tally) in.guide.tally->reduce_block((count + kStageChunk - 1) / kStageChunk);
     // The pixels' side state, once the pass is known to go on (a chunk writes its own pixels).
     for_each_chunk(count, [&](size_t b, size_t m) {
+      if (!in.share.owns(first + b)) return;
       if (settings_.adaptive_paths)
         for (size_t k = b; k < b + m; ++k) {
           const size_t pixel = first + k;
@@ -109,9 +111,9 @@ bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
                      std::span(glossy_).subspan(b, glossy_count_[b / kStageChunk]),
                      std::span<const PointState>(states).subspan(first + b, m), extra);
     });
-    // A distributed render reduces sums_[0, count) across machines here.
     fold_block(first, states, std::span<const PassSums>(sums_).first(count),
-               std::span<const OwnerValues>(owner_).first(count), in.params, in.pass, radii, copy);
+               std::span<const OwnerValues>(owner_).first(count), in.params, in.pass, radii, copy,
+               in.share);
   }
   return true;
 }

@@ -29,6 +29,11 @@ class SppmMethod final : public PhotonMethod {
             PointState* copy) override;
   void save(RenderState& s) const override;
   void restore(const RenderState& s) override;
+  std::vector<SideArray> side_arrays() override {
+    return {{visible_.data(), sizeof(uint32_t)},
+            {min_mass_.data(), sizeof(float)},
+            {glossy_f_.data(), sizeof(float)}};
+  }
   PixelLayout layout(const std::vector<PointState>& states,
                      const RenderState* saved) const override;
 
