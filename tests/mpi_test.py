@@ -31,10 +31,13 @@ import time
 
 import OpenImageIO as oiio
 
-# mpirun as root (CI containers) and without the kernel's cross-memory attach (containers
-# forbid ptrace), so that ranks on one node talk through plain shared memory.
+# mpirun as root (CI containers), without the kernel's cross-memory attach (containers forbid
+# ptrace), so that ranks on one node talk through plain shared memory, and started by the
+# "isolated" launcher: every rank on this node, with no ssh needed (a fresh machine has none,
+# and mpirun's default launcher refuses to start without it even for local ranks).
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-           OMPI_MCA_btl_vader_single_copy_mechanism="none", OMPI_MCA_rmaps_base_oversubscribe="1")
+           OMPI_MCA_btl_vader_single_copy_mechanism="none", OMPI_MCA_plm="isolated",
+           OMPI_MCA_rmaps_base_oversubscribe="1")
 
 
 def pixels(path):
