@@ -11,9 +11,11 @@ imported.
                                              and references and renders have the channels of
                                              src/estimator/channels.def; then the Cornell
                                              sweep, whose shipped reference must be 10x below
-                                             its smallest actual error; then the glTF reader
-                                             (tools.gltf_scene) on .gltf, .glb, external
-                                             buffers, a node hierarchy and interleaved data
+                                             its smallest actual error; tools.claim_check's row
+                                             against the same renders and compare; then the
+                                             glTF reader (tools.gltf_scene) on .gltf, .glb,
+                                             external buffers, a node hierarchy and
+                                             interleaved data
   tools_test.py bad-input --photonbound EXE  missing files, wrong channels, bad options and
                                              unreadable glTF end with one line on stderr and a
                                              non-zero exit
@@ -137,9 +139,41 @@ def smoke(exe, tmp):
     check(not leftovers, f"temporary files left behind: {leftovers}")
     cornell_reference_margin(exe, tmp)
     adaptive_study(exe, tmp)
+    claim_check(exe, tmp)
     mitsuba_translation(tmp)
     cycles_reading(exe, tmp)
     gltf_reading(tmp)
+
+
+def claim_check(exe, tmp):
+    """tools.claim_check on the plane under a point light (16x16, a loose target, a longer render of 3x): its row
+    agrees with `photonbound compare` of the same two renders redone, and its verdict with its
+    own figures (the renders are deterministic: same seeds, same images)."""
+    scene = os.path.join(REPO, "scenes", "plane_point.gltf")
+    rows_json = os.path.join(tmp, "claims.json")
+    p = run_tool("claim_check", scene, "--target", "0.05", "--resolution", "16x16", "--factor",
+                 "3", "--photonbound", exe, "--json", rows_json)
+    check(p.returncode == 0, f"tools.claim_check: {p.stderr.strip()}")
+    if p.returncode != 0:
+        return
+    (row,) = json.load(open(rows_json))
+    a, b = os.path.join(tmp, "cc_stop.exr"), os.path.join(tmp, "cc_long.exr")
+    base = [exe, "render", scene, "--resolution", "16x16", "--progress"]
+    subprocess.run(base + ["-o", a, "--target-error", "0.05", "--time", "60", "--seed", "1"],
+                   check=True, capture_output=True)
+    subprocess.run(base + ["-o", b, "--passes", str(3 * row["passes"]), "--time", "150", "--seed",
+                           "2"], check=True, capture_output=True)
+    c = json.loads(subprocess.run([exe, "compare", a, b, "--json"], check=True,
+                                  capture_output=True, text=True).stdout)
+    check(row["mae"] == c["mean_abs_error"],
+          f"tools.claim_check: mae {row['mae']} but compare says {c['mean_abs_error']}")
+    own = 0.75 * row["long_claim"]
+    want = math.sqrt(max(0.0, row["mae"] ** 2 - own ** 2))
+    check(abs(row["actual"] - want) <= 1e-12 * max(1.0, want),
+          f"tools.claim_check: actual {row['actual']}, expected {want}")
+    verdict = ("cut" if row["stop"] != "target-error"
+               else "within" if row["actual"] <= row["claim"] else "exceeded")
+    check(row["verdict"] == verdict, f"tools.claim_check: verdict {row['verdict']}, not {verdict}")
 
 
 def adaptive_study(exe, tmp):
