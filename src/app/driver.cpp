@@ -86,10 +86,14 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
   RenderReport report;
   bool developed = false;
   double develop_seconds = 0.0;  // this pass's develop
-  auto develop = [&] {
+  // `last`: the stop is known and no pass follows, so the image is developed too (the closing
+  // write then does not develop the same states again: a development of the default scene costs
+  // about a pass).
+  auto develop = [&](bool last = false) {
     const auto start = Clock::now();
     renderer_.collect();  // a distributed render: every rank's states, here
-    report.summary = renderer_.develop();
+    if (last) report.film.emplace();
+    report.summary = renderer_.develop(last ? &*report.film : nullptr);
     developed = true;
     develop_seconds = seconds_since(start);
   };
@@ -115,7 +119,7 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
       // The render is the last whole pass's: its summary, told again with the stop (observers
       // do not repeat a pass they have written).
       report.stop = interrupt && interrupt->load() ? StopReason::Interrupted : StopReason::Time;
-      develop();
+      develop(true);
       const PassInfo info{renderer_, state_,         pass,        run_seconds,
                           true,      report.summary, report.stop, develop_seconds};
       for (PassObserver* obs : observers) obs->after_pass(info);
@@ -158,16 +162,13 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
     if (check && report.summary.model_refuted) report.stop = StopReason::ModelRefuted;
     if (interrupt && interrupt->load()) report.stop = StopReason::Interrupted;
 
-    if (report.stop != StopReason::None && !developed) develop();
+    if (report.stop != StopReason::None && !developed) develop(true);
     const PassInfo info{renderer_, state_,         pass,        run_seconds,
                         developed, report.summary, report.stop, develop_seconds};
     for (PassObserver* obs : observers) obs->after_pass(info);
   }
   for (PassObserver* obs : observers) obs->finish();
-  if (!developed) {
-    renderer_.collect();
-    report.summary = renderer_.develop();
-  }
+  if (!developed) develop(true);
   report.work = renderer_.work();
   report.seconds = state_.seconds;
   return report;

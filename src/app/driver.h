@@ -9,6 +9,7 @@
 
 #include <atomic>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -70,6 +71,9 @@ struct RenderReport {
   double seconds = 0.0;  // wall clock of all runs
   StopReason stop = StopReason::None;
   FilmSummary summary;
+  // The image of the final states, when they were developed after the stop was known (a stop by
+  // the target is decided on a development without the image: then none).
+  std::optional<FilmImage> film;
   RunInfo run() const { return {seconds, stop_text(stop)}; }
 };
 

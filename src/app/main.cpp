@@ -195,7 +195,9 @@ void finish_render(const pb::RenderOptions& options, const pb::Renderer& rendere
                    const pb::RenderReport& report, const pb::DriverState& schedule,
                    uint64_t scene_hash, bool keep_state, const std::string& state_path) {
   // Ctrl-C keeps the work: the state is written then too.
-  const pb::ExrImage image = renderer.image(report.run());
+  const pb::ExrImage image = report.film
+                                 ? renderer.image(report.run(), *report.film, report.summary)
+                                 : renderer.image(report.run());
   pb::write_exr(options.output, image);
   print_lines(pb::result_diagnostics(options, image, renderer.world().scene(), report.summary,
                                      report.work.passes));

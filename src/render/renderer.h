@@ -100,6 +100,11 @@ class Renderer {
   // The EXR (channels.def) with every option and the run in its metadata.
   ExrImage image(const RunInfo& run) const;
   ExrImage image(const RunInfo& run, const RenderState& state) const;
+  // The EXR of the current states from their development (`film` and `summary`, made by
+  // develop(&film) since the last pass).
+  ExrImage image(const RunInfo& run, const FilmImage& film, const FilmSummary& summary) const {
+    return image(run, film, summary, work_, initial_radius_, states_.size());
+  }
 
   const RenderOptions& options() const { return options_; }
   // PPM: the visible points. SPPM: the image size and the median footprint only.
