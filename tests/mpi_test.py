@@ -23,6 +23,7 @@ import argparse
 import hashlib
 import os
 import re
+import select
 import signal
 import subprocess
 import sys
@@ -31,12 +32,14 @@ import time
 
 import OpenImageIO as oiio
 
-# mpirun as root (CI containers), without the kernel's cross-memory attach (containers forbid
-# ptrace), so that ranks on one node talk through plain shared memory, and started by the
-# "isolated" launcher: every rank on this node, with no ssh needed (a fresh machine has none,
-# and mpirun's default launcher refuses to start without it even for local ranks).
+# mpirun as root (CI containers); ranks on one node over shared memory only (btl self,vader: no
+# network transport to probe), without the kernel's cross-memory attach (containers forbid
+# ptrace) and with the shared-memory files in /tmp (a container's /dev/shm may be 64 MB); started
+# by the "isolated" launcher: every rank on this node, with no ssh needed (a fresh machine has
+# none, and mpirun's default launcher refuses to start without it even for local ranks).
 ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-           OMPI_MCA_btl_vader_single_copy_mechanism="none", OMPI_MCA_plm="isolated",
+           OMPI_MCA_btl="self,vader", OMPI_MCA_btl_vader_single_copy_mechanism="none",
+           OMPI_MCA_btl_vader_backing_directory="/tmp", OMPI_MCA_plm="isolated",
            OMPI_MCA_rmaps_base_oversubscribe="1")
 
 
@@ -126,10 +129,26 @@ def resume(r):
     print("resume: 4 passes on 2 ranks + 4 on 3 ranks = 8 passes in one process")
 
 
-def rank_pid(rank):
-    """The pid of the running photonbound of this MPI rank (from its environment)."""
+def descends_from(pid, ancestor):
+    """Whether process `pid` is `ancestor` or below it."""
+    for _ in range(16):
+        if pid == ancestor:
+            return True
+        try:
+            with open(f"/proc/{pid}/stat") as f:
+                pid = int(f.read().rsplit(")", 1)[1].split()[1])
+        except (OSError, ValueError, IndexError):
+            return False
+        if pid <= 1:
+            return False
+    return False
+
+
+def rank_pid(rank, mpirun):
+    """The pid of the running photonbound of this MPI rank under the mpirun process `mpirun`
+    (from its environment; other tests' ranks may be running too)."""
     for pid in os.listdir("/proc"):
-        if not pid.isdigit():
+        if not pid.isdigit() or not descends_from(int(pid), mpirun):
             continue
         try:
             with open(f"/proc/{pid}/cmdline", "rb") as f:
@@ -169,7 +188,7 @@ def failure(r):
     proc = running(r, out, state, ["--checkpoint-every", "0.3", "--quiet"])
     wait_for(state, proc)
     time.sleep(0.5)
-    pid = rank_pid(1)
+    pid = rank_pid(1, proc.pid)
     if pid is None:
         proc.kill()
         sys.exit("rank 1 not found")
@@ -188,13 +207,21 @@ def failure(r):
     # SIGUSR1 to mpirun: rank 0 finishes the pass and writes, as on Ctrl-C in one process.
     out, state = r.path("u.exr"), r.path("u.pbstate")
     proc = running(r, out, state, ["--progress"])
+    # After the first progress line a pass has run, so every rank is past installing its
+    # handler (before it, SIGUSR1's default action would end a rank).
+    seen = []
     deadline = time.time() + 60
-    while rank_pid(1) is None and time.time() < deadline:
-        time.sleep(0.1)
-    time.sleep(1.5)
+    while time.time() < deadline:
+        ready, _, _ = select.select([proc.stderr], [], [], 1.0)
+        line = proc.stderr.readline() if ready else ""
+        if line:
+            seen.append(line)
+        if line.startswith("pass ") or proc.poll() is not None:
+            break
     proc.send_signal(signal.SIGUSR1)
     try:
-        _, err = proc.communicate(timeout=60)
+        _, rest = proc.communicate(timeout=60)
+        err = "".join(seen) + rest
     except subprocess.TimeoutExpired:
         proc.kill()
         sys.exit("SIGUSR1 did not end the run within 60 s")
