@@ -339,6 +339,11 @@ int preview(const pb::PreviewOptions& o) {
 int run(int argc, char** argv) {
   try {
     const pb::Command cmd = pb::parse_command_line(argc, argv);
+    // Under mpirun only render and resume are shared; every other command is rank 0's alone
+    // (one answer, one output file).
+    if (g_mpi->distributed() && g_mpi->rank() != 0 && cmd.kind != pb::Command::Kind::Render &&
+        cmd.kind != pb::Command::Kind::Resume)
+      return 0;
     switch (cmd.kind) {
       case pb::Command::Kind::Help:
         std::cout << pb::usage_text();
