@@ -2,13 +2,12 @@
 // (0 done, 1 runtime failure or bad input file, 2 bad usage).
 #include "app/checkpoint.h"
 #include "app/checkpoint_writer.h"
-#include "app/compare.h"
 #include "app/diagnostics.h"
 #include "app/driver.h"
+#include "app/image_commands.h"
 #include "app/outputs.h"
 #include "app/progress.h"
 #include "dist/mpi_exchange.h"
-#include "estimator/channels.h"
 #include "gltf/gltf_loader.h"
 #include "io/image_io.h"
 #include "options/options.h"
@@ -292,50 +291,6 @@ int resume(const pb::ResumeOptions& r) {
   return render(pb::resumed_options(saved.options, r), &saved);
 }
 
-// compare and preview read whole images: each within a share of the machine's memory.
-pb::ReadLimit machine_share(int images) {
-  return {pb::default_memory_budget() / uint64_t(images),
-          images == 1 ? "3/4 of the machine's memory" : "half of 3/4 of the machine's memory"};
-}
-
-int compare(const pb::CompareOptions& o) {
-  const pb::CompareResult r =
-      pb::compare_images(pb::read_exr(o.render, machine_share(2)),
-                         pb::read_exr(o.reference, machine_share(2)), o.render, o.reference);
-  std::cout << (o.json ? pb::to_json(r) : pb::to_text(r));
-  return 0;
-}
-
-// sRGB-encoded PNG of the radiance channels, for quick looks and the README.
-int preview(const pb::PreviewOptions& o) {
-  pb::check_distinct({{"-o", o.output}}, {{"the input image", o.input}});
-  pb::check_output_path({"-o", o.output});
-  const pb::ExrImage in = pb::read_exr(o.input, machine_share(1));
-  const int r = in.channel_index(pb::channel_name(pb::Channel::Radiance, 0));
-  const int g = in.channel_index(pb::channel_name(pb::Channel::Radiance, 1));
-  const int b = in.channel_index(pb::channel_name(pb::Channel::Radiance, 2));
-  if (r < 0 || g < 0 || b < 0) throw pb::ImageError(o.input + ": has no R, G, B channels");
-  const double scale = std::exp2(o.exposure);
-  const size_t pixels = size_t(in.width) * size_t(in.height), nc = in.channels.size();
-  std::vector<unsigned char> rgb(3 * pixels);
-  std::vector<float> levels(pixels);
-  for (size_t p = 0; p < pixels; ++p) {
-    const int src[3] = {r, g, b};
-    levels[p] = std::max({in.pixels[p * nc + size_t(r)], in.pixels[p * nc + size_t(g)],
-                          in.pixels[p * nc + size_t(b)]});
-    for (int c = 0; c < 3; ++c) {
-      double v = std::clamp(double(in.pixels[p * nc + size_t(src[c])]) * scale, 0.0, 1.0);
-      if (!(v == v)) v = 0.0;
-      v = v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1.0 / 2.4) - 0.055;
-      rgb[3 * p + size_t(c)] = static_cast<unsigned char>(std::lround(255.0 * v));
-    }
-  }
-  pb::write_png(o.output, in.width, in.height, rgb);
-  if (const auto w = pb::exposure_warning(std::move(levels), o.exposure, o.input))
-    std::cerr << *w << "\n";
-  return 0;
-}
-
 int run(int argc, char** argv) {
   try {
     const pb::Command cmd = pb::parse_command_line(argc, argv);
@@ -363,9 +318,9 @@ int run(int argc, char** argv) {
       case pb::Command::Kind::Resume:
         return resume(cmd.resume);
       case pb::Command::Kind::Compare:
-        return compare(cmd.compare);
+        return pb::compare_command(cmd.compare);
       case pb::Command::Kind::Preview:
-        return preview(cmd.preview);
+        return pb::preview_command(cmd.preview);
     }
   } catch (const pb::UsageError& e) {
     // Every rank parses the same command line: one message is enough.

@@ -9,7 +9,6 @@
 
 #include <climits>
 #include <cstdlib>
-#include <cstring>
 #include <stdexcept>
 
 namespace pb {

@@ -174,19 +174,18 @@ bool Renderer::step(std::vector<PointState>* copy, const Cutoff* cutoff) {
       tally_.begin_pass(guide_->cells(), (kFoldBlock + kStageChunk - 1) / kStageChunk);
       learn = {&tally_, work_.passes, double(options_.photons_per_pass)};
     }
-    PassInputs in{world_,
-                  grid_,
-                  hits_,
-                  params_,
-                  boundary_on_ ? &boundary_ : nullptr,
-                  options_.seed,
-                  pass,
-                  options_.direct == DirectMode::NextEvent,
-                  cutoff,
-                  learn,
-                  work_.photons > 0 ? double(work_.rays) / double(work_.photons) : 2.0,
-                  Share{}};
-    if (exchange_) in.share = Share{exchange_->rank(), exchange_->ranks()};
+    const PassInputs in{world_,
+                        grid_,
+                        hits_,
+                        params_,
+                        boundary_on_ ? &boundary_ : nullptr,
+                        options_.seed,
+                        pass,
+                        options_.direct == DirectMode::NextEvent,
+                        cutoff,
+                        learn,
+                        work_.photons > 0 ? double(work_.rays) / double(work_.photons) : 2.0,
+                        exchange_ ? Share{exchange_->rank(), exchange_->ranks()} : Share{}};
     // A distributed pass copies after collecting (below): the copy needs every rank's states.
     const bool whole =
         method_->step(in, states_, radii_, copy && !exchange_ ? copy->data() : nullptr);
