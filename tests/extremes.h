@@ -428,6 +428,7 @@ inline void one_photon_per_pass(uint64_t passes) {
   static_assert(std::is_same_v<decltype(WorkCounters::photons), uint64_t>);
   RenderOptions o = options(test::scene_path("plane_point.gltf"), 4, 1);
   o.passes = passes;
+  o.adaptive_radius = false;  // HOJ08's update itself, checked exactly below
   Render run(o.scene, o);
   const double alpha = o.alpha, floor = run.min_r2();
   const size_t n = run.r->states().size();

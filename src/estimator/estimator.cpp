@@ -123,18 +123,28 @@ void accumulate_pass(PointState& s, const PassSums& g, const OwnerValues& o,
   s.alt_x += sign * x;
   s.alt_r2 += sign * r2_bias;
 
-  // PPM update (section 3, HOJ08): only photons that could contribute shrink the radius.
-  const double applied = ppm_radius_update(s.n, s.r2, g.count, params.alpha, params.min_r2);
+  // PPM update (section 3, HOJ08): only photons that could contribute shrink the radius. With
+  // --adaptive radius the update is the slow schedule's (section 13), the most a radius may keep.
+  const double r2_pass_end = s.r2;
+  const double alpha = params.adaptive_radius ? adaptive_cap_alpha(params.alpha) : params.alpha;
+  const double applied = ppm_radius_update(s.n, s.r2, g.count, alpha, params.min_r2);
   s.tau = (s.tau + phi) * applied;
   s.tau_lap = (s.tau_lap + lap) * applied;
 
   // Section 13: the radius of the next pass is a function of the passes so far, fixed before
   // its photons, so section 3's identity and section 4's samples hold as for the PPM schedule.
-  // It may only be smaller than PPM's (so it shrinks at least at PPM's rate) and by at most
-  // kAdaptiveMaxShrink per pass; N, tau and tauLap follow R^2 as in the PPM update.
+  // It may only be smaller than the slow schedule's (so it shrinks at least at that rate); the
+  // cost rule takes it down to --alpha's schedule where the photons are not the noise, and the
+  // bias rule below that by at most kAdaptiveMaxShrink per pass; N, tau and tauLap follow R^2
+  // as in the PPM update.
   if (params.adaptive_radius) {
+    const double ip = double(pass);
+    const double floor_r2 = r2_pass_end * params.alpha * ip / (params.alpha * (ip - 1.0) + 1.0);
+    const double cost = r2_pass_end * cost_r2_factor(s, pass, params.photons_per_pass);
+    const double base = std::min(s.r2, std::max(floor_r2, cost));
     const double want = preferred_r2(s, pass, params.photons_per_pass);
-    const double r2 = std::max(params.min_r2, std::max(s.r2 * kAdaptiveMaxShrink, want));
+    const double r2 =
+        std::max(params.min_r2, std::max(base * kAdaptiveMaxShrink, std::min(base, want)));
     if (r2 < s.r2) {
       const double f = r2 / s.r2;
       s.r2 = r2;
@@ -143,6 +153,27 @@ void accumulate_pass(PointState& s, const PassSums& g, const OwnerValues& o,
       s.tau_lap *= f;
     }
   }
+}
+
+double cost_r2_factor(const PointState& s, uint64_t passes, double photons_per_pass) {
+  if (passes < 2 || s.photons < kMinPhotonsForBound || !(s.r2 > 0.0) || !(s.mean_r2 > 0.0))
+    return 1.0;
+  const double i = double(passes);
+  // M: the photons a pass brings at the current radius (they scale with the disc's area).
+  const double m = double(s.photons) / i * (s.r2 / s.mean_r2);
+  const dvec3 p = photon_radiance(s, passes, photons_per_pass);
+  // The photon part's variance for M Poisson arrivals of equal power: P^2 E[w^2] / M with
+  // E[w^2] = kWeightSecondMoment for arrivals uniform over the disc. Unequal powers and
+  // densities only add to it, so this is the photons' least share and the rest's most.
+  const double v_photons = glm::dot(p, p) * kernel::kWeightSecondMoment / m;
+  const dvec3 s2 = slope_and_spread(s, i, photons_per_pass).s2;
+  const double v_rest = (s2.x + s2.y + s2.z) - v_photons;
+  if (!(v_rest > 0.0) || !(v_photons > 0.0)) return 1.0;
+  // A pass costs c0 + c1 M at a point, and N passes reach the variance (v_rest + v_photons) /
+  // N with v_photons ~ 1 / M: the time to an error, (v_rest + k / M)(c0 + c1 M) with k = v_photons
+  // M, is least at M*^2 = k c0 / (v_rest c1), so R^2 should scale by M* / M.
+  const double f = std::sqrt(v_photons * kAdaptiveCostPhotons / (v_rest * m));
+  return std::isfinite(f) ? std::min(f, 1.0) : 1.0;
 }
 
 double preferred_r2(const PointState& s, uint64_t passes, double photons_per_pass) {

@@ -6,6 +6,7 @@
 #include "estimator/disc_moments.h"
 #include "util/math.h"
 
+#include <algorithm>
 #include <cstdint>
 
 namespace pb {
@@ -89,8 +90,9 @@ struct EstimatorParams {
   double alpha = 0.7;             // PPM radius reduction, in (0, 1]
   double photons_per_pass = 1.0;  // M_e
   double min_r2 = 0.0;            // floor on R^2 (ESTIMATOR.md section 8)
-  // --adaptive radius: after the PPM update, each point's radius moves down to the one its own
-  // error model prefers (ESTIMATOR.md section 13), never above the PPM schedule's.
+  // --adaptive radius: each point's radius between the schedules of kAdaptiveSlowAlpha and
+  // alpha, by the cost of its photons against its other noise, and below that where its bias
+  // model prefers (ESTIMATOR.md section 13); never above the slow schedule's.
   bool adaptive_radius = false;
 };
 
@@ -101,6 +103,15 @@ inline constexpr uint64_t kAdaptiveMinPasses = 4;
 inline constexpr double kAdaptiveMaxShrink = 0.5;
 // A bias slope moves a radius only where it exceeds this many of its own sds (section 13).
 inline constexpr double kAdaptiveSlopeZ = 3.0;
+// The slowest schedule --adaptive radius keeps a radius on (section 13): R^2 ~ i^-0.11, so every
+// radius shrinks at a guaranteed rate, where --alpha's 0.7 gives i^-0.43. Where the photons are
+// the noise a larger radius is worth more than its bias; the cost rule brings a radius down to
+// --alpha's schedule where they are not, and the bias rule below it.
+inline constexpr double kAdaptiveSlowAlpha = 0.9;
+inline double adaptive_cap_alpha(double alpha) { return std::max(alpha, kAdaptiveSlowAlpha); }
+// A pass's work at a point beyond its photons (camera path, next-event sample, grid lookup,
+// update), in gathered photons: measured as 0.55 us against 14 ns a photon (bench/README.md).
+inline constexpr double kAdaptiveCostPhotons = 40.0;
 
 // The squared radius that minimises the predicted mean squared error of a point's estimate
 // over the next passes (ESTIMATOR.md section 13): R^2 = (v / (2 A^2 (i + 1)))^(1/3), with
@@ -108,6 +119,13 @@ inline constexpr double kAdaptiveSlopeZ = 3.0;
 // both summed over the channels. +inf where the model has nothing to say (too few passes or
 // photons, no significant slope): the PPM schedule then decides alone.
 double preferred_r2(const PointState& state, uint64_t passes, double photons_per_pass);
+
+// The cost rule (section 13): the factor on a point's last squared radius that minimises the
+// time to an error when a pass's photon part has the variance P^2 E[w^2] / M of M Poisson
+// arrivals and the rest of its variance does not depend on the radius, for a pass that costs as
+// much as kAdaptiveCostPhotons gathered photons beyond its photons. At most 1; 1 where the model
+// has nothing to say (fewer than 2 passes or 5 photons, no variance beyond the photons').
+double cost_r2_factor(const PointState& state, uint64_t passes, double photons_per_pass);
 
 // A point's predicted error relative to its radiance, sqrt(mean_c(S_c^2 / i + B_c^2)) /
 // mean_c L_c, at most 1; 1 where it cannot be formed (fewer than 2 passes, no radiance). The

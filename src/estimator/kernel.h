@@ -21,6 +21,10 @@ double unit_mass(double t);
 // Laplacian of kappa with respect to position (radius 1): 105/pi t(1-t)(5t-3).
 double unit_laplacian(double t);
 
+// E[w(t)^2] for t uniform over the unit disc, 2 integral_0^1 w(t)^2 t dt = 287 / 132 (E[w] = 1):
+// the variance of a kernel sum over Poisson arrivals of equal power, per arrival.
+inline constexpr double kWeightSecondMoment = 287.0 / 132.0;
+
 // Photon weight normalised like a box kernel: w(t) = pi kappa(t) = 3.5 k(t).
 inline double weight(double t) { return 3.5 * profile(t); }
 

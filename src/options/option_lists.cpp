@@ -143,13 +143,13 @@ OptionSpec asset_dirs() {
 }
 
 // --adaptive LIST: a comma list of the parts that follow the error estimates: `radius`
-// (ESTIMATOR.md section 13) and `photons` (section 14). `paths` (more camera paths where the
-// camera part dominates) is named by issue 39 and refused by name until it exists.
+// (ESTIMATOR.md section 13, the default), `photons` (section 14) and `paths` (section 15).
 OptionSpec adaptive() {
   OptionSpec s = base("--adaptive", "adaptive", "LIST", "rendering", OptionKind::Image,
                       "comma list of what follows each pixel's error estimates: radius (each "
-                      "point's radius minimises its predicted error, never above the --alpha "
-                      "schedule), photons (emission learnt from where past photons met the "
+                      "point's radius between the schedules of alpha 0.9 and --alpha by what its "
+                      "photons cost against its other noise, below where its bias dominates), "
+                      "photons (emission learnt from where past photons met the "
                       "error), paths (more camera paths where the camera part is a pixel's noise; "
                       "SPPM), or none");
   s.parse = [](RenderOptions& o, const std::string& t) {

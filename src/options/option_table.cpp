@@ -50,7 +50,8 @@ std::vector<OptionSpec> make_table() {
                            "photons emitted per pass (M_e)"),
                       &RenderOptions::photons_per_pass, {1, 1000000000ULL}));
   t.push_back(real(base("--alpha", "alpha", "A", render, K::Image,
-                        "PPM radius reduction; 1 never shrinks the radius"),
+                        "PPM radius reduction (with --adaptive radius: the fastest where the "
+                        "photons are not the noise); 1 with --adaptive none never shrinks it"),
                    &RenderOptions::alpha, {0, 1, true, false, "", ""}));
   t.push_back(adaptive());
   t.push_back(real(

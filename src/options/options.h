@@ -57,8 +57,9 @@ struct RenderOptions {
   double alpha = 0.7;
   // --adaptive: which parts of the render follow each pixel's own error estimates
   // (ESTIMATOR.md sections 13-15); none = every point on the PPM schedule, every photon
-  // emitted in proportion to power.
-  bool adaptive_radius = false;
+  // emitted in proportion to power. The radius is the default: it reached every measured
+  // target as soon or sooner (section 13, "Measured").
+  bool adaptive_radius = true;
   bool adaptive_photons = false;
   bool adaptive_paths = false;   // SPPM: section 15
   std::optional<double> radius;  // world units; default from the pixel footprint

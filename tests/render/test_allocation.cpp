@@ -45,8 +45,9 @@ long allocations_in_one_pass(Method method, DirectMode direct, bool paths = fals
   g_counting = false;
   EXPECT_GT(g_allocations.load(), 0) << "the first pass sizes its buffers";
   // Warm: the photon count of a pass varies, so the hit buffers may still grow for a few passes;
-  // --adaptive paths sizes its scratch at its first allocation (kPathsMinPasses).
-  for (int k = 0; k < (paths ? 20 : 5); ++k) r.step();
+  // --adaptive paths sizes its scratch at its first allocation (kPathsMinPasses); the adaptive
+  // radius spreads the radii over the first 20-odd passes, and the grid's levels grow with them.
+  for (int k = 0; k < 40; ++k) r.step();
   long most = 0;
   for (int k = 0; k < 3; ++k) {
     g_allocations = 0;

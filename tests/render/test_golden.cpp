@@ -28,6 +28,9 @@ struct Golden {
   // bound and no radiance: the checksums above are taken with --bias-model laplacian. 0: not
   // recorded (no AVX2 machine was at hand when it came; PB_GOLDEN_PRINT=1 there prints it).
   uint64_t two_scale_avx2 = 0, two_scale_xeon = 0;
+  // The defaults, --adaptive radius with the two-scale bias (ESTIMATOR.md section 13): every
+  // checksum above is taken with --adaptive none, whose images are the earlier ones bit for bit.
+  uint64_t radius_avx2 = 0, radius_xeon = 0;
 };
 
 // History: made before the architecture change (issue 12) on 45c8a0b, unchanged through it;
@@ -50,29 +53,38 @@ struct Golden {
 // for the three Cornell boxes when the photon pass stopped applying the shading-normal factor
 // to a mirror branch drawn about the true normal (photon_pass.cpp; the mirror sphere's rim):
 // only an AVX-512 Xeon was at hand, so their AVX2 checksums are 0, not recorded, and an AVX2
-// machine prints its value for them; the five other images check either CPU as before.
+// machine prints its value for them; the five other images check either CPU as before. The
+// default --adaptive radius (ESTIMATOR.md section 13, the default since its cost rule) has a
+// checksum of its own, the others being taken with --adaptive none (unchanged): recorded on an
+// AVX-512 Xeon only.
 const Golden kGolden[] = {
     {"cornell_nee", Method::PPM, "cornell.gltf", 24, 5, 4000, DirectMode::NextEvent, 0.7, 0,
-     0xa21b74ed3a4c2237ULL, 0, 0xcfe134bcf5e1c9b4ULL},
+     0xa21b74ed3a4c2237ULL, 0, 0xcfe134bcf5e1c9b4ULL, 0, 0xeaf082c2811bd2d0ULL},
     {"cornell_photons", Method::PPM, "cornell.gltf", 20, 4, 3000, DirectMode::Photons, 0.8, 0,
-     0x6c7bb25996601a73ULL, 0, 0xf882b64a9e6cf136ULL},
+     0x6c7bb25996601a73ULL, 0, 0xf882b64a9e6cf136ULL, 0, 0x7f3fc14dced5c0e2ULL},
     {"glass_slab", Method::PPM, "glass_slab.gltf", 20, 4, 3000, DirectMode::Photons, 0.7,
-     0xb2eb6018f5e51523ULL, 0xe265b6a785d75ae2ULL, 0, 0xb2dc7bc152409c84ULL},
+     0xb2eb6018f5e51523ULL, 0xe265b6a785d75ae2ULL, 0, 0xb2dc7bc152409c84ULL, 0,
+     0x04044d739b577232ULL},
     {"spot", Method::PPM, "spot.gltf", 16, 3, 2000, DirectMode::NextEvent, 0.7,
-     0x87e79b9c3846062fULL, 0xc28ef8cae5843de7ULL, 0, 0xc28ef8cae5843de7ULL},
+     0x87e79b9c3846062fULL, 0xc28ef8cae5843de7ULL, 0, 0xc28ef8cae5843de7ULL, 0,
+     0xc28ef8cae5843de7ULL},
     {"closed_box", Method::PPM, "closed_box.gltf", 16, 4, 2000, DirectMode::NextEvent, 0.9,
-     0xb9b97883a6e21822ULL, 0xc109a352d5bb0354ULL, 0, 0x2a65ef36025add4aULL},
+     0xb9b97883a6e21822ULL, 0xc109a352d5bb0354ULL, 0, 0x2a65ef36025add4aULL, 0,
+     0x18e038dc8d93bb2cULL},
     {"sppm_cornell", Method::SPPM, "cornell.gltf", 24, 5, 4000, DirectMode::NextEvent, 0.7, 0,
-     0xdb56737add212301ULL, 0, 0xcbe7a18dbbb10a15ULL},
+     0xdb56737add212301ULL, 0, 0xcbe7a18dbbb10a15ULL, 0, 0x729bd4b941201106ULL},
     {"sppm_box", Method::SPPM, "closed_box.gltf", 16, 4, 2000, DirectMode::NextEvent, 0.9,
-     0x4220db98874c0aa2ULL, 0xdb42c34b8251179eULL, 0, 0x076d8e84b3887d8fULL},
+     0x4220db98874c0aa2ULL, 0xdb42c34b8251179eULL, 0, 0x076d8e84b3887d8fULL, 0,
+     0x3fec7ae88768d9a1ULL},
     {"plane", Method::PPM, "plane_point.gltf", 16, 4, 2000, DirectMode::Photons, 0.7,
-     0x701aa91eba913cb7ULL, 0x468c3cefd74adebcULL, 0, 0xa0bdb59ec06d6ce5ULL},
+     0x701aa91eba913cb7ULL, 0x468c3cefd74adebcULL, 0, 0xa0bdb59ec06d6ce5ULL, 0,
+     0x30e9c59981596bc8ULL},
 };
 
-uint64_t checksum_of(const Golden& g, BiasModel bias_model) {
+uint64_t checksum_of(const Golden& g, BiasModel bias_model, bool adaptive_radius = false) {
   RenderOptions o = test::quick_options(g.scene, g.size, g.passes);
   o.bias_model = bias_model;
+  o.adaptive_radius = adaptive_radius;
   o.photons_per_pass = g.photons;
   o.direct = g.direct;
   o.alpha = g.alpha;
@@ -96,13 +108,14 @@ uint64_t checksum_of(const Golden& g, BiasModel bias_model) {
 // PB_GOLDEN_PRINT=1 prints the checksums, for a deliberate update.
 TEST(Golden, ImagesAreBitIdenticalToTheStoredChecksums) {
   constexpr size_t n = std::size(kGolden);
-  uint64_t h[n], h4[n];
+  uint64_t h[n], h4[n], hr[n];
   for (size_t k = 0; k < n; ++k) {
     h[k] = checksum_of(kGolden[k], BiasModel::Laplacian);
     h4[k] = checksum_of(kGolden[k], BiasModel::TwoScale);
+    hr[k] = checksum_of(kGolden[k], BiasModel::TwoScale, true);
     if (std::getenv("PB_GOLDEN_PRINT"))
-      std::printf("    %s 0x%016llxULL 0x%016llxULL\n", kGolden[k].name, (unsigned long long)h[k],
-                  (unsigned long long)h4[k]);
+      std::printf("    %s 0x%016llxULL 0x%016llxULL 0x%016llxULL\n", kGolden[k].name,
+                  (unsigned long long)h[k], (unsigned long long)h4[k], (unsigned long long)hr[k]);
   }
   // Which CPU's set this machine computes, told by the images whose two checksums are recorded
   // and differ; a machine that matches neither set fails here.
@@ -131,6 +144,12 @@ TEST(Golden, ImagesAreBitIdenticalToTheStoredChecksums) {
     else
       std::printf("%s: no two-scale checksum is recorded for this CPU (0x%016llx)\n", g.name,
                   (unsigned long long)h4[k]);
+    const uint64_t want_r = xeon ? g.radius_xeon : g.radius_avx2;
+    if (want_r != 0)
+      EXPECT_EQ(hr[k], want_r) << g.name << ": 0x" << std::hex << hr[k] << " with the defaults";
+    else
+      std::printf("%s: no checksum with the defaults is recorded for this CPU (0x%016llx)\n",
+                  g.name, (unsigned long long)hr[k]);
   }
 }
 

@@ -25,8 +25,9 @@ double normal_cdf_one() { return 0.8413447460685429; }  // `bounds_study TABLE s
 RenderOptions study_options(const std::string& scene, int size, uint64_t passes) {
   RenderOptions o = test::quick_options(scene, size, passes);
   o.method = g_method;
-  // PB_STUDY_ADAPTIVE=radius,photons,paths (or any of them): the tables with ESTIMATOR.md
-  // section 13's radius, section 14's photon guide and section 15's camera paths.
+  // PB_STUDY_ADAPTIVE=radius,photons,paths (or any of them, or none for the --alpha schedule):
+  // the tables with ESTIMATOR.md section 13's radius, section 14's photon guide and section 15's
+  // camera paths. Unset: the defaults (the radius alone).
   // PB_STUDY_BIAS=laplacian: the bounds with HJJ10's a R^2 alone (ESTIMATOR.md section 6c).
   if (const char* b = std::getenv("PB_STUDY_BIAS"))
     o.bias_model = std::string(b) == "laplacian" ? BiasModel::Laplacian : BiasModel::TwoScale;
