@@ -704,18 +704,31 @@ PassSample biased_gather(uint64_t seed, uint64_t pass, double r2, double me) {
   return g;
 }
 
+// The default's parameters (the adaptive radius over --alpha = kAlpha) and those of its slow
+// schedule alone, the most a radius may keep (ESTIMATOR.md section 13).
+struct AdaptiveAndSlow {
+  EstimatorParams adaptive, slow;
+};
+AdaptiveAndSlow adaptive_and_slow() {
+  AdaptiveAndSlow p;
+  p.adaptive.alpha = kAlpha;
+  p.adaptive.photons_per_pass = kMe;
+  p.adaptive.adaptive_radius = true;
+  p.slow = p.adaptive;
+  p.slow.adaptive_radius = false;
+  p.slow.alpha = adaptive_cap_alpha(kAlpha);
+  return p;
+}
+
+// --alpha's per-pass factor for equal counts on a radius R^2 before pass j: the cost rule's floor.
+double alpha_step(double r2, int j) { return r2 * kAlpha * j / (kAlpha * (j - 1.0) + 1.0); }
+
 TEST(AdaptiveRadius, StaysBetweenHalfAndTheSlowScheduleAndMoves) {
   // Every pass: the radius after it is at most the slow schedule's update from the same state
   // (so it shrinks at least at that rate) and at least half of the lower of that and --alpha's
   // per-pass factor (one noisy slope cannot collapse it). The biased passes have a slope far
   // beyond its noise, so the bias rule must take the radius below --alpha's schedule.
-  EstimatorParams adaptive;
-  adaptive.alpha = kAlpha;
-  adaptive.photons_per_pass = kMe;
-  adaptive.adaptive_radius = true;
-  EstimatorParams slow = adaptive;
-  slow.adaptive_radius = false;
-  slow.alpha = adaptive_cap_alpha(kAlpha);
+  const auto [adaptive, slow] = adaptive_and_slow();
   ASSERT_EQ(slow.alpha, kAdaptiveSlowAlpha);
   PointState s;
   s.r2 = 0.25;
@@ -724,13 +737,13 @@ TEST(AdaptiveRadius, StaysBetweenHalfAndTheSlowScheduleAndMoves) {
     const PassSample g = biased_gather(21, uint64_t(j), s.r2, kMe);
     PointState on_schedule = s;
     accumulate_pass(on_schedule, g, slow, uint64_t(j));
-    const double alpha_step = s.r2 * kAlpha * j / (kAlpha * (j - 1.0) + 1.0);
+    const double alpha_r2 = alpha_step(s.r2, j);
     accumulate_pass(s, g, adaptive, uint64_t(j));
     ASSERT_LE(s.r2, on_schedule.r2) << "pass " << j;
-    ASSERT_GE(s.r2, kAdaptiveMaxShrink * std::min(on_schedule.r2, alpha_step) * (1.0 - 1e-15))
+    ASSERT_GE(s.r2, kAdaptiveMaxShrink * std::min(on_schedule.r2, alpha_r2) * (1.0 - 1e-15))
         << "pass " << j;
     if (j == 1) ASSERT_EQ(s.r2, on_schedule.r2);  // no variance yet: the slow schedule
-    below_alpha += s.r2 < alpha_step * (1.0 - 1e-12);
+    below_alpha += s.r2 < alpha_r2 * (1.0 - 1e-12);
     // Only the radius differs: the samples' moments are the same function of the same pass.
     ASSERT_EQ(s.photons, on_schedule.photons);
   }
@@ -769,13 +782,7 @@ PassSample photon_noise_gather(uint64_t seed, uint64_t pass, double r2, double m
 
 TEST(AdaptiveRadius, CostRuleKeepsLargeRadiiWhereThePhotonsAreTheNoiseOnly) {
   for (const double noise : {0.0, 20.0}) {
-    EstimatorParams adaptive;
-    adaptive.alpha = kAlpha;
-    adaptive.photons_per_pass = kMe;
-    adaptive.adaptive_radius = true;
-    EstimatorParams slow = adaptive;
-    slow.adaptive_radius = false;
-    slow.alpha = kAdaptiveSlowAlpha;
+    const auto [adaptive, slow] = adaptive_and_slow();
     PointState s;
     s.r2 = 0.25;
     int on_slow = 0, on_alpha = 0;
@@ -783,10 +790,10 @@ TEST(AdaptiveRadius, CostRuleKeepsLargeRadiiWhereThePhotonsAreTheNoiseOnly) {
       const PassSample g = photon_noise_gather(31, uint64_t(j), s.r2, kMe, noise);
       PointState on_schedule = s;
       accumulate_pass(on_schedule, g, slow, uint64_t(j));
-      const double alpha_step = s.r2 * kAlpha * j / (kAlpha * (j - 1.0) + 1.0);
+      const double alpha_r2 = alpha_step(s.r2, j);
       accumulate_pass(s, g, adaptive, uint64_t(j));
       on_slow += s.r2 == on_schedule.r2;
-      on_alpha += std::fabs(s.r2 / alpha_step - 1.0) < 1e-12;
+      on_alpha += std::fabs(s.r2 / alpha_r2 - 1.0) < 1e-12;
     }
     if (noise == 0.0) {
       // The Poisson variance is P^2 / M, below the rule's P^2 E[w^2] / M: nothing else to pay.
