@@ -80,8 +80,17 @@ void gather_kernel(const VisiblePoint& point, double r2, const HashGrid& grid,
     // wall of a thin closed shell, the room under a floor), where no light from it can reach.
     // On one smooth surface the two never hold together (convex: the point is behind the
     // photon's plane; concave: the photon is in front of the point's).
+    // Nor from a surface stacked in front of the point's and facing the same way (a board or a
+    // ledge in front of a wall, the next tread of a stair): the photon in front of the point's
+    // tangent plane and the point behind the photon's. Its light fell on that surface, which
+    // may be lit where the point is shaded, and the kernel's mass counts the point's surface
+    // alone. On one smooth surface the two never hold together either (concave: the point is
+    // in front of the photon's plane; convex: the photon is behind the point's).
     const vec3 d = h.position - p;
-    if (glm::dot(d, point.normal) < -behind_tol && glm::dot(d, h.normal) < -behind_tol) return;
+    const float ahead_p = glm::dot(d, point.normal), ahead_h = glm::dot(d, h.normal);
+    if ((ahead_p < -behind_tol && ahead_h < -behind_tol) ||
+        (ahead_p > behind_tol && ahead_h > behind_tol))
+      return;
     const float cos_s = glm::dot(h.wi, point.shading);
     ++count;  // it could contribute, so it counts toward the radius reduction
     if (cos_s <= 0.0f) return;
