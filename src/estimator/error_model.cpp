@@ -1,5 +1,6 @@
 #include "estimator/error_model.h"
 
+#include "estimator/kernel.h"
 #include "util/parallel.h"
 
 #include <boost/math/distributions/normal.hpp>
@@ -77,8 +78,8 @@ double abs_error_variance(double mu, double sigma) {
 }
 
 double correlated_pixels(double radius, double footprint) {
-  // 1 / integral over the unit disc of kappa^2 (kernel.h's quintic, by quadrature).
-  constexpr double kInverseSquaredMass = 1.444913694367901;
+  // 1 / integral over the unit disc of kappa^2 = pi / E[w^2] (kernel.h's quintic).
+  constexpr double kInverseSquaredMass = std::numbers::pi / kernel::kWeightSecondMoment;
   if (!(footprint > 0.0)) return 1.0;
   const double q = radius / footprint;
   return std::max(1.0, kInverseSquaredMass * q * q);

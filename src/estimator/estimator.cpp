@@ -125,7 +125,6 @@ void accumulate_pass(PointState& s, const PassSums& g, const OwnerValues& o,
 
   // PPM update (section 3, HOJ08): only photons that could contribute shrink the radius. With
   // --adaptive radius the update is the slow schedule's (section 13), the most a radius may keep.
-  const double r2_pass_end = s.r2;
   const double alpha = params.adaptive_radius ? adaptive_cap_alpha(params.alpha) : params.alpha;
   const double applied = ppm_radius_update(s.n, s.r2, g.count, alpha, params.min_r2);
   s.tau = (s.tau + phi) * applied;
@@ -139,8 +138,8 @@ void accumulate_pass(PointState& s, const PassSums& g, const OwnerValues& o,
   // as in the PPM update.
   if (params.adaptive_radius) {
     const double ip = double(pass);
-    const double floor_r2 = r2_pass_end * params.alpha * ip / (params.alpha * (ip - 1.0) + 1.0);
-    const double cost = r2_pass_end * cost_r2_factor(s, pass, params.photons_per_pass);
+    const double floor_r2 = r2_pass * params.alpha * ip / (params.alpha * (ip - 1.0) + 1.0);
+    const double cost = r2_pass * cost_r2_factor(s, pass, params.photons_per_pass);
     const double base = std::min(s.r2, std::max(floor_r2, cost));
     const double want = preferred_r2(s, pass, params.photons_per_pass);
     const double r2 =
@@ -159,7 +158,8 @@ double cost_r2_factor(const PointState& s, uint64_t passes, double photons_per_p
   if (passes < 2 || s.photons < kMinPhotonsForBound || !(s.r2 > 0.0) || !(s.mean_r2 > 0.0))
     return 1.0;
   const double i = double(passes);
-  // M: the photons a pass brings at the current radius (they scale with the disc's area).
+  // M: the photons a pass brings at the current radius (they scale with the disc's area; mean_r2
+  // streams the edge-corrected R_b^2 of section 11, R_j^2 itself on a whole disc).
   const double m = double(s.photons) / i * (s.r2 / s.mean_r2);
   const dvec3 p = photon_radiance(s, passes, photons_per_pass);
   // The photon part's variance for M Poisson arrivals of equal power: P^2 E[w^2] / M with

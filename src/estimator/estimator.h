@@ -110,14 +110,15 @@ inline constexpr double kAdaptiveSlopeZ = 3.0;
 inline constexpr double kAdaptiveSlowAlpha = 0.9;
 inline double adaptive_cap_alpha(double alpha) { return std::max(alpha, kAdaptiveSlowAlpha); }
 // A pass's work at a point beyond its photons (camera path, next-event sample, grid lookup,
-// update), in gathered photons: measured as 0.55 us against 14 ns a photon (bench/README.md).
+// update), in gathered photons: about 0.55 us against 14 ns a photon at 512x512 (ESTIMATOR.md
+// section 13 derives it from bench/README.md's pass figures).
 inline constexpr double kAdaptiveCostPhotons = 40.0;
 
 // The squared radius that minimises the predicted mean squared error of a point's estimate
 // over the next passes (ESTIMATOR.md section 13): R^2 = (v / (2 A^2 (i + 1)))^(1/3), with
 // A^2 the bias slopes' squares net of their own noise and v the per-pass variance times R^2,
 // both summed over the channels. +inf where the model has nothing to say (too few passes or
-// photons, no significant slope): the PPM schedule then decides alone.
+// photons, no significant slope): the cost rule's band then decides alone.
 double preferred_r2(const PointState& state, uint64_t passes, double photons_per_pass);
 
 // The cost rule (section 13): the factor on a point's last squared radius that minimises the

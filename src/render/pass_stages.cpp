@@ -61,9 +61,10 @@ void gather_kernel(const VisiblePoint& point, double r2, const HashGrid& grid,
                    const GuideLearning* learn) {
   const float radius = search_radius(r2);
   const double inv_r2 = 1.0 / r2;
-  // How far a photon may lie behind the point's tangent plane, facing it, and still count: far
-  // above the rounding of positions (the point is lifted off its surface by ~1e-7 of its
-  // coordinates, so a photon on the same flat surface is "behind" it by that much).
+  // How far a photon may lie behind or in front of the point's tangent plane (and the point off
+  // the photon's) and still count under the rules below: far above the rounding of positions (the
+  // point is lifted off its surface by ~1e-7 of its coordinates, so a photon on the same flat
+  // surface is "behind" it by that much).
   const vec3 p = point.position;
   const float behind_tol =
       1e-3f * radius + 1e-5f * std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
@@ -86,11 +87,14 @@ void gather_kernel(const VisiblePoint& point, double r2, const HashGrid& grid,
     // may be lit where the point is shaded, and the kernel's mass counts the point's surface
     // alone. On one smooth surface the two never hold together either (concave: the point is
     // in front of the photon's plane; convex: the photon is behind the point's).
+    // Both rules: the photon off the point's plane and the point off the photon's, on sides of
+    // the same sign. A photon on the point's own plane (most of them) costs one dot product.
     const vec3 d = h.position - p;
-    const float ahead_p = glm::dot(d, point.normal), ahead_h = glm::dot(d, h.normal);
-    if ((ahead_p < -behind_tol && ahead_h < -behind_tol) ||
-        (ahead_p > behind_tol && ahead_h > behind_tol))
-      return;
+    const float ahead_p = glm::dot(d, point.normal);
+    if (std::abs(ahead_p) > behind_tol) {
+      const float ahead_h = glm::dot(d, h.normal);
+      if (std::abs(ahead_h) > behind_tol && (ahead_h > 0.0f) == (ahead_p > 0.0f)) return;
+    }
     const float cos_s = glm::dot(h.wi, point.shading);
     ++count;  // it could contribute, so it counts toward the radius reduction
     if (cos_s <= 0.0f) return;
