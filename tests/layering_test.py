@@ -20,6 +20,7 @@ SRC = ROOT / "src"
 LIBRARIES = {
     "embree3/": "embree",
     "OpenImageIO/": "PkgConfig::OIIO",
+    "OpenEXR/": "OpenEXR::OpenEXR",
     "tiny_gltf.h": "TinyGLTF::TinyGLTF",
     "draco/": "draco::draco",
     "meshoptimizer.h": "meshoptimizer::meshoptimizer",
@@ -34,15 +35,17 @@ LIBRARIES = {
 
 
 def modules():
-    """{folder: (deps, public_libs, private_libs)} from the pb_module calls."""
+    """{folder: (deps, public_libs, private_libs)} from the pb_module calls, and from the
+    pb_loaded_module calls, whose folder is a subfolder (io/oiio)."""
     text = (SRC / "CMakeLists.txt").read_text()
     text = re.sub(r"#.*", "", text)
     found = {}
-    for call in re.finditer(r"pb_module\(([^)]*)\)", text):
+    for call in re.finditer(r"pb_(?:loaded_)?module\(([^)]*)\)", text):
         words = call.group(1).split()
-        if words[0] == "name":
-            continue  # the function's own definition
-        name, section, parts = words[0], None, {"DEPS": [], "PUBLIC_LIBS": [], "PRIVATE_LIBS": []}
+        if words[0] in ("name", "path"):
+            continue  # the functions' own definitions
+        name, section = words[0], None
+        parts = {"DEPS": [], "PUBLIC_LIBS": [], "PRIVATE_LIBS": [], "SOURCES": []}
         for w in words[1:]:
             if w in parts:
                 section = w
@@ -75,7 +78,8 @@ def violations():
             if path.suffix in (".h", ".cpp"):
                 found.append(f"{path.relative_to(ROOT)}: a source outside every folder")
             continue
-        folder = path.relative_to(SRC).parts[0]
+        parts = path.relative_to(SRC).parts
+        folder = "/".join(parts[:2]) if "/".join(parts[:2]) in mods else parts[0]
         if folder not in mods:
             found.append(f"{path.relative_to(ROOT)}: folder {folder} is no target")
             continue

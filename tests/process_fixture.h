@@ -34,10 +34,12 @@ inline std::string quote(const std::string& s) {
   return q + "'";
 }
 
-// Runs `photonbound ARGS` through the shell (in `dir` when given), with a 60 s limit.
-inline Outcome run_photonbound(const std::string& args, const std::string& dir = "") {
+// Runs `photonbound ARGS` through the shell (in `dir` when given), with a 60 s limit; `env`
+// (NAME=VALUE ...) is put in its environment.
+inline Outcome run_photonbound(const std::string& args, const std::string& dir = "",
+                               const std::string& env = "") {
   std::string cmd = dir.empty() ? "" : "cd " + quote(dir) + " && ";
-  cmd += "timeout 60 " + std::string(PHOTONBOUND_EXE) + " " + args + " 2>&1 >/dev/null";
+  cmd += env + " timeout 60 " + std::string(PHOTONBOUND_EXE) + " " + args + " 2>&1 >/dev/null";
   Outcome r;
   FILE* pipe = popen(cmd.c_str(), "r");
   if (!pipe) return r;

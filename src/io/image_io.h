@@ -1,5 +1,6 @@
-// EXR reading and writing, and decoding the images of glTF textures. The only file that
-// includes OpenImageIO is src/io/image_io.cpp.
+// EXR reading and writing, and decoding the images of glTF textures. EXRs are written through
+// OpenEXR (image_io.cpp); everything that needs OpenImageIO (reads, texture decoding, PNG) is
+// in the module src/io/oiio/, which image_io.cpp loads on first use (io/oiio_codec.h).
 #pragma once
 
 #include "scene/scene.h"
@@ -27,7 +28,7 @@ struct ExrImage {
 };
 
 // How write_exr compresses. The bound, noise and variance channels are noise-like floats that
-// ZIP shrinks by only ~6% (512x512 default scene) for ~0.45 s of CPU, so checkpoints, which are
+// ZIP shrinks by only ~6% (512x512 default scene) for ~0.4 s of CPU, so checkpoints, which are
 // rewritten every few seconds to minutes, are written uncompressed; the final image uses ZIP.
 enum class ExrCompression { Zip, None };
 

@@ -1,4 +1,4 @@
-#include "io/image_limits.h"
+#include "io/oiio/image_limits.h"
 
 #include <algorithm>
 #include <cstring>

@@ -1,7 +1,7 @@
 // Checks of an opened image before its pixels are read (issue 36): what the header claims
 // against the read's budget and against what the file's bytes can hold, and the buffers
 // OpenImageIO will allocate to read it. Each throws ImageError naming the file. Used by
-// image_io.cpp only.
+// the OpenImageIO module (src/io/oiio/codec.cpp) only.
 #pragma once
 
 #include <OpenImageIO/imageio.h>
