@@ -170,14 +170,16 @@ void shrink_fourth(std::vector<PixelResult>& results, int width, int height) {
         return BiasEstimate{dvec3(r.fourth), sd * sd, r.known && !r.exact};
       },
       width, height, kFourthNoiseFactor);
-  for (size_t p = 0; p < results.size(); ++p)
-    for (int c = 0; c < 3; ++c) {
-      PixelResult& r = results[p];
-      const double w4 =
-          r.fourth[c] == 0.0f ? 0.0 : bias_shrinkage(tau4[p][c], squared(double(r.fourth_sd[c])));
-      r.fourth[c] = float(r.fourth[c] * w4);
-      r.fourth_sd[c] = float(r.fourth_sd[c] * std::sqrt(w4));
-    }
+  parallel_for(results.size(), 4096, [&](size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p)
+      for (int c = 0; c < 3; ++c) {
+        PixelResult& r = results[p];
+        const double w4 =
+            r.fourth[c] == 0.0f ? 0.0 : bias_shrinkage(tau4[p][c], squared(double(r.fourth_sd[c])));
+        r.fourth[c] = float(r.fourth[c] * w4);
+        r.fourth_sd[c] = float(r.fourth_sd[c] * std::sqrt(w4));
+      }
+  });
 }
 
 }  // namespace pb
