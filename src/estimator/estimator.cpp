@@ -29,6 +29,10 @@ SlopeAndSpread slope_and_spread(const PointState& s, double i, double photons_pe
   return r;
 }
 
+double cost_factor(const PointState& s, uint64_t passes, double photons_per_pass,
+                   const SlopeAndSpread& spread);
+double preferred(const PointState& s, uint64_t passes, const SlopeAndSpread& spread);
+
 }  // namespace
 
 double relative_error(const PointState& s, uint64_t passes, double photons_per_pass) {
@@ -139,9 +143,10 @@ void accumulate_pass(PointState& s, const PassSums& g, const OwnerValues& o,
   if (params.adaptive_radius) {
     const double ip = double(pass);
     const double floor_r2 = r2_pass * params.alpha * ip / (params.alpha * (ip - 1.0) + 1.0);
-    const double cost = r2_pass * cost_r2_factor(s, pass, params.photons_per_pass);
+    const SlopeAndSpread spread = slope_and_spread(s, ip, params.photons_per_pass);
+    const double cost = r2_pass * cost_factor(s, pass, params.photons_per_pass, spread);
     const double base = std::min(s.r2, std::max(floor_r2, cost));
-    const double want = preferred_r2(s, pass, params.photons_per_pass);
+    const double want = preferred(s, pass, spread);
     const double r2 =
         std::max(params.min_r2, std::max(base * kAdaptiveMaxShrink, std::min(base, want)));
     if (r2 < s.r2) {
@@ -154,7 +159,12 @@ void accumulate_pass(PointState& s, const PassSums& g, const OwnerValues& o,
   }
 }
 
-double cost_r2_factor(const PointState& s, uint64_t passes, double photons_per_pass) {
+namespace {
+
+// cost_r2_factor and preferred_r2 with the point's slope and spread taken once (accumulate_pass
+// asks both every pass; slope_and_spread was 1.2% of a pass computed twice).
+double cost_factor(const PointState& s, uint64_t passes, double photons_per_pass,
+                   const SlopeAndSpread& spread) {
   if (passes < 2 || s.photons < kMinPhotonsForBound || !(s.r2 > 0.0) || !(s.mean_r2 > 0.0))
     return 1.0;
   const double i = double(passes);
@@ -166,7 +176,7 @@ double cost_r2_factor(const PointState& s, uint64_t passes, double photons_per_p
   // E[w^2] = kWeightSecondMoment for arrivals uniform over the disc. Unequal powers and
   // densities only add to it, so this is the photons' least share and the rest's most.
   const double v_photons = glm::dot(p, p) * kernel::kWeightSecondMoment / m;
-  const dvec3 s2 = slope_and_spread(s, i, photons_per_pass).s2;
+  const dvec3 s2 = spread.s2;
   const double v_rest = (s2.x + s2.y + s2.z) - v_photons;
   if (!(v_rest > 0.0) || !(v_photons > 0.0)) return 1.0;
   // A pass costs c0 + c1 M at a point, and N passes reach the variance (v_rest + v_photons) /
@@ -176,13 +186,13 @@ double cost_r2_factor(const PointState& s, uint64_t passes, double photons_per_p
   return std::isfinite(f) ? std::min(f, 1.0) : 1.0;
 }
 
-double preferred_r2(const PointState& s, uint64_t passes, double photons_per_pass) {
+double preferred(const PointState& s, uint64_t passes, const SlopeAndSpread& spread) {
   constexpr double kNone = std::numeric_limits<double>::infinity();
   if (passes < kAdaptiveMinPasses || s.photons < kMinPhotonsForBound || !(s.r2 > 0.0) ||
       !(s.mean_r2 > 0.0))
     return kNone;
   const double i = double(passes);
-  const auto [a, s2] = slope_and_spread(s, i, photons_per_pass);
+  const auto& [a, s2] = spread;
   double a2 = 0.0, v = 0.0;
   for (int c = 0; c < 3; ++c) {
     // Var(a) <= V_B / mean(R^2)^2 (section 6b). E[a_hat^2] = a^2 + Var(a), but subtracting
@@ -202,6 +212,17 @@ double preferred_r2(const PointState& s, uint64_t passes, double photons_per_pas
   // MSE(R^2) = A^2 R^4 + v / (N R^2) for N passes at one radius; its minimum is at
   // R^6 = v / (2 A^2 N), taken with N = i + 1, the passes once the next one is in.
   return std::cbrt(v / (2.0 * a2 * (i + 1.0)));
+}
+
+}  // namespace
+
+double cost_r2_factor(const PointState& s, uint64_t passes, double photons_per_pass) {
+  return cost_factor(s, passes, photons_per_pass,
+                     slope_and_spread(s, double(passes), photons_per_pass));
+}
+
+double preferred_r2(const PointState& s, uint64_t passes, double photons_per_pass) {
+  return preferred(s, passes, slope_and_spread(s, double(passes), photons_per_pass));
 }
 
 dvec3 photon_radiance(const PointState& s, uint64_t passes, double photons_per_pass) {
