@@ -86,14 +86,17 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
   RenderReport report;
   bool developed = false;
   double develop_seconds = 0.0;  // this pass's develop
-  // `last`: the stop is known and no pass follows, so the image is developed too (the closing
-  // write then does not develop the same states again: a development of the default scene costs
-  // about a pass).
-  auto develop = [&](bool last = false) {
+  // `with_image`: the image is developed too, where the render may stop on this development
+  // (the closing write then does not develop the same states again: a development of the
+  // default scene costs about a pass). A development without it drops an earlier one's image.
+  auto develop = [&](bool with_image = false) {
     const auto start = Clock::now();
     renderer_.collect();  // a distributed render: every rank's states, here
-    if (last) report.film.emplace();
-    report.summary = renderer_.develop(last ? &*report.film : nullptr);
+    if (with_image)
+      report.film.emplace();
+    else
+      report.film.reset();
+    report.summary = renderer_.develop(with_image ? &*report.film : nullptr);
     developed = true;
     develop_seconds = seconds_since(start);
   };
@@ -131,7 +134,9 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
     for (PassObserver* obs : observers) want = obs->wants_summary(pass, run_seconds) || want;
     developed = false;
     develop_seconds = 0.0;
-    if (want) develop();
+    // A stop test develops the image with its summary: if the render stops here, that is the
+    // image it writes (before, a target stop developed the same states twice).
+    if (want) develop(check);
     if (check) {
       // Sparse schedule (ESTIMATOR.md section 7): checks about 10% apart in pass count, so the
       // criterion is not retried after every pass (optional stopping).
@@ -166,6 +171,8 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
     const PassInfo info{renderer_, state_,         pass,        run_seconds,
                         developed, report.summary, report.stop, develop_seconds};
     for (PassObserver* obs : observers) obs->after_pass(info);
+    // A test that did not stop keeps no image (it holds 80 bytes a pixel until the next).
+    if (report.stop == StopReason::None) report.film.reset();
   }
   for (PassObserver* obs : observers) obs->finish();
   if (!developed) develop(true);
