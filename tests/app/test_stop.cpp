@@ -232,5 +232,32 @@ TEST(Stop, TheClosingLineGivesNoMeanOverAMinorityOfPixels) {
   EXPECT_EQ(stop_figures(o, s), "mean bound inf");
 }
 
+// The image a render writes is its final states' development: a target stop hands over the one
+// its stop test developed (it is not developed twice), a stop on passes after tests that did
+// not stop develops the last states, not an earlier test's.
+TEST(Stop, TheReportsImageIsTheLastStatesDevelopment) {
+  struct Case {
+    double target;
+    uint64_t passes;
+    const char* stop;
+  };
+  for (const Case c : {Case{1e30, 40, "target-error"}, Case{1e-12, 21, "passes"}}) {
+    RenderOptions o = test::quick_options("cornell.gltf", 16, c.passes);
+    o.photons_per_pass = 2000;
+    o.target_error = c.target;
+    Renderer r(load_gltf(o.scene), o);
+    const RenderReport report = test::run_to_stop(r);
+    EXPECT_EQ(stop_text(report.stop), c.stop);
+    ASSERT_TRUE(report.film.has_value()) << c.stop;
+    FilmImage fresh;
+    const FilmSummary summary = r.develop(&fresh);
+    EXPECT_EQ(report.summary.mean_bound, summary.mean_bound) << c.stop;
+    EXPECT_EQ(report.summary.predicted_error, summary.predicted_error) << c.stop;
+    EXPECT_EQ(report.film->radiance, fresh.radiance) << c.stop;
+    EXPECT_EQ(report.film->bound, fresh.bound) << c.stop;
+    EXPECT_EQ(report.film->target_ratio, fresh.target_ratio) << c.stop;
+  }
+}
+
 }  // namespace
 }  // namespace pb
