@@ -27,9 +27,6 @@ namespace pb {
 
 namespace {
 
-// The most texels a texture may have (decode_image's message says 2^28).
-constexpr uint64_t kMaxTexels = uint64_t(1) << 28;
-
 // The most texels a whole read within `limit` can have: one float channel each.
 uint64_t max_texels(const ReadLimit& limit) { return limit.max_bytes / sizeof(float); }
 
@@ -147,8 +144,6 @@ void write_exr(const std::string& path, const ExrImage& image, ExrCompression co
       Imf::OutputFile file(tmp.c_str(), header, std::max(threads, 1));
       file.setFrameBuffer(frame);
       file.writePixels(image.height);
-    } catch (const ImageError&) {
-      throw;
     } catch (const std::exception& e) {
       throw ImageError(path + ": cannot write: " + one_line(e.what()));
     }

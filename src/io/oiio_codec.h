@@ -20,6 +20,10 @@ namespace pb {
 
 inline constexpr int kOiioCodecAbi = 1;
 
+// The most texels a texture may have (decode_image's messages say 2^28): the container walk in
+// image_io.cpp and the module's header check both hold images to it.
+inline constexpr uint64_t kMaxTexels = uint64_t(1) << 28;
+
 struct CodecFailure {
   enum class Kind { None, Image, TooLarge, FormatRefused };
   Kind kind = Kind::None;

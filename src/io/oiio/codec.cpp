@@ -24,9 +24,6 @@ namespace pb {
 
 namespace {
 
-// The most texels a texture may have (decode_image's message says 2^28).
-constexpr uint64_t kMaxTexels = uint64_t(1) << 28;
-
 // OpenImageIO 2.4's IOMemReader reads wherever it is told: an EXR whose chunk offset table holds
 // a negative offset made OpenEXR read before the buffer (ASan: heap-buffer-overflow in
 // IOMemReader::pread, found by tools/fuzz.sh image). This one reads only inside it.
