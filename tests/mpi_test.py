@@ -5,13 +5,15 @@ when the build found MPI. Each runs `mpirun --oversubscribe -np K photonbound ..
 
   mpi_test.py MODE --photonbound EXE --mpirun MPIRUN --scenes DIR
 
-  same-image   SPPM and PPM renders with 1, 2 and 3 ranks (one thread each) and the plain
+  same-image   SPPM and PPM renders (and SPPM with --adaptive paths) with 1, 2 and 3 ranks
+               (one thread each) and the plain
                binary give the same pixels bit for bit: each rank traces its own photons, every
                rank gathers from all of them in photon order, and each pixel's state is computed
                by one rank exactly as one process computes it
   target-stop  a --target-error render stops at the same pass, with the same stop line and
                image, on 2 ranks as in one process
-  resume       4 passes on 2 ranks, resumed on 3 ranks to 8, equal the plain 8-pass render
+  resume       4 passes on 2 ranks, resumed on 3 ranks to 8, equal the plain 8-pass render (and
+               with --adaptive paths, 18 on 2 ranks and 3 more on 3)
   failure      a rank killed mid-render ends the run with a non-zero exit and mpirun's line
                naming the rank, and the last checkpoint resumes in one process; SIGUSR1 to
                mpirun (which forwards it) stops a render as Ctrl-C stops one process: the pass
@@ -77,9 +79,12 @@ def ok(result, what):
 
 def same_image(r):
     cornell = os.path.join(r.scenes, "cornell.gltf")
-    for method, passes in (("sppm", 8), ("ppm", 6)):
+    # --adaptive paths allocates from pass 17 on (kPathsMinPasses) from every pixel's variances,
+    # each computed by the rank that owns the pixel and shared before the allocation.
+    for method, passes, adaptive in (("sppm", 8, "radius"), ("ppm", 6, "radius"),
+                                     ("sppm", 20, "radius,paths")):
         common = ["--resolution", "96x72", "--passes", str(passes), "--seed", "3", "--quiet",
-                  "--method", method]
+                  "--method", method, "--adaptive", adaptive]
         ok(r.plain("render", cornell, "-o", r.path("plain.exr"), *common), "plain render")
         want = pixels(r.path("plain.exr"))
         for k in (1, 2, 3):
@@ -87,7 +92,8 @@ def same_image(r):
             ok(r.ranks(k, "render", cornell, "-o", out, *common), f"-np {k} {method}")
             if pixels(out) != want:
                 sys.exit(f"{method}: -np {k} gives another image than one process")
-        print(f"{method}: -np 1, 2, 3 and the plain binary give the same pixels")
+        print(f"{method} --adaptive {adaptive}: -np 1, 2, 3 and the plain binary give the same "
+              "pixels")
 
 
 def stop_line(stderr):
@@ -117,16 +123,22 @@ def target_stop(r):
 
 def resume(r):
     cornell = os.path.join(r.scenes, "cornell.gltf")
-    common = ["--resolution", "96x72", "--seed", "3", "--quiet"]
-    state = r.path("s.pbstate")
-    ok(r.ranks(2, "render", cornell, "-o", r.path("r4.exr"), *common, "--passes", "4",
-               "--state", state), "-np 2 first 4 passes")
-    ok(r.ranks(3, "resume", state, "-o", r.path("r8.exr"), "--passes", "8", "--quiet"),
-       "-np 3 resume")
-    ok(r.plain("render", cornell, "-o", r.path("p8.exr"), *common, "--passes", "8"), "plain 8")
-    if pixels(r.path("r8.exr")) != pixels(r.path("p8.exr")):
-        sys.exit("2 ranks then 3 ranks resumed give another image than 8 passes in one process")
-    print("resume: 4 passes on 2 ranks + 4 on 3 ranks = 8 passes in one process")
+    # With paths, the state file holds every pixel's path history, which each rank keeps for
+    # the pixels it owns: the first part runs past pass 16, where the allocation begins.
+    for adaptive, first, total in (("radius", 4, 8), ("radius,paths", 18, 21)):
+        common = ["--resolution", "96x72", "--seed", "3", "--quiet", "--adaptive", adaptive]
+        state = r.path("s.pbstate")
+        ok(r.ranks(2, "render", cornell, "-o", r.path("r4.exr"), *common, "--passes",
+                   str(first), "--state", state), f"-np 2 first {first} passes")
+        ok(r.ranks(3, "resume", state, "-o", r.path("r8.exr"), "--passes", str(total),
+                   "--quiet"), "-np 3 resume")
+        ok(r.plain("render", cornell, "-o", r.path("p8.exr"), *common, "--passes", str(total)),
+           f"plain {total}")
+        if pixels(r.path("r8.exr")) != pixels(r.path("p8.exr")):
+            sys.exit(f"--adaptive {adaptive}: 2 ranks then 3 ranks resumed give another image "
+                     f"than {total} passes in one process")
+        print(f"resume, --adaptive {adaptive}: {first} passes on 2 ranks + {total - first} on 3 "
+              f"ranks = {total} passes in one process")
 
 
 def descends_from(pid, ancestor):
@@ -237,7 +249,7 @@ def failure(r):
     cornell = os.path.join(r.scenes, "cornell.gltf")
     res = r.ranks(2, "render", cornell, "-o", r.path("a.exr"), "--adaptive", "photons",
                   "--passes", "2", "--quiet")
-    if res.returncode == 0 or "do not run distributed yet" not in res.stderr:
+    if res.returncode == 0 or "does not run distributed yet" not in res.stderr:
         sys.exit(f"--adaptive photons on 2 ranks: exit {res.returncode}\n{res.stderr}")
     if os.path.exists(r.path("a.exr")):
         sys.exit("--adaptive photons on 2 ranks wrote an image")

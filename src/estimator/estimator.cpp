@@ -45,6 +45,11 @@ dvec3 pass_variance(const PointState& s, uint64_t passes, double photons_per_pas
   return slope_and_spread(s, double(passes), photons_per_pass).s2;
 }
 
+dvec3 pass_bias(const PointState& s, uint64_t passes, double photons_per_pass) {
+  if (passes < 2 || !(s.r2 > 0.0)) return dvec3(0.0);
+  return slope_and_spread(s, double(passes), photons_per_pass).a * s.mean_r2;
+}
+
 double ppm_radius_update(double& n, double& r2, double m, double alpha, double min_r2) {
   const double r2_pass = r2;
   double shrink = 1.0;

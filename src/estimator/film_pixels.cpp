@@ -38,6 +38,29 @@ dvec3 sparse_term(const PixelLayout& layout, const PointState& s, const dvec3& f
   return out;
 }
 
+}  // namespace
+
+dvec3 sppm_sparse_term(const PointState& s, const SppmPhotonCap& cap, uint64_t visible_passes,
+                       uint64_t passes, double confidence) {
+  if (visible_passes == 0 || s.photons >= kMinPhotonsForBound || !(cap.photon_cap > 0.0))
+    return dvec3(0.0);
+  // Lambertian points: the scene's largest Lambertian f over the pixel's smallest c; glossy
+  // points: the largest f / c any of them had.
+  const dvec3 f_over_c = glm::max(dvec3(cap.max_f) / std::max(double(cap.mass), kMinKernelMass),
+                                  dvec3(double(cap.glossy_f)));
+  // The pixel's estimate averages its samples over every pass, and a pass without a visible
+  // point has no photon part: the photon part's mean is at most k_v lambda_u / i times a
+  // photon's cap, with lambda_u the bound per visible pass (n photons in k_v such passes), so
+  // chi^2 / (2 i) times the cap, over all i passes (ESTIMATOR.md section 12).
+  dvec3 out;
+  for (int ch = 0; ch < 3; ++ch)
+    out[ch] = sparse_photon_bound(s.photons, passes, cap.photon_cap * f_over_c[ch] / (kPiD * s.r2),
+                                  confidence);
+  return out;
+}
+
+namespace {
+
 double kernel_mass(const PixelLayout& layout, size_t k) {
   return layout.mass.empty() ? 1.0 : std::max(double(layout.mass[k]), kMinKernelMass);
 }
@@ -68,16 +91,10 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
     // A pixel that never had a visible point has no photon part to wait for: its samples are
     // the emission along its paths, known from two passes on.
     const uint64_t visible = layout.visible_passes.empty() ? passes : layout.visible_passes[pixel];
-    // Lambertian points: the scene's largest Lambertian f over the pixel's smallest c; glossy
-    // points: the largest f / c any of them had.
-    dvec3 f_over_c = dvec3(layout.max_f) / kernel_mass(layout, pixel);
-    if (!layout.glossy_f.empty()) f_over_c = glm::max(f_over_c, dvec3(layout.glossy_f[pixel]));
-    // The pixel's estimate averages its samples over every pass, and a pass without a visible
-    // point has no photon part: the photon part's mean is at most k_v lambda_u / i times a
-    // photon's cap, with lambda_u the bound per visible pass (n photons in k_v such passes), so
-    // chi^2 / (2 i) times the cap, over all i passes (ESTIMATOR.md section 12).
-    r.sparse = visible == 0 ? dvec3(0.0)
-                            : sparse_term(layout, states[pixel], f_over_c, passes, confidence);
+    const SppmPhotonCap cap{layout.photon_cap, layout.max_f,
+                            layout.mass.empty() ? 1.0f : layout.mass[pixel],
+                            layout.glossy_f.empty() ? 0.0f : layout.glossy_f[pixel]};
+    r.sparse = sppm_sparse_term(states[pixel], cap, visible, passes, confidence);
     // Without the photon cap a state with few photons has no bound (unknown); a pixel that never
     // had a visible point has no photon part to wait for.
     r.photon_free = visible == 0;

@@ -31,6 +31,20 @@ struct PixelResult {
   bool known = true;
 };
 
+// ESTIMATOR.md section 12: what bounds one photon's share of an SPPM pixel's pass sample. Its
+// Lambertian points: the scene's largest Lambertian f over the smallest kernel mass they had;
+// its glossy points: the largest f / c they had (0: none).
+struct SppmPhotonCap {
+  double photon_cap = 0.0;  // PixelLayout::photon_cap
+  vec3 max_f{0.0f};
+  float mass = 1.0f;
+  float glossy_f = 0.0f;
+};
+// The sparse-photon term of an SPPM pixel's bound per channel after `passes` passes: 0 with
+// kMinPhotonsForBound photons or more, or without a visible point in any pass.
+dvec3 sppm_sparse_term(const PointState& s, const SppmPhotonCap& cap, uint64_t visible_passes,
+                       uint64_t passes, double confidence);
+
 // ESTIMATOR.md sections 5 and 10: every pixel's sums of its states.
 std::vector<PixelResult> combine_pixels(const PixelLayout& layout,
                                         const std::vector<PointState>& states, uint64_t passes,

@@ -14,6 +14,7 @@
 
 #include "estimator/estimator.h"
 #include "render/camera_pass.h"
+#include "render/exchange.h"
 #include "render/hash_grid.h"
 #include "render/next_event.h"
 #include "render/photon_guide.h"
@@ -156,6 +157,13 @@ struct PassInputs {
   double rays_per_photon = 2.0;
   // The chunks of states this process computes (the others are other ranks').
   Share share{};
+  // What bounds one photon's share of a sample (film.h's PixelLayout::photon_cap) and the
+  // bounds' confidence: --adaptive paths weighs the sparse-photon bound paths cannot lower.
+  double photon_cap = 0.0;
+  double confidence = 0.9;
+  // A distributed render's exchange (null in one process): --adaptive paths shares the
+  // pixels' variances, each computed by the rank that owns the pixel, before allocating.
+  Exchange* exchange = nullptr;
   // Whether a chunk of the fold block starting at `first` should give up: only the first block
   // can (the later ones come after a fold).
   bool cut(size_t first) const { return first == 0 && cutoff && cutoff->reached(); }

@@ -54,10 +54,17 @@ inline constexpr double kPhotonNoise = 287.0 / 132.0;
 // The two parts of a pixel's per-pass variance (summed over the channels) for one path, and
 // what one of its paths costs, from its state after `passes` passes and its history.
 struct PathVariance {
-  double camera = 0.0;  // V_cam
-  double photon = 0.0;  // V_ph at the radius of the next pass
-  double cost = 1.0;    // a path's cost in photon rays
+  float camera = 0.0f;  // V_cam
+  float photon = 0.0f;  // V_ph at the radius of the next pass
+  float cost = 1.0f;    // a path's cost in photon rays
+  // The pixel's share of the image's predicted mean error (summed over the channels) at the
+  // horizon below: its noise, sqrt(2 / pi) S / sqrt(i) (the mean of |sigma Z|), and what paths
+  // cannot lower, beta O: its bias |B| times the rate beta at which it falls with the passes,
+  // beta = -d ln mean_j(R_j^2) / d ln i, plus its sparse-photon term (sparse_at_horizon, beta 1).
+  float noise = 0.0f;
+  float settled = 0.0f;
 };
+static_assert(sizeof(PathVariance) == 20, "20 bytes a pixel during the allocation");
 PathVariance path_variance(const PointState& state, uint64_t passes, double photons_per_pass,
                            const PathHistory& history, const PathCosts& costs);
 
@@ -66,17 +73,32 @@ PathVariance path_variance(const PointState& state, uint64_t passes, double phot
 // to the nearest integer.
 int paths_for(const PathVariance& v, double g);
 
+// The image's error that more paths cannot lower, against the part they can (ESTIMATOR.md
+// section 15): a render to a target stops when its noise N and the rest O reach it, and O (the
+// bias, the sparse-photon bound) falls as passes^-beta whatever the paths, so the time to the
+// target is least at K^2 sd(K) = V_cam g / (cost (1 + 2 beta O / N)). Returns 2 beta O / N
+// over the pixels (+inf where no pixel has noise, 0 where nothing else).
+double settled_share(std::span<const PathVariance> v);
+
+// The parts are weighed where the render will be, not where it is: at this many times the
+// passes done (a render to a target goes on for about as long as it has run when it is not
+// there yet). By then a pixel's photons have doubled: a sparse pixel of n >= 3 photons has left
+// the sparse-photon bound, and one of fewer keeps half its term (it falls as 1 / i).
+inline constexpr double kPathsHorizon = 2.0;
+double sparse_at_horizon(const PointState& state, const dvec3& sparse_term);
+
 // What choose_paths works in, kept across passes so that a steady pass allocates nothing.
 struct PathScratch {
   std::vector<PathVariance> variance;
   std::vector<double> chunk_sd, chunk_cost;
 };
 
-// paths[p] for every pixel from states[p] and history[p] (the next pass's numbers): 1 before
-// kPathsMinPasses passes. The image-wide g is found by a few rounds that alternate it with
-// the numbers; sums are taken in a fixed order, so the result does not depend on the threads.
-void choose_paths(std::span<const PointState> states, std::span<const PathHistory> history,
-                  uint64_t passes, double photons_per_pass, const PathCosts& costs,
-                  std::span<uint8_t> paths, PathScratch& scratch);
+// paths[p] for every pixel from v[p] = path_variance of its state and history, with its
+// sparse part (the next pass's numbers): 1 before kPathsMinPasses passes. The image-wide g is
+// found by a few rounds that alternate it with the numbers, and divided by 1 + settled_share;
+// sums are taken in a fixed order, so the result does not depend on the threads (nor on the
+// ranks, which share v before).
+void choose_paths(std::span<const PathVariance> v, uint64_t passes, double photons_per_pass,
+                  const PathCosts& costs, std::span<uint8_t> paths, PathScratch& scratch);
 
 }  // namespace pb

@@ -101,10 +101,10 @@ FilmSettings Renderer::film_settings() const {
 
 void Renderer::distribute(Exchange* exchange) {
   if (exchange && exchange->ranks() > 1) {
-    if (options_.adaptive_photons || options_.adaptive_paths)
+    if (options_.adaptive_photons)
       throw std::invalid_argument(
-          "--adaptive photons and --adaptive paths do not run distributed yet (they need every "
-          "state on every rank); run them in one process, or without mpirun");
+          "--adaptive photons does not run distributed yet (its learning needs every state on "
+          "every rank); run it in one process, or without mpirun");
     exchange_ = exchange;
   } else {
     exchange_ = nullptr;
@@ -185,7 +185,10 @@ bool Renderer::step(std::vector<PointState>* copy, const Cutoff* cutoff) {
                         cutoff,
                         learn,
                         work_.photons > 0 ? double(work_.rays) / double(work_.photons) : 2.0,
-                        exchange_ ? Share{exchange_->rank(), exchange_->ranks()} : Share{}};
+                        exchange_ ? Share{exchange_->rank(), exchange_->ranks()} : Share{},
+                        kPeakWeight * max_photon_power_ / double(options_.photons_per_pass),
+                        options_.confidence,
+                        exchange_};
     // A distributed pass copies after collecting (below): the copy needs every rank's states.
     const bool whole =
         method_->step(in, states_, radii_, copy && !exchange_ ? copy->data() : nullptr);

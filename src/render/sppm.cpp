@@ -1,5 +1,6 @@
 #include "render/sppm.h"
 
+#include "estimator/film_pixels.h"
 #include "estimator/path_mean.h"
 
 #include <algorithm>
@@ -58,8 +59,24 @@ bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
   if (settings_.adaptive_paths) {
     PathCosts costs;
     costs.rays_per_photon = in.rays_per_photon;
-    choose_paths(states, history_, in.pass - 1, in.params.photons_per_pass, costs, paths_,
-                 path_scratch_);
+    const uint64_t done = in.pass - 1;
+    std::vector<PathVariance>& v = path_scratch_.variance;
+    v.resize(n);
+    if (done >= kPathsMinPasses) {
+      // Each pixel's variances by the rank that owns its state (the others' are stale there),
+      // then every rank has them all and allocates alike.
+      for_each_chunk(n, [&](size_t at, size_t m) {
+        if (!in.share.owns(at)) return;
+        for (size_t p = at; p < at + m; ++p) {
+          v[p] = path_variance(states[p], done, in.params.photons_per_pass, history_[p], costs);
+          const SppmPhotonCap cap{in.photon_cap, max_f_, min_mass_[p], glossy_f_[p]};
+          v[p].settled += float(sparse_at_horizon(
+              states[p], sppm_sparse_term(states[p], cap, visible_[p], done, in.confidence)));
+        }
+      });
+      if (in.exchange) in.exchange->share_owned(v.data(), sizeof(PathVariance), n, true);
+    }
+    choose_paths(v, done, in.params.photons_per_pass, costs, paths_, path_scratch_);
   }
   for (size_t first = 0; first < n; first += block) {
     const size_t count = std::min(block, n - first);

@@ -30,9 +30,12 @@ class SppmMethod final : public PhotonMethod {
   void save(RenderState& s) const override;
   void restore(const RenderState& s) override;
   std::vector<SideArray> side_arrays() override {
-    return {{visible_.data(), sizeof(uint32_t)},
-            {min_mass_.data(), sizeof(float)},
-            {glossy_f_.data(), sizeof(float)}};
+    std::vector<SideArray> a{{visible_.data(), sizeof(uint32_t)},
+                             {min_mass_.data(), sizeof(float)},
+                             {glossy_f_.data(), sizeof(float)}};
+    // --adaptive paths: each pixel's path history, kept by the rank that owns it.
+    if (!history_.empty()) a.push_back({history_.data(), sizeof(PathHistory)});
+    return a;
   }
   PixelLayout layout(const std::vector<PointState>& states,
                      const RenderState* saved) const override;
