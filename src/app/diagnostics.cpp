@@ -95,10 +95,9 @@ std::vector<std::string> option_diagnostics(const RenderOptions& options) {
     lines.push_back(
         "photonbound: warning: with --adaptive paths and --bias-model laplacian the mean-error "
         "stop is not calibrated at tight targets (docs/error-bounds.md): use --bias-model "
-        "two-scale, the default, or --adaptive radius");
-  // PPM's visible points are fixed by its one camera pass: there are no paths to add. The
-  // default has paths for SPPM; only a user who asked for them is told.
-  if (options.adaptive_paths && options.adaptive_given && options.method == Method::PPM)
+        "two-scale, the default");
+  // PPM's visible points are fixed by its one camera pass: there are no paths to add.
+  if (options.adaptive_paths && options.method == Method::PPM)
     lines.push_back(
         "photonbound: warning: --adaptive paths does nothing here: PPM traces its camera paths "
         "once (--method sppm traces them every pass)");

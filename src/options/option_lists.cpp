@@ -143,8 +143,7 @@ OptionSpec asset_dirs() {
 }
 
 // --adaptive LIST: a comma list of the parts that follow the error estimates: `radius`
-// (ESTIMATOR.md section 13), `photons` (section 14) and `paths` (section 15); the default is
-// radius,paths.
+// (ESTIMATOR.md section 13, the default), `photons` (section 14) and `paths` (section 15).
 OptionSpec adaptive() {
   OptionSpec s = base("--adaptive", "adaptive", "LIST", "rendering", OptionKind::Image,
                       "comma list of what follows each pixel's error estimates: radius (each "
@@ -172,7 +171,6 @@ OptionSpec adaptive() {
     o.adaptive_radius = radius;
     o.adaptive_photons = photons;
     o.adaptive_paths = paths;
-    o.adaptive_given = true;
   };
   s.check = [](const RenderOptions&) {};
   s.format = [](const RenderOptions& o) -> std::string {
@@ -186,7 +184,6 @@ OptionSpec adaptive() {
     o.adaptive_radius = RenderOptions{}.adaptive_radius;
     o.adaptive_photons = RenderOptions{}.adaptive_photons;
     o.adaptive_paths = RenderOptions{}.adaptive_paths;
-    o.adaptive_given = false;
   };
   s.accepted = {"radius",         "none",  "radius,radius",       "photons",
                 "photons,radius", "paths", "paths,radius,photons"};

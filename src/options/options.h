@@ -57,13 +57,11 @@ struct RenderOptions {
   double alpha = 0.7;
   // --adaptive: which parts of the render follow each pixel's own error estimates
   // (ESTIMATOR.md sections 13-15); none = every point on the PPM schedule, every photon
-  // emitted in proportion to power. The radius and the paths are the default: together they
-  // reached every measured target as soon or sooner, or within 5% (sections 13 and 15,
-  // "Measured"). Paths are SPPM's: PPM traces its camera paths once and leaves them out.
+  // emitted in proportion to power. The radius is the default: it reached every measured
+  // target as soon or sooner (section 13, "Measured").
   bool adaptive_radius = true;
   bool adaptive_photons = false;
-  bool adaptive_paths = true;    // SPPM: section 15
-  bool adaptive_given = false;   // --adaptive was given (PPM warns only then about paths)
+  bool adaptive_paths = false;   // SPPM: section 15
   std::optional<double> radius;  // world units; default from the pixel footprint
   // --bias-model (ESTIMATOR.md section 6c): the bounds' bias with the two scales' fourth-order
   // part, or the Laplacian's second-order part alone (HJJ10). Never changes the image.

@@ -63,6 +63,7 @@ double settled_share(std::span<const PathVariance> v) {
   // In pixel order: the same sums for any threads.
   double noise = 0.0, settled = 0.0;
   for (const PathVariance& p : v) {
+    if (std::isnan(p.noise) || std::isnan(p.settled)) continue;  // nothing known of the pixel
     noise += double(p.noise);
     settled += double(p.settled);
   }

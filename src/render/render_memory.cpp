@@ -36,9 +36,8 @@ std::string MemoryEstimate::text() const {
   return t + ", " + bytes_text(baseline) + " for the program)";
 }
 
-// --adaptive paths (sppm.h, path_allocation.h; in the default): a pixel's number of paths (1
-// byte), its history (12) and the allocation's variance model during a pass (20), counted, not
-// measured.
+// --adaptive paths (sppm.h, path_allocation.h): a pixel's number of paths (1 byte), its
+// history (12) and the allocation's variance model during a pass (20), counted, not measured.
 constexpr uint64_t kPathPixelBytes = 33;
 
 MemoryEstimate estimate_render_memory(const RenderOptions& o, uint64_t width, uint64_t height,

@@ -67,16 +67,6 @@ TEST_F(Cli, WarnsWhereAdaptivePathsDoesNothingOrIsUncalibrated) {
   Outcome r = run(base + " --method ppm --adaptive paths");
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.err.find("warning: --adaptive paths does nothing here"), std::string::npos) << r.err;
-  // The default has paths (SPPM's); PPM leaves them out without a word when nobody asked.
-  r = run(base + " --method ppm");
-  EXPECT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
-  r = run(base + " --target-error 0.5 --bias-model laplacian");
-  EXPECT_EQ(r.code, 0) << r.err;
-  EXPECT_NE(r.err.find("mean-error stop is not calibrated"), std::string::npos) << r.err;
-  r = run(base + " --target-error 0.5 --bias-model laplacian --adaptive radius");
-  EXPECT_EQ(r.code, 0) << r.err;
-  EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;
   r = run(base + " --adaptive paths");
   EXPECT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(r.err.find("warning"), std::string::npos) << r.err;

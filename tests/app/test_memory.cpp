@@ -38,11 +38,10 @@ class Memory : public pb::test::TempDirTest {
 };
 
 TEST_F(Memory, AResolutionBeyondTheLimitIsRefusedBeforeTheSceneLoads) {
-  // 16384^2 pixels at about 673 bytes each (640, and 33 for the default's camera paths): 168
-  // GiB. It ran for 9 s and ended with a bare "std::bad_alloc"; --max-memory is given so that
-  // the machine's size does not matter.
+  // 16384^2 pixels at about 640 bytes each: 160 GiB. It ran for 9 s and ended with a bare
+  // "std::bad_alloc"; --max-memory is given so that the machine's size does not matter.
   expect_refused(render("--resolution 16384x16384 --max-memory 64G"),
-                 {"photonbound: the render needs about 168 GiB (168 GiB for 268435456 pixels",
+                 {"photonbound: the render needs about 160 GiB (160 GiB for 268435456 pixels",
                   "over the 64 GiB of --max-memory; lower --resolution or --photons-per-pass"});
 }
 

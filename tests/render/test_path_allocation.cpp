@@ -100,6 +100,10 @@ TEST(PathAllocation, ErrorThatPathsCannotLowerBuysFewerPaths) {
   // 2 beta O / N: the noises sum to 0.64, a sparse term of 3.2 (beta 1) gives 10.
   v[9].settled = 3.2f;
   EXPECT_NEAR(settled_share(v), 10.0, 1e-5);
+  // A pixel of which nothing is known (NaN) weighs nothing either way.
+  std::vector<PathVariance> with_nan = v;
+  with_nan.push_back(PathVariance{1.0f, 1.0f, 3.3f, std::nanf(""), 1.0f});
+  EXPECT_NEAR(settled_share(with_nan), 10.0, 1e-5);
   choose_paths(v, kPathsMinPasses, 1000.0, PathCosts{}, with, scratch);
   EXPECT_LT(with[5], alone[5]);
   for (size_t p = 0; p < v.size(); ++p) EXPECT_LE(with[p], alone[p]);
