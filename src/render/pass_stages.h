@@ -157,10 +157,9 @@ struct PassInputs {
   double rays_per_photon = 2.0;
   // The chunks of states this process computes (the others are other ranks').
   Share share{};
-  // What bounds one photon's share of a sample (film.h's PixelLayout::photon_cap) and the
-  // bounds' confidence: --adaptive paths weighs the sparse-photon bound paths cannot lower.
+  // What bounds one photon's share of a sample (film.h's PixelLayout::photon_cap): --adaptive
+  // paths weighs the sparse-photon bound, which paths cannot lower.
   double photon_cap = 0.0;
-  double confidence = 0.9;
   // A distributed render's exchange (null in one process): --adaptive paths shares the
   // pixels' variances, each computed by the rank that owns the pixel, before allocating.
   Exchange* exchange = nullptr;

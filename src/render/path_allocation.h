@@ -85,6 +85,10 @@ double settled_share(std::span<const PathVariance> v);
 // there yet). By then a pixel's photons have doubled: a sparse pixel of n >= 3 photons has left
 // the sparse-photon bound, and one of fewer keeps half its term (it falls as 1 / i).
 inline constexpr double kPathsHorizon = 2.0;
+// The sparse-photon term is weighed at this confidence whatever --confidence says: an option a
+// resume may change (it only adjusts the stop and the report) must not change which paths are
+// traced, and so the image.
+inline constexpr double kPathsConfidence = 0.9;
 double sparse_at_horizon(const PointState& state, const dvec3& sparse_term);
 
 // What choose_paths works in, kept across passes so that a steady pass allocates nothing.

@@ -187,7 +187,6 @@ bool Renderer::step(std::vector<PointState>* copy, const Cutoff* cutoff) {
                         work_.photons > 0 ? double(work_.rays) / double(work_.photons) : 2.0,
                         exchange_ ? Share{exchange_->rank(), exchange_->ranks()} : Share{},
                         kPeakWeight * max_photon_power_ / double(options_.photons_per_pass),
-                        options_.confidence,
                         exchange_};
     // A distributed pass copies after collecting (below): the copy needs every rank's states.
     const bool whole =

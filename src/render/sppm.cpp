@@ -71,7 +71,7 @@ bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
           v[p] = path_variance(states[p], done, in.params.photons_per_pass, history_[p], costs);
           const SppmPhotonCap cap{in.photon_cap, max_f_, min_mass_[p], glossy_f_[p]};
           v[p].settled += float(sparse_at_horizon(
-              states[p], sppm_sparse_term(states[p], cap, visible_[p], done, in.confidence)));
+              states[p], sppm_sparse_term(states[p], cap, visible_[p], done, kPathsConfidence)));
         }
       });
       if (in.exchange) in.exchange->share_owned(v.data(), sizeof(PathVariance), n, true);

@@ -87,6 +87,31 @@ TEST_F(Checkpoints, ResumeIsBitIdenticalWithAdaptivePaths) {
   EXPECT_THROW(plain.restore(s.render), StateError);
 }
 
+// --confidence is an option a resume may change (it adjusts the stop and the report): the
+// paths' allocation, which weighs the sparse-photon bound at a confidence, must not follow it,
+// or the resumed image would not be the uninterrupted one's. The caustic's floor has pixels
+// with 0-2 photons (with the allocation following --confidence, 0.5 moved this image by 8e-5
+// in the mean).
+TEST_F(Checkpoints, ConfidenceDoesNotChangeWhichPathsAreTraced) {
+  RenderOptions o = test::quick_options("caustic.gltf", 32, 20);
+  o.photons_per_pass = 10000;
+  o.method = Method::SPPM;
+  o.adaptive_paths = true;
+  const Scene scene = load_gltf(o.scene);
+  Renderer a(scene, o);
+  o.confidence = 0.5;
+  Renderer b(scene, o);
+  for (int k = 0; k < 20; ++k) {
+    a.step();
+    b.step();
+  }
+  ASSERT_EQ(a.states().size(), b.states().size());
+  for (size_t k = 0; k < a.states().size(); ++k) {
+    ASSERT_EQ(a.states()[k].mean_x, b.states()[k].mean_x) << "state " << k;
+    ASSERT_EQ(a.states()[k].r2, b.states()[k].r2) << "state " << k;
+  }
+}
+
 // Checkpoints written on the background thread: each snapshot is the render exactly as one pass
 // left it (its states equal a render stepped to that pass), checkpointing does not change the
 // render, and resuming from any snapshot finishes bit-identical to the uninterrupted render.
