@@ -40,14 +40,10 @@ double relative_error(const PointState& s, uint64_t passes, double photons_per_p
   return std::isfinite(r) ? std::min(r, 1.0) : 1.0;
 }
 
-dvec3 pass_variance(const PointState& s, uint64_t passes, double photons_per_pass) {
-  if (passes < 2 || !(s.r2 > 0.0)) return dvec3(0.0);
-  return slope_and_spread(s, double(passes), photons_per_pass).s2;
-}
-
-dvec3 pass_bias(const PointState& s, uint64_t passes, double photons_per_pass) {
-  if (passes < 2 || !(s.r2 > 0.0)) return dvec3(0.0);
-  return slope_and_spread(s, double(passes), photons_per_pass).a * s.mean_r2;
+PassSpread pass_spread(const PointState& s, uint64_t passes, double photons_per_pass) {
+  if (passes < 2 || !(s.r2 > 0.0)) return {};
+  const SlopeAndSpread r = slope_and_spread(s, double(passes), photons_per_pass);
+  return {r.s2, r.a * s.mean_r2};
 }
 
 double ppm_radius_update(double& n, double& r2, double m, double alpha, double min_r2) {

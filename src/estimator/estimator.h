@@ -133,12 +133,15 @@ double cost_r2_factor(const PointState& state, uint64_t passes, double photons_p
 // photon guide weighs what a photon brings to the point by it (ESTIMATOR.md section 14).
 double relative_error(const PointState& state, uint64_t passes, double photons_per_pass);
 
-// S^2 per channel: the variance of one pass's sample X_j after the retroactive bias correction
-// (section 4), 0 before 2 passes. The camera-path allocation (section 15) splits it.
-dvec3 pass_variance(const PointState& state, uint64_t passes, double photons_per_pass);
-// B per channel, a mean_j(R_j^2) of section 3 (estimate's bias without the fourth-order part),
-// 0 before 2 passes. The camera-path allocation weighs the error paths cannot lower by it.
-dvec3 pass_bias(const PointState& state, uint64_t passes, double photons_per_pass);
+// Per channel, 0 before 2 passes: S^2, the variance of one pass's sample X_j after the
+// retroactive bias correction (section 4), and B = a mean_j(R_j^2) (section 3; estimate's bias
+// without the fourth-order part). The camera-path allocation (section 15) splits the first and
+// weighs the error paths cannot lower by the second.
+struct PassSpread {
+  dvec3 variance{0.0};
+  dvec3 bias{0.0};
+};
+PassSpread pass_spread(const PointState& state, uint64_t passes, double photons_per_pass);
 
 // The PPM radius update (HOJ08; ESTIMATOR.md section 3) for m photons that could contribute:
 // R^2 *= (N + alpha m) / (N + m), N += alpha m, R^2 floored at min_r2. Returns the factor R^2

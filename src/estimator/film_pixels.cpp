@@ -28,13 +28,14 @@ void count_slopes(PixelResult& r, const PointEstimate& e) {
 // SPPM (section 10): one state per pixel, whose samples carry the emission seen along the path.
 // The bound of a state's photon part while it has fewer than kMinPhotonsForBound photons.
 // `f_over_c`: the largest f / c a photon's pass sample can carry (f the BRDF, c the kernel mass).
-dvec3 sparse_term(const PixelLayout& layout, const PointState& s, const dvec3& f_over_c,
+// `photon_cap`: PixelLayout::photon_cap.
+dvec3 sparse_term(double photon_cap, const PointState& s, const dvec3& f_over_c,
                   uint64_t passes_with_point, double confidence) {
-  if (s.photons >= kMinPhotonsForBound || !(layout.photon_cap > 0.0)) return dvec3(0.0);
+  if (s.photons >= kMinPhotonsForBound || !(photon_cap > 0.0)) return dvec3(0.0);
   dvec3 out;
   for (int ch = 0; ch < 3; ++ch)
     out[ch] = sparse_photon_bound(s.photons, passes_with_point,
-                                  layout.photon_cap * f_over_c[ch] / (kPiD * s.r2), confidence);
+                                  photon_cap * f_over_c[ch] / (kPiD * s.r2), confidence);
   return out;
 }
 
@@ -42,8 +43,7 @@ dvec3 sparse_term(const PixelLayout& layout, const PointState& s, const dvec3& f
 
 dvec3 sppm_sparse_term(const PointState& s, const SppmPhotonCap& cap, uint64_t visible_passes,
                        uint64_t passes, double confidence) {
-  if (visible_passes == 0 || s.photons >= kMinPhotonsForBound || !(cap.photon_cap > 0.0))
-    return dvec3(0.0);
+  if (visible_passes == 0) return dvec3(0.0);
   // Lambertian points: the scene's largest Lambertian f over the pixel's smallest c; glossy
   // points: the largest f / c any of them had.
   const dvec3 f_over_c = glm::max(dvec3(cap.max_f) / std::max(double(cap.mass), kMinKernelMass),
@@ -52,11 +52,7 @@ dvec3 sppm_sparse_term(const PointState& s, const SppmPhotonCap& cap, uint64_t v
   // point has no photon part: the photon part's mean is at most k_v lambda_u / i times a
   // photon's cap, with lambda_u the bound per visible pass (n photons in k_v such passes), so
   // chi^2 / (2 i) times the cap, over all i passes (ESTIMATOR.md section 12).
-  dvec3 out;
-  for (int ch = 0; ch < 3; ++ch)
-    out[ch] = sparse_photon_bound(s.photons, passes, cap.photon_cap * f_over_c[ch] / (kPiD * s.r2),
-                                  confidence);
-  return out;
+  return sparse_term(cap.photon_cap, s, f_over_c, passes, confidence);
 }
 
 namespace {
@@ -117,8 +113,9 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
     if (r.exact) r.radius = float(std::sqrt(states[k].r2));
     r.exact = false;
     if (!layout.point_f.empty())
-      r.sparse += sparse_term(layout, states[k], dvec3(layout.point_f[k]) / kernel_mass(layout, k),
-                              passes, confidence);
+      r.sparse +=
+          sparse_term(layout.photon_cap, states[k],
+                      dvec3(layout.point_f[k]) / kernel_mass(layout, k), passes, confidence);
     r.known = r.known && passes >= 2 && (e.known || layout.photon_cap > 0.0) &&
               (layout.mass.empty() || layout.mass[k] >= kValidKernelMass);
   }

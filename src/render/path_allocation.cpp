@@ -17,7 +17,7 @@ PathVariance path_variance(const PointState& s, uint64_t passes, double photons_
       !(s.mean_r2 > 0.0))
     return v;
   const double i = double(passes);
-  const dvec3 s2 = pass_variance(s, passes, photons_per_pass);
+  const auto [s2, bias] = pass_spread(s, passes, photons_per_pass);
   const double total = s2.x + s2.y + s2.z;
   // Photons per path and pass, averaged over the passes (the state counts the first path's).
   const double per_path = double(s.photons) / i;
@@ -38,7 +38,6 @@ PathVariance path_variance(const PointState& s, uint64_t passes, double photons_
   // (R_i^2 - mean) / i a pass, so B ~ mean_j(R_j^2) falls as i^-beta, beta = 1 - R_i^2 / mean.
   // B's own noise (section 6b) is not bias: only B^2 - Var(B) counts. Both parts are taken at
   // twice the passes done (kPathsHorizon), where a render that goes on spends most of its time.
-  const dvec3 bias = pass_bias(s, passes, photons_per_pass);
   const double beta = std::clamp(1.0 - s.r2 / s.mean_r2, 0.0, 1.0);
   const double shrink2 = (s.mean_r2 / s.r2) * (s.mean_r2 / s.r2);
   double b = 0.0, sd = 0.0;
