@@ -306,6 +306,11 @@ void rules_table(int seeds, int other_seeds) {
           // PB_STUDY_CONFIDENCE (0.5, 0.9 or 0.95) keeps one confidence's rows.
           if (const char* c = std::getenv("PB_STUDY_CONFIDENCE"); c && std::atof(c) != confidence)
             continue;
+          // PB_STUDY_TARGET (a number) replaces the scene's targets by that one.
+          if (const char* e = std::getenv("PB_STUDY_TARGET")) {
+            if (target != sc.targets[0]) continue;
+            target = std::atof(e);
+          }
           int within = 0;
           double ratio = 0.0, passes = 0.0, seconds = 0.0, pixels_within = 0.0;
           for (int seed = 1; seed <= n_seeds; ++seed) {
@@ -321,7 +326,7 @@ void rules_table(int seeds, int other_seeds) {
             Renderer r(scene, o);
             const RenderReport report = test::run_to_stop(r);
             FilmImage img;
-            r.develop(&img);
+            const FilmSummary summary = r.develop(&img);
             // Per pixel-channel truth: the reference's, or the exact answer (grey; NaN where a
             // pixel has no point, which is exact and left out, as `compare` does).
             std::vector<double> truth = ref.value;
@@ -346,6 +351,12 @@ void rules_table(int seeds, int other_seeds) {
               px += 1.0;
             }
             const double actual = sum / std::max(n, 1.0);
+            // PB_STUDY_RUNS=1: each run's stop pass, predicted mean error and its upper limit
+            // against the actual (which holds the reference's own error, section 15).
+            if (std::getenv("PB_STUDY_RUNS"))
+              std::printf("  seed %d: %llu passes, predicted %.5f (upper %.5f), actual %.5f\n",
+                          seed, (unsigned long long)report.work.passes, summary.predicted_error,
+                          summary.predicted_error_upper, actual);
             within += actual <= target;
             ratio += target / actual / n_seeds;
             pixels_within += px_in / std::max(px, 1.0) / n_seeds;
