@@ -265,7 +265,8 @@ void cornell_table(int seeds) {
 // pass are chosen so that even the largest target needs a few times --min-passes (16) passes:
 // a run that stops at its first test has had no chance to stop late.
 // `rules [ppm|sppm] SEEDS OTHER_SEEDS`: SEEDS for mean-error (default 20), OTHER_SEEDS for the
-// two others (default SEEDS); PB_STUDY_RULE and PB_STUDY_SCENE select one rule or scene.
+// two others (default SEEDS); PB_STUDY_RULE and PB_STUDY_SCENE select one rule or scene,
+// PB_STUDY_TARGET one target, and PB_STUDY_RUNS=1 prints every run (section 15 of ESTIMATOR.md).
 void rules_table(int seeds, int other_seeds) {
   std::printf("### Stop rules (%s; mean-error %d seeds per row, the other rules %d)\n\n",
               g_method == Method::PPM ? "PPM" : "SPPM", seeds, other_seeds);
