@@ -91,7 +91,7 @@ double normal_quantile(double p) {
 
 // ESTIMATOR.md section 6b: the prior of the bias, by summed-area tables over the window.
 std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, int width,
-                              int height, double noise_factor) {
+                              int height, double noise_factor, double own_factor) {
   const SummedArea<dvec3> b2(width, height, [&](size_t p) {
     const BiasEstimate e = pixel(p);
     return e.use ? e.bias * e.bias : dvec3(0.0);
@@ -110,9 +110,15 @@ std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, 
         const size_t xb = std::min(x + kPriorWindow + 1, size_t(width));
         const size_t yb = std::min(y + kPriorWindow + 1, size_t(height));
         const double count = n.box(xa, ya, xb, yb);
+        const size_t p = y * size_t(width) + x;
         if (count > 0.0)
-          tau2[y * size_t(width) + x] = glm::max(
+          tau2[p] = glm::max(
               dvec3(0.0), (b2.box(xa, ya, xb, yb) - noise_factor * v.box(xa, ya, xb, yb)) / count);
+        // The floor (section 6b): a lone bias that stands out of its own noise keeps at
+        // least its own size, however small its window's others are.
+        if (own_factor <= 0.0) continue;
+        if (const BiasEstimate e = pixel(p); e.use)
+          tau2[p] = glm::max(tau2[p], e.bias * e.bias - own_factor * noise_factor * e.variance);
       }
   });
   return tau2;

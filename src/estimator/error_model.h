@@ -47,12 +47,25 @@ struct BiasEstimate {
 // of the true bias around 0, estimated over the (2 kPriorWindow + 1)^2 window of the pixels in
 // use as mean(B^2) - mean(Var B) (the estimates' own noise taken out), never below 0.
 inline constexpr int kPriorWindow = 4;
+// The floor under a window's tau^2 from the pixel's own estimate: tau^2 >= B^2 - k' k Var B
+// with k' = kPriorOwnFactor (and the prior's noise factor k). A contact shadow is a few biased
+// pixels in a window of 81 whose others are near 0, and the window alone shrinks their bias
+// toward 0; with the noise beside it lowered by `--adaptive paths` that bias is most of the
+// error, and the mean-error stop was 7-8% low (14 of 20 within at 90% on the Cornell box). A
+// pixel's own B counts only beyond about sqrt(5) of its sds (a chi-square of 1 beyond 5: 2.5%
+// of pure noise), so that where the bias is noise the window still decides. Measured in
+// section 6b's table: k' = 5 calibrates `radius,paths` (16-20 of 20 within at 90%) for 1-6% more
+// passes where the window alone was already calibrated. Only with `--adaptive paths`
+// (FilmSettings::prior_floor): without them the window alone keeps the stop calibrated, and
+// the floor cost the plane, the indirect room and the caustic a stop test's worth of passes.
+inline constexpr double kPriorOwnFactor = 5.0;
 // `pixel(p)` gives pixel p's estimate (read in place: a copy of the image's estimates would
 // raise a render's peak memory by 56 bytes per pixel).
 // `noise_factor` k: tau^2 = max(0, mean(B^2) - k mean(Var B)); k > 1 asks the window's
 // estimates to stand out of their noise before any of it counts as bias (section 6c).
+// `own_factor` k': the floor tau^2 >= B^2 - k' k Var B of the pixel's own estimate; 0: none.
 std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, int width,
-                              int height, double noise_factor = 1.0);
+                              int height, double noise_factor = 1.0, double own_factor = 0.0);
 // The noise factor of the fourth-order bias's prior (section 6c). Where the radiance is smooth
 // B4 is noise, and with k = 1 tau4^2 is still positive in about half of the windows:
 // mean(B4^2) / mean(V4) over a window's 81 pixels has an sd of sqrt(2 K / 81) under the null,

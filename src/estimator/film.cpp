@@ -213,8 +213,9 @@ FilmSummary develop(const PixelLayout& layout, const std::vector<PointState>& st
   sum.relative_floor = relative_floor(results);
   if (image) prepare_image(*image, layout.width, layout.height);
   check_model(results, sum);
-  if (s.bias_model == BiasModel::TwoScale) shrink_fourth(results, layout.width, layout.height);
-  const std::vector<dvec3> tau2 = prior_of(results, layout.width, layout.height);
+  if (s.bias_model == BiasModel::TwoScale)
+    shrink_fourth(results, layout.width, layout.height, s.prior_floor);
+  const std::vector<dvec3> tau2 = prior_of(results, layout.width, layout.height, s.prior_floor);
   const BoundRule rule(passes, s, sum.relative_floor);
   Tally tally(pixels);
   // Over fixed chunks of pixels on every thread, their sums added in chunk order: the summary

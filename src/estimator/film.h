@@ -68,6 +68,9 @@ struct FilmSettings {
   double target = 0.0;         // 0 = no target
   double stop_fraction = 0.9;  // the share of pixels pixel_quantile_bound is taken at
   BiasModel bias_model = BiasModel::TwoScale;
+  // The bias priors' floor from each pixel's own estimate (ESTIMATOR.md section 6b): on with
+  // SPPM's `--adaptive paths`, whose lowered noise uncovers the biases a window shrinks.
+  bool prior_floor = false;
 };
 
 // Each PPM point's W_k f (render/camera_pass.h, VisiblePoint::f) read in place from the

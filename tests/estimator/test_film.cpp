@@ -160,4 +160,59 @@ TEST(BiasPrior, AWindowOfNoiseCountsAsBiasOnlyBeyondTheNoiseFactor) {
     for (const dvec3& t : prior(biased, k)) EXPECT_GT(bias_shrinkage(t.x, 1.0), 0.85);
 }
 
+// The floor of the pixel's own estimate (ESTIMATOR.md section 6b, kPriorOwnFactor), as
+// --adaptive paths takes it. A contact shadow: 4 pixels of bias 6 (B = 6 + N(0, 1)) in a field
+// of noise. The window holds 81 pixels, so its tau^2 is about (4 x 37 + 77) / 81 - 1 = 1.8 and
+// shrinks their bias by w of about 0.64; the floor keeps tau^2 >= B^2 - 5, w = (B^2 - 5) /
+// (B^2 - 4) of about 0.97 at B = 6 (above 0.9 for B > 3.3, 1.1% of draws: the assertion takes
+// the 4 pixels' mean, 0.8). Pure noise: B^2 / Var B is a chi-square of one degree, beyond 5 in
+// 2.5% of the pixels, and each of those takes w = (B^2 - 5) / (B^2 - 4) at most: over the image
+// E[w; chi^2 > 5] = 0.013 (quadrature), which the window's own w (itself above 0 in half the
+// pixels at k = 1) shares; 0.02 bounds the mean w the floor adds.
+TEST(BiasPrior, APixelsOwnBiasBeyondItsNoiseIsNotShrunkByItsWindow) {
+  constexpr int n = 64;
+  std::mt19937_64 rng(23);
+  std::normal_distribution<double> z;
+  std::vector<double> b(n * n);
+  for (double& v : b) v = z(rng);
+  const size_t shadow[] = {32 * n + 30, 32 * n + 31, 33 * n + 30, 33 * n + 31};
+  for (size_t p : shadow) b[p] = 6.0 + z(rng);
+  auto prior = [&](double own) {
+    return bias_prior(
+        [&](size_t p) {
+          return BiasEstimate{dvec3(b[p]), dvec3(1.0), true};
+        },
+        n, n, 1.0, own);
+  };
+  const std::vector<dvec3> window = prior(0.0), floored = prior(kPriorOwnFactor);
+  double w_window = 0.0, w_floor = 0.0;
+  for (size_t p : shadow) {
+    w_window += bias_shrinkage(window[p].x, 1.0) / 4.0;
+    w_floor += bias_shrinkage(floored[p].x, 1.0) / 4.0;
+    EXPECT_GE(floored[p].x, b[p] * b[p] - kPriorOwnFactor - 1e-12);
+  }
+  std::printf("the shadow's mean w: %.3f by its window, %.3f with the floor\n", w_window, w_floor);
+  EXPECT_LT(w_window, 0.75);
+  EXPECT_GT(w_floor, 0.8);
+  // Away from the shadow's windows the floor moves only the pixels beyond sqrt(5) sds.
+  double moved = 0.0, count = 0.0, mean_w_window = 0.0, mean_w_floor = 0.0;
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < n; ++x) {
+      if (std::abs(x - 30) <= kPriorWindow + 1 && std::abs(y - 32) <= kPriorWindow + 1) continue;
+      const size_t p = size_t(y) * n + size_t(x);
+      EXPECT_GE(floored[p].x, window[p].x);
+      if (floored[p].x > window[p].x) {
+        moved += 1.0;
+        EXPECT_GT(b[p] * b[p], kPriorOwnFactor);
+      }
+      mean_w_window += bias_shrinkage(window[p].x, 1.0);
+      mean_w_floor += bias_shrinkage(floored[p].x, 1.0);
+      count += 1.0;
+    }
+  std::printf("noise: the floor moves %.4f of the pixels, mean w %.4f -> %.4f\n", moved / count,
+              mean_w_window / count, mean_w_floor / count);
+  EXPECT_LT(moved / count, 0.04);  // 2.5% expected; 4% is 5 binomial sds above on 3700 pixels
+  EXPECT_LT((mean_w_floor - mean_w_window) / count, 0.02);
+}
+
 }  // namespace

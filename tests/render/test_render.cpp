@@ -85,6 +85,19 @@ TEST(Render, BitIdenticalAcrossThreadCountsWithAdaptivePaths) {
   expect_bit_identical_with(o, &RenderOptions::adaptive_paths);
 }
 
+// The bias priors' floor (ESTIMATOR.md section 6b) comes with SPPM's paths only: the window
+// alone keeps the stop calibrated without them, and PPM has no paths to add.
+TEST(Render, ThePriorsFloorComesWithAdaptivePaths) {
+  const Scene scene = load_gltf(test::quick_options("cornell.gltf", 8, 1).scene);
+  for (Method m : {Method::SPPM, Method::PPM})
+    for (bool paths : {false, true}) {
+      RenderOptions o = test::quick_options("cornell.gltf", 8, 1);
+      o.method = m;
+      o.adaptive_paths = paths;
+      EXPECT_EQ(Renderer(scene, o).film_settings().prior_floor, paths && m == Method::SPPM);
+    }
+}
+
 TEST(Render, BitIdenticalAcrossThreadCountsWithPhotonsOnly) {
   RenderOptions o = test::quick_options("glass_slab.gltf", 40, 3);
   o.photons_per_pass = 20000;
