@@ -87,9 +87,9 @@ std::vector<std::string> option_diagnostics(const RenderOptions& options) {
     lines.push_back(
         "photonbound: warning: --follow-roughness does nothing here: it needs --method sppm with "
         "next-event direct light");
-  // docs/error-bounds.md "The mean-error stop with the adaptive parts": with paths and the
-  // Laplacian's bias alone the rule held for 11 of 20 runs at the Cornell box's tightest target,
-  // not 18 (the contact shadows' fourth-order bias, ESTIMATOR.md section 6c).
+  // docs/error-bounds.md "The mean-error stop with the adaptive parts, earlier rows": with paths
+  // and the Laplacian's bias alone the rule held for 11 of 20 runs at the Cornell box's tightest
+  // target, not 18 (the contact shadows' fourth-order bias, ESTIMATOR.md section 6c).
   if (options.adaptive_paths && options.method == Method::SPPM && options.target_error &&
       options.stop_rule == StopRule::MeanError && options.bias_model == BiasModel::Laplacian)
     lines.push_back(
