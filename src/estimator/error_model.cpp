@@ -91,7 +91,7 @@ double normal_quantile(double p) {
 
 // ESTIMATOR.md section 6b: the prior of the bias, by summed-area tables over the window.
 std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, int width,
-                              int height, double noise_factor, double own_factor) {
+                              int height, double noise_factor, std::span<const uint8_t> floor) {
   const SummedArea<dvec3> b2(width, height, [&](size_t p) {
     const BiasEstimate e = pixel(p);
     return e.use ? e.bias * e.bias : dvec3(0.0);
@@ -101,6 +101,9 @@ std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, 
     return e.use ? e.variance : dvec3(0.0);
   });
   const SummedArea<double> n(width, height, [&](size_t p) { return pixel(p).use ? 1.0 : 0.0; });
+  // The windows that hold a pixel with paths (section 6b: the floor is theirs).
+  const SummedArea<double> taken(
+      width, height, [&](size_t p) { return p < floor.size() && floor[p] ? 1.0 : 0.0; });
   std::vector<dvec3> tau2(size_t(width) * size_t(height), dvec3(0.0));
   parallel_for(size_t(height), 16, [&](size_t y0, size_t y1) {
     for (size_t y = y0; y < y1; ++y)
@@ -116,9 +119,10 @@ std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, 
               dvec3(0.0), (b2.box(xa, ya, xb, yb) - noise_factor * v.box(xa, ya, xb, yb)) / count);
         // The floor (section 6b): a lone bias that stands out of its own noise keeps at
         // least its own size, however small its window's others are.
-        if (own_factor <= 0.0) continue;
+        if (floor.empty() || taken.box(xa, ya, xb, yb) == 0.0) continue;
         if (const BiasEstimate e = pixel(p); e.use)
-          tau2[p] = glm::max(tau2[p], e.bias * e.bias - own_factor * noise_factor * e.variance);
+          tau2[p] =
+              glm::max(tau2[p], e.bias * e.bias - kPriorOwnFactor * noise_factor * e.variance);
       }
   });
   return tau2;

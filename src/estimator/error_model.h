@@ -4,7 +4,9 @@
 // absolute value, for a normal error: the folded normal distribution's moments.
 #pragma once
 
+#include <cstdint>
 #include <functional>
+#include <span>
 
 #include "util/math.h"
 
@@ -56,16 +58,19 @@ inline constexpr int kPriorWindow = 4;
 // of pure noise), so that where the bias is noise the window still decides. Measured in
 // section 6b's table: k' = 5 calibrates `radius,paths` (16-20 of 20 within at 90%) for 1-6% more
 // passes where the window alone was already calibrated. Only with `--adaptive paths`
-// (FilmSettings::prior_floor): without them the window alone keeps the stop calibrated, and
-// the floor cost the plane, the indirect room and the caustic a stop test's worth of passes.
+// (FilmSettings::prior_floor) and in the windows of pixels that have had a second path: where
+// no path lowered the noise the window alone keeps the stop calibrated, and the floor there
+// cost the plane 6% more passes.
 inline constexpr double kPriorOwnFactor = 5.0;
 // `pixel(p)` gives pixel p's estimate (read in place: a copy of the image's estimates would
 // raise a render's peak memory by 56 bytes per pixel).
 // `noise_factor` k: tau^2 = max(0, mean(B^2) - k mean(Var B)); k > 1 asks the window's
 // estimates to stand out of their noise before any of it counts as bias (section 6c).
-// `own_factor` k': the floor tau^2 >= B^2 - k' k Var B of the pixel's own estimate; 0: none.
+// `floor`: per pixel, 1 where paths were taken; a pixel with one in its window takes the floor
+// tau^2 >= B^2 - kPriorOwnFactor k Var B of its own estimate (empty: no pixel does).
 std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, int width,
-                              int height, double noise_factor = 1.0, double own_factor = 0.0);
+                              int height, double noise_factor = 1.0,
+                              std::span<const uint8_t> floor = {});
 // The noise factor of the fourth-order bias's prior (section 6c). Where the radiance is smooth
 // B4 is noise, and with k = 1 tau4^2 is still positive in about half of the windows:
 // mean(B4^2) / mean(V4) over a window's 81 pixels has an sd of sqrt(2 K / 81) under the null,

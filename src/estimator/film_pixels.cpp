@@ -164,27 +164,28 @@ void check_model(const std::vector<PixelResult>& results, FilmSummary& sum) {
 
 // ESTIMATOR.md section 6b: the bias prior over the known pixels with a random state.
 std::vector<dvec3> prior_of(const std::vector<PixelResult>& results, int width, int height,
-                            bool floor) {
+                            std::span<const uint8_t> floor) {
   return bias_prior(
       [&](size_t p) {
         const PixelResult& r = results[p];
         return BiasEstimate{r.bias, r.bias_variance, r.known && !r.exact};
       },
-      width, height, 1.0, floor ? kPriorOwnFactor : 0.0);
+      width, height, 1.0, floor);
 }
 
 // ESTIMATOR.md section 6c: the fourth-order part shrunk by a prior of its own (over the same
 // window), in place: each pixel keeps w4 B4 and sqrt(w4 V4). Where it is noise (a smooth radiance,
 // tau4 ~ 0) it then neither moves the bias nor dilutes the Laplacian's. Done before the
 // second-order prior, so that develop() never holds two priors at once.
-void shrink_fourth(std::vector<PixelResult>& results, int width, int height, bool floor) {
+void shrink_fourth(std::vector<PixelResult>& results, int width, int height,
+                   std::span<const uint8_t> floor) {
   const std::vector<dvec3> tau4 = bias_prior(
       [&](size_t p) {
         const PixelResult& r = results[p];
         const dvec3 sd(r.fourth_sd);
         return BiasEstimate{dvec3(r.fourth), sd * sd, r.known && !r.exact};
       },
-      width, height, kFourthNoiseFactor, floor ? kPriorOwnFactor : 0.0);
+      width, height, kFourthNoiseFactor, floor);
   parallel_for(results.size(), 4096, [&](size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p)
       for (int c = 0; c < 3; ++c) {

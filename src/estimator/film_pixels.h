@@ -54,9 +54,11 @@ double relative_floor(const std::vector<PixelResult>& results);
 // ESTIMATOR.md sections 11b and 11c: the shares of disagreeing states, and whether they refute.
 void check_model(const std::vector<PixelResult>& results, FilmSummary& sum);
 // ESTIMATOR.md section 6b: the bias prior over the known pixels with a random state.
+// `floor`: the pixels whose windows take the floor of their own estimate (empty: none).
 std::vector<dvec3> prior_of(const std::vector<PixelResult>& results, int width, int height,
-                            bool floor);
+                            std::span<const uint8_t> floor);
 // ESTIMATOR.md section 6c: each pixel's fourth-order part shrunk in place by its own prior.
-void shrink_fourth(std::vector<PixelResult>& results, int width, int height, bool floor);
+void shrink_fourth(std::vector<PixelResult>& results, int width, int height,
+                   std::span<const uint8_t> floor);
 
 }  // namespace pb

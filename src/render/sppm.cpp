@@ -239,6 +239,12 @@ PixelLayout SppmMethod::layout(const std::vector<PointState>&, const RenderState
   l.max_f = max_f_;
   l.glossy_f = saved ? saved->glossy_f : glossy_f_;
   l.mass = saved ? saved->min_mass : min_mass_;
+  // --adaptive paths: which pixels have had a second path (their history's dof, sum of
+  // K_j - 1, above 0); the bias priors' floor acts only in their windows.
+  const size_t n = saved ? saved->path_history.size() / 3 : history_.size();
+  l.paths_taken.resize(n);
+  for (size_t p = 0; p < n; ++p)
+    l.paths_taken[p] = (saved ? saved->path_history[3 * p + 2] : history_[p].dof) > 0.0f;
   return l;
 }
 

@@ -177,14 +177,25 @@ TEST(BiasPrior, APixelsOwnBiasBeyondItsNoiseIsNotShrunkByItsWindow) {
   for (double& v : b) v = z(rng);
   const size_t shadow[] = {32 * n + 30, 32 * n + 31, 33 * n + 30, 33 * n + 31};
   for (size_t p : shadow) b[p] = 6.0 + z(rng);
-  auto prior = [&](double own) {
+  // The floor acts in the windows of pixels that have had paths: here every pixel has.
+  const std::vector<uint8_t> everywhere(n * n, 1), none;
+  auto prior = [&](std::span<const uint8_t> paths) {
     return bias_prior(
         [&](size_t p) {
           return BiasEstimate{dvec3(b[p]), dvec3(1.0), true};
         },
-        n, n, 1.0, own);
+        n, n, 1.0, paths);
   };
-  const std::vector<dvec3> window = prior(0.0), floored = prior(kPriorOwnFactor);
+  const std::vector<dvec3> window = prior(none), floored = prior(everywhere);
+  // A pixel with paths 4 columns right of the shadow's right-hand pixels: their windows hold
+  // it and take the floor; the left-hand ones, 5 columns away, keep their window's prior.
+  std::vector<uint8_t> one(n * n, 0);
+  one[32 * n + 35] = 1;
+  const std::vector<dvec3> near = prior(one);
+  for (size_t row : {32, 33}) {
+    EXPECT_EQ(near[row * n + 30].x, window[row * n + 30].x);
+    EXPECT_EQ(near[row * n + 31].x, floored[row * n + 31].x);
+  }
   double w_window = 0.0, w_floor = 0.0;
   for (size_t p : shadow) {
     w_window += bias_shrinkage(window[p].x, 1.0) / 4.0;
