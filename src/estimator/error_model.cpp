@@ -101,9 +101,12 @@ std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, 
     return e.use ? e.variance : dvec3(0.0);
   });
   const SummedArea<double> n(width, height, [&](size_t p) { return pixel(p).use ? 1.0 : 0.0; });
-  // The windows that hold a pixel with paths (section 6b: the floor is theirs).
-  const SummedArea<double> taken(
-      width, height, [&](size_t p) { return p < floor.size() && floor[p] ? 1.0 : 0.0; });
+  // The windows that hold a pixel with paths (section 6b: the floor is theirs); without paths
+  // an empty table, not 8 more bytes per pixel.
+  const bool floored = !floor.empty();
+  const SummedArea<double> taken(floored ? width : 0, floored ? height : 0, [&](size_t p) {
+    return p < floor.size() && floor[p] ? 1.0 : 0.0;
+  });
   std::vector<dvec3> tau2(size_t(width) * size_t(height), dvec3(0.0));
   parallel_for(size_t(height), 16, [&](size_t y0, size_t y1) {
     for (size_t y = y0; y < y1; ++y)
@@ -119,7 +122,7 @@ std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, 
               dvec3(0.0), (b2.box(xa, ya, xb, yb) - noise_factor * v.box(xa, ya, xb, yb)) / count);
         // The floor (section 6b): a lone bias that stands out of its own noise keeps at
         // least its own size, however small its window's others are.
-        if (floor.empty() || taken.box(xa, ya, xb, yb) == 0.0) continue;
+        if (!floored || taken.box(xa, ya, xb, yb) == 0.0) continue;
         if (const BiasEstimate e = pixel(p); e.use)
           tau2[p] =
               glm::max(tau2[p], e.bias * e.bias - kPriorOwnFactor * noise_factor * e.variance);
