@@ -56,9 +56,9 @@ inline constexpr int kPriorWindow = 4;
 // error, and the mean-error stop was 7-8% low (14 of 20 within at 90% on the Cornell box). A
 // pixel's own B counts only beyond about sqrt(5) of its sds (a chi-square of 1 beyond 5: 2.5%
 // of pure noise), so that where the bias is noise the window still decides. Measured in
-// section 6b's table: k' = 5 calibrates `radius,paths` (16-20 of 20 within at 90%) for 1-6% more
-// passes where the window alone was already calibrated. Only with `--adaptive paths`
-// (FilmSettings::prior_floor) and in the windows of pixels that have had a second path: where
+// section 15's table: k' = 5 calibrates `radius,paths` (16-20 of 20 within at 90%) for 1-6% more
+// passes where the window alone was already calibrated. Only with `--adaptive paths`, in the
+// windows of pixels that have had a second path (PixelLayout::paths_taken): where
 // no path lowered the noise the window alone keeps the stop calibrated, and the floor there
 // cost the plane 6% more passes.
 inline constexpr double kPriorOwnFactor = 5.0;

@@ -213,8 +213,7 @@ FilmSummary develop(const PixelLayout& layout, const std::vector<PointState>& st
   sum.relative_floor = relative_floor(results);
   if (image) prepare_image(*image, layout.width, layout.height);
   check_model(results, sum);
-  const std::span<const uint8_t> floor =
-      s.prior_floor ? std::span<const uint8_t>(layout.paths_taken) : std::span<const uint8_t>();
+  const std::span<const uint8_t> floor = layout.paths_taken;
   if (s.bias_model == BiasModel::TwoScale)
     shrink_fourth(results, layout.width, layout.height, floor);
   const std::vector<dvec3> tau2 = prior_of(results, layout.width, layout.height, floor);

@@ -68,10 +68,6 @@ struct FilmSettings {
   double target = 0.0;         // 0 = no target
   double stop_fraction = 0.9;  // the share of pixels pixel_quantile_bound is taken at
   BiasModel bias_model = BiasModel::TwoScale;
-  // The bias priors' floor from each pixel's own estimate (ESTIMATOR.md section 6b): on with
-  // SPPM's `--adaptive paths`, whose lowered noise uncovers the biases a window shrinks, in
-  // the windows of the pixels that have had a second path (PixelLayout::paths_taken).
-  bool prior_floor = false;
 };
 
 // Each PPM point's W_k f (render/camera_pass.h, VisiblePoint::f) read in place from the
@@ -105,7 +101,8 @@ struct PixelLayout {
   std::vector<float> mass;          // per state; empty: 1
   double footprint = 0.0;  // median pixel footprint at the points (the errors' correlation)
   // SPPM, --adaptive paths: per pixel, 1 where it has had more than one camera path in a pass
-  // (section 15); empty: none has.
+  // (section 15); the bias priors' floor acts in their windows (section 6b). Empty without
+  // paths (PPM, or SPPM without --adaptive paths).
   std::vector<uint8_t> paths_taken;
 };
 // Combines the states of every pixel. With passes < 2 no bound exists: every pixel with

@@ -96,7 +96,6 @@ FilmSettings Renderer::film_settings() const {
   s.target = options_.target_error.value_or(0.0);
   s.stop_fraction = options_.stop_fraction;
   s.bias_model = options_.bias_model;
-  s.prior_floor = options_.adaptive_paths && options_.method == Method::SPPM;
   return s;
 }
 

@@ -85,17 +85,32 @@ TEST(Render, BitIdenticalAcrossThreadCountsWithAdaptivePaths) {
   expect_bit_identical_with(o, &RenderOptions::adaptive_paths);
 }
 
-// The bias priors' floor (ESTIMATOR.md section 6b) comes with SPPM's paths only: the window
-// alone keeps the stop calibrated without them, and PPM has no paths to add.
-TEST(Render, ThePriorsFloorComesWithAdaptivePaths) {
-  const Scene scene = load_gltf(test::quick_options("cornell.gltf", 8, 1).scene);
-  for (Method m : {Method::SPPM, Method::PPM})
-    for (bool paths : {false, true}) {
-      RenderOptions o = test::quick_options("cornell.gltf", 8, 1);
-      o.method = m;
-      o.adaptive_paths = paths;
-      EXPECT_EQ(Renderer(scene, o).film_settings().prior_floor, paths && m == Method::SPPM);
-    }
+// The bias priors' floor (ESTIMATOR.md section 6b) acts in the windows of the pixels that
+// have had a second camera path: none before paths start (after pass 16), some of the Cornell
+// box's after 20 passes (the glass ball's pixels take up to 16), none without --adaptive paths
+// or under PPM, which has no paths to add.
+TEST(Render, ThePriorsFloorFollowsThePixelsThatHadPaths) {
+  const Scene scene = load_gltf(test::quick_options("cornell.gltf", 32, 20).scene);
+  auto pixels_with_paths = [&](Method m, bool paths, uint64_t passes) {
+    RenderOptions o = test::quick_options("cornell.gltf", 32, passes);
+    o.method = m;
+    o.photons_per_pass = 20000;
+    o.adaptive_paths = paths;
+    Renderer r(scene, o);
+    for (uint64_t p = 0; p < passes; ++p) r.step();
+    const PixelLayout l = r.layout();
+    EXPECT_TRUE(l.paths_taken.empty() || l.paths_taken.size() == 32u * 32u);
+    size_t n = 0;
+    for (uint8_t t : l.paths_taken) n += t;
+    return std::make_pair(l.paths_taken.empty(), n);
+  };
+  EXPECT_EQ(pixels_with_paths(Method::SPPM, true, 16), std::make_pair(false, size_t(0)));
+  const auto [empty, taken] = pixels_with_paths(Method::SPPM, true, 20);
+  EXPECT_FALSE(empty);
+  EXPECT_GT(taken, 0u);
+  EXPECT_LT(taken, 32u * 32u);
+  EXPECT_TRUE(pixels_with_paths(Method::SPPM, false, 20).first);
+  EXPECT_TRUE(pixels_with_paths(Method::PPM, true, 20).first);
 }
 
 TEST(Render, BitIdenticalAcrossThreadCountsWithPhotonsOnly) {
