@@ -58,7 +58,7 @@ namespace {
 template <bool kLaplacian, class PhotonFlux>
 void gather_kernel(const VisiblePoint& point, double r2, const HashGrid& grid,
                    const std::vector<PhotonHit>& hits, PhotonFlux&& photon_flux, PassSums& out,
-                   const GuideLearning* learn) {
+                   const GuideLearning* learn, const RegionView* region) {
   const float radius = search_radius(r2);
   const double inv_r2 = 1.0 / r2;
   // How far a photon may lie behind or in front of the point's tangent plane (and the point off
@@ -95,6 +95,11 @@ void gather_kernel(const VisiblePoint& point, double r2, const HashGrid& grid,
       const float ahead_h = glm::dot(d, h.normal);
       if (std::abs(ahead_h) > behind_tol && (ahead_h > 0.0f) == (ahead_p > 0.0f)) return;
     }
+    // Nor beyond the point's edge (ESTIMATOR.md section 11, "The photons of the region"): the
+    // kernel's moments count the region of the disc the point's surface reaches, so a photon
+    // outside it (on the next of a row of coplanar boards, on a panel beyond a gap) is not the
+    // point's: counted, it would be renormalised by a mass that leaves its surface out.
+    if (region && !region->contains(d)) return;
     const float cos_s = glm::dot(h.wi, point.shading);
     ++count;  // it could contribute, so it counts toward the radius reduction
     if (cos_s <= 0.0f) return;
@@ -143,35 +148,42 @@ class PointBsdfCursor {
 
 template <bool kLaplacian>
 void gather_photons(const VisiblePoint& point, double r2, const HashGrid& grid,
-                    const std::vector<PhotonHit>& hits, PassSums& out, const GuideLearning* learn) {
+                    const std::vector<PhotonHit>& hits, PassSums& out, const GuideLearning* learn,
+                    const RegionView* region) {
   gather_kernel<kLaplacian>(
-      point, r2, grid, hits, [](const PhotonHit& h) { return dvec3(h.flux); }, out, learn);
+      point, r2, grid, hits, [](const PhotonHit& h) { return dvec3(h.flux); }, out, learn, region);
 }
 
 template <bool kLaplacian>
 void gather_photons(const VisiblePoint& point, const PointBsdf& glossy, double r2,
                     const HashGrid& grid, const std::vector<PhotonHit>& hits, PassSums& out,
-                    const GuideLearning* learn) {
+                    const GuideLearning* learn, const RegionView* region) {
   gather_kernel<kLaplacian>(
       point, r2, grid, hits,
       [&](const PhotonHit& h) { return dvec3(h.flux * glossy.bsdf.eval(glossy.wo, h.wi)); }, out,
-      learn);
+      learn, region);
 }
 
 template void gather_photons<true>(const VisiblePoint&, double, const HashGrid&,
-                                   const std::vector<PhotonHit>&, PassSums&, const GuideLearning*);
+                                   const std::vector<PhotonHit>&, PassSums&, const GuideLearning*,
+                                   const RegionView*);
 template void gather_photons<false>(const VisiblePoint&, double, const HashGrid&,
-                                    const std::vector<PhotonHit>&, PassSums&, const GuideLearning*);
+                                    const std::vector<PhotonHit>&, PassSums&, const GuideLearning*,
+                                    const RegionView*);
 template void gather_photons<true>(const VisiblePoint&, const PointBsdf&, double, const HashGrid&,
-                                   const std::vector<PhotonHit>&, PassSums&, const GuideLearning*);
+                                   const std::vector<PhotonHit>&, PassSums&, const GuideLearning*,
+                                   const RegionView*);
 template void gather_photons<false>(const VisiblePoint&, const PointBsdf&, double, const HashGrid&,
-                                    const std::vector<PhotonHit>&, PassSums&, const GuideLearning*);
+                                    const std::vector<PhotonHit>&, PassSums&, const GuideLearning*,
+                                    const RegionView*);
 
 void gather_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
                  const HashGrid& grid, const std::vector<PhotonHit>& hits, PointBsdfTable glossy,
-                 std::span<PassSums> out, GuideTally::Chunk* tally, const GuideInputs& guide) {
+                 GatherDiscs discs, std::span<PassSums> out, GuideTally::Chunk* tally,
+                 const GuideInputs& guide) {
   std::fill(out.begin(), out.end(), PassSums{});
   PointBsdfCursor cursor(glossy, points.size());
+  RegionTable::Cursor regions(discs.regions);
   for (size_t k = 0; k < points.size(); ++k) {
     const VisiblePoint& p = points[k];
     if (!(max_component(p.f) > 0.0f)) continue;  // SPPM: a pixel without a visible point
@@ -185,27 +197,51 @@ void gather_pass(std::span<const VisiblePoint> points, std::span<const PointStat
       learn.weight = relative_error(states[k], guide.passes_done, guide.photons_per_pass) *
                      double(p.f.x + p.f.y + p.f.z) / states[k].r2;
     }
-    gather_point(p, cursor.at(k), states[k].r2, grid, hits, out[k], tally ? &learn : nullptr);
+    if (discs.regions) {
+      gather_point(p, cursor.at(k), states[k].r2, grid, hits, regions.at(uint32_t(k)), out[k],
+                   tally ? &learn : nullptr);
+    } else {
+      static const DiscMoments kWhole;
+      gather_point(p, cursor.at(k), states[k].r2, grid, hits, discs.boundary,
+                   discs.owner.empty() ? kWhole : discs.owner[k].disc, out[k],
+                   tally ? &learn : nullptr);
+    }
   }
 }
 
 void gather_point(const VisiblePoint& p, const PointBsdf* glossy, double r2, const HashGrid& grid,
-                  const std::vector<PhotonHit>& hits, PassSums& out, const GuideLearning* learn) {
+                  const std::vector<PhotonHit>& hits, const BoundaryIndex* boundary,
+                  const DiscMoments& disc, PassSums& out, const GuideLearning* learn) {
+  DiscRegion region;
+  RegionView view;
+  const bool cut = boundary && !disc.full &&
+                   boundary->region(p.triangle, p.position, p.normal, search_radius(r2), region);
+  if (cut) view = region.view();
+  gather_point(p, glossy, r2, grid, hits, cut ? &view : nullptr, out, learn);
+}
+
+void gather_point(const VisiblePoint& p, const PointBsdf* glossy, double r2, const HashGrid& grid,
+                  const std::vector<PhotonHit>& hits, const RegionView* region, PassSums& out,
+                  const GuideLearning* learn) {
   if (glossy)
-    gather_photons(p, *glossy, r2, grid, hits, out, learn);
+    gather_photons(p, *glossy, r2, grid, hits, out, learn, region);
   else
-    gather_photons(p, r2, grid, hits, out, learn);
+    gather_photons(p, r2, grid, hits, out, learn, region);
 }
 
 void disc_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
                const BoundaryIndex* boundary, std::span<const float> clearance,
-               std::span<OwnerValues> out) {
+               std::span<OwnerValues> out, RegionTable* regions) {
+  if (regions) regions->clear();
+  DiscRegion region;
   for (size_t k = 0; k < points.size(); ++k) {
     const VisiblePoint& p = points[k];
     if (!(max_component(p.f) > 0.0f)) continue;
     const float r = search_radius(states[k].r2);
-    if (boundary && (clearance.empty() || r > clearance[k]))
-      out[k].disc = boundary->moments(p.triangle, p.position, p.normal, r);
+    if (!boundary || (!clearance.empty() && r <= clearance[k])) continue;
+    if (!boundary->region(p.triangle, p.position, p.normal, r, region)) continue;
+    out[k].disc = BoundaryIndex::moments_of(region, r);
+    if (regions) regions->add(uint32_t(k), region);
   }
 }
 

@@ -4,8 +4,9 @@
 //   values
 //   1. trace photons          PhotonTracer::run (photon_pass.h)       -> hits of a photon range
 //   2. build the grid         build_photon_grid                       -> grid over the hits
-//   3. gather                 gather_pass: photons within each radius  -> PassSums (phi, lap, M)
-//   4. owner values           disc_pass (PPM), next_event_pass         -> OwnerValues (D, disc)
+//   3. gather                 gather_pass: photons within each disc's  -> PassSums (phi, lap, M)
+//                             region (the owner values' moments)
+//   4. owner values           disc_pass (PPM, before 3), next_event_pass -> OwnerValues (D, disc)
 //   5. fold                   fold_pass: sums and values into states   -> states, radii
 // Stage 3 runs on any set of photon hits, and its PassSums (estimator.h) add over disjoint sets.
 // A pass split across processes (exchange.h) shares stage 1 by photon range and stages 0 and
@@ -59,22 +60,30 @@ struct GuideLearning {
   GuideTally::Chunk* chunk = nullptr;
   double weight = 0.0;  // the point's relative error times mean(f) / R^2
 };
+// With `region`, only the photons inside it (the part of the disc the point's surface reaches,
+// ESTIMATOR.md section 11); null: the whole disc.
 template <bool kLaplacian = true>
 void gather_photons(const VisiblePoint& point, double r2, const HashGrid& grid,
                     const std::vector<PhotonHit>& hits, PassSums& out,
-                    const GuideLearning* learn = nullptr);
+                    const GuideLearning* learn = nullptr, const RegionView* region = nullptr);
 // The same for a point on a non-Lambertian surface: each photon's power times f(wo, wi_photon),
 // the path weight point.f once.
 template <bool kLaplacian = true>
 void gather_photons(const VisiblePoint& point, const PointBsdf& glossy, double r2,
                     const HashGrid& grid, const std::vector<PhotonHit>& hits, PassSums& out,
-                    const GuideLearning* learn = nullptr);
+                    const GuideLearning* learn = nullptr, const RegionView* region = nullptr);
 
 // The gather of one point, on its Bsdf where it has one (glossy non-null) and as a Lambertian
-// point otherwise: the two overloads above, chosen.
+// point otherwise: the two overloads above, chosen, within the region of its disc whose moments
+// `disc` holds (found again from `boundary` when the disc is not whole; null: no index).
 void gather_point(const VisiblePoint& point, const PointBsdf* glossy, double r2,
-                  const HashGrid& grid, const std::vector<PhotonHit>& hits, PassSums& out,
+                  const HashGrid& grid, const std::vector<PhotonHit>& hits,
+                  const BoundaryIndex* boundary, const DiscMoments& disc, PassSums& out,
                   const GuideLearning* learn = nullptr);
+// The same with the region known (null: the whole disc).
+void gather_point(const VisiblePoint& point, const PointBsdf* glossy, double r2,
+                  const HashGrid& grid, const std::vector<PhotonHit>& hits,
+                  const RegionView* region, PassSums& out, const GuideLearning* learn = nullptr);
 
 // The glossy side table of a span of points: entries sorted by PointBsdf::point, which counts
 // from the span's first point at `base` (entries outside the span are skipped).
@@ -94,18 +103,27 @@ struct GuideInputs {
   uint64_t passes_done = 0;
   double photons_per_pass = 1.0;
 };
+// The discs the points gather over: owner[k].disc, from stage 4's disc_pass (PPM) or the camera
+// path (SPPM), and the regions of those that are not whole (`regions`; without it, found again
+// from `boundary`).
+struct GatherDiscs {
+  const BoundaryIndex* boundary = nullptr;
+  std::span<const OwnerValues> owner;
+  const RegionTable* regions = nullptr;
+};
 void gather_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
                  const HashGrid& grid, const std::vector<PhotonHit>& hits, PointBsdfTable glossy,
-                 std::span<PassSums> out, GuideTally::Chunk* tally = nullptr,
+                 GatherDiscs discs, std::span<PassSums> out, GuideTally::Chunk* tally = nullptr,
                  const GuideInputs& guide = {});
 
 // Stage 4, PPM: out[k].disc = the kernel's moments over the reachable part of points[k]'s disc
 // at the pass's radius (ESTIMATOR.md section 11); without `boundary` every disc counts as whole.
 // `clearance` holds per point BoundaryIndex::clearance: the radius up to which its disc is whole
-// without asking.
+// without asking. With `regions`, the regions of the discs that are not whole go there (cleared
+// first).
 void disc_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
                const BoundaryIndex* boundary, std::span<const float> clearance,
-               std::span<OwnerValues> out);
+               std::span<OwnerValues> out, RegionTable* regions = nullptr);
 
 // Stage 4: adds one next-event sample (ESTIMATOR.md section 4) to out[k].direct for every
 // point with f > 0, Rng keyed by (seed, pass, first + k, DirectLight). A point on a GGX lobe's

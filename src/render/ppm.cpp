@@ -18,6 +18,7 @@ PpmMethod::PpmMethod(const World& world, const PinholeCamera& camera, int max_de
   }
   sums_.resize(std::min(kFoldBlock, state_count_));
   owner_.resize(sums_.size());
+  regions_.resize((sums_.size() + kStageChunk - 1) / kStageChunk);
 }
 
 void PpmMethod::prepare(const BoundaryIndex& boundary, double initial_radius) {
@@ -35,7 +36,7 @@ void PpmMethod::prepare(const BoundaryIndex& boundary, double initial_radius) {
 bool ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
               std::span<const PointBsdf> glossy, std::span<const float> clearance,
               std::span<PointState> states, std::span<float> radii, std::span<PassSums> sums,
-              std::span<OwnerValues> owner, PointState* copy) {
+              std::span<OwnerValues> owner, PointState* copy, std::span<RegionTable> regions) {
   const size_t n = states.size(), block = sums.size();
   for (size_t first = 0; first < n; first += block) {
     const size_t count = std::min(block, n - first);
@@ -52,12 +53,14 @@ bool ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
       const PointBsdfTable table{glossy, at};
       std::optional<GuideTally::Chunk> learn;
       if (in.guide.tally) learn.emplace(*in.guide.tally, b / kStageChunk);
-      gather_pass(pts, st, in.grid, in.hits, table, sums.subspan(b, m), learn ? &*learn : nullptr,
-                  in.guide);
+      // The discs first: the gather counts the photons of each disc's region (section 11).
       const std::span<OwnerValues> own = owner.subspan(b, m);
       std::fill(own.begin(), own.end(), OwnerValues{});
-      disc_pass(pts, st, in.boundary, clearance.empty() ? clearance : clearance.subspan(at, m),
-                own);
+      RegionTable* chunk_regions = regions.empty() ? nullptr : &regions[b / kStageChunk];
+      disc_pass(pts, st, in.boundary, clearance.empty() ? clearance : clearance.subspan(at, m), own,
+                chunk_regions);
+      gather_pass(pts, st, in.grid, in.hits, table, {in.boundary, own, chunk_regions},
+                  sums.subspan(b, m), learn ? &*learn : nullptr, in.guide);
       if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, at, own);
     });
     if (cut.load()) return false;  // the first block: nothing folded yet
@@ -71,7 +74,8 @@ bool ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
 
 bool PpmMethod::step(const PassInputs& in, std::span<PointState> states, std::span<float> radii,
                      PointState* copy) {
-  return ppm_pass(in, pass_.points, pass_.glossy, clearance_, states, radii, sums_, owner_, copy);
+  return ppm_pass(in, pass_.points, pass_.glossy, clearance_, states, radii, sums_, owner_, copy,
+                  regions_);
 }
 
 void PpmMethod::restore(const RenderState& s) {

@@ -9,15 +9,17 @@
 
 namespace pb {
 
-// Stages 3-5 of pass in.pass at `points`, block by block of sums.size() points: gather into
-// `sums`, the disc moments (with `clearance`, per point; empty: ask the boundary index for every
-// disc) and next-event samples into `owner`, then fold into `states` and `radii`. `glossy` is
-// the points' glossy side table (CameraPassResult::glossy); `copy` (sized to the points) receives
-// the new states. False when in.cutoff was reached before the first fold (nothing changed).
+// Stages 3-5 of pass in.pass at `points`, block by block of sums.size() points: the disc moments
+// (with `clearance`, per point; empty: ask the boundary index for every disc) and next-event
+// samples into `owner`, the gather into `sums` within those discs, then fold into `states` and
+// `radii`. `glossy` is the points' glossy side table (CameraPassResult::glossy); `copy` (sized to
+// the points) receives the new states. `regions` (one per chunk of kStageChunk points of a block;
+// empty: none) keeps each chunk's discs' regions from the moments to the gather. False when
+// in.cutoff was reached before the first fold (nothing changed).
 bool ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
               std::span<const PointBsdf> glossy, std::span<const float> clearance,
               std::span<PointState> states, std::span<float> radii, std::span<PassSums> sums,
-              std::span<OwnerValues> owner, PointState* copy);
+              std::span<OwnerValues> owner, PointState* copy, std::span<RegionTable> regions = {});
 
 class PpmMethod final : public PhotonMethod {
  public:
@@ -38,8 +40,9 @@ class PpmMethod final : public PhotonMethod {
   std::vector<float> clearance_;  // per point, BoundaryIndex::clearance at the initial radius
   // With glossy points: the points with f times Bsdf::max_f for the sparse-photon bound.
   std::vector<VisiblePoint> capped_points_;
-  std::vector<PassSums> sums_;      // one fold block's (pass_stages.h)
-  std::vector<OwnerValues> owner_;  // the same block's
+  std::vector<PassSums> sums_;        // one fold block's (pass_stages.h)
+  std::vector<OwnerValues> owner_;    // the same block's
+  std::vector<RegionTable> regions_;  // per chunk of the block: its discs' regions
 };
 
 }  // namespace pb

@@ -43,6 +43,7 @@ SppmMethod::SppmMethod(const World& world, const PinholeCamera& camera, CameraPa
   sums_.resize(block);
   owner_.resize(block);
   glossy_count_.resize((block + kStageChunk - 1) / kStageChunk);
+  regions_.resize(glossy_count_.size());
   if (settings.adaptive_paths) {
     paths_.assign(state_count_, 1);
     history_.assign(state_count_, PathHistory{});
@@ -93,13 +94,14 @@ bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
       const std::span<OwnerValues> own = std::span(owner_).subspan(b, m);
       const std::span<PointBsdf> scratch = std::span(glossy_).subspan(b, m);
       const std::span<const PointState> st = std::span<const PointState>(states).subspan(at, m);
+      RegionTable& regions = regions_[b / kStageChunk];
       const size_t n_glossy = trace_visible_points(
-          camera, at, std::span<const float>(radii).subspan(at, m), pts, scratch, own);
+          camera, at, std::span<const float>(radii).subspan(at, m), pts, scratch, own, &regions);
       const PointBsdfTable table{scratch.first(n_glossy), 0};  // indices into pts
       std::optional<GuideTally::Chunk> learn;
       if (in.guide.tally) learn.emplace(*in.guide.tally, b / kStageChunk);
-      gather_pass(pts, st, in.grid, in.hits, table, std::span(sums_).subspan(b, m),
-                  learn ? &*learn : nullptr, in.guide);
+      gather_pass(pts, st, in.grid, in.hits, table, {in.boundary, own, &regions},
+                  std::span(sums_).subspan(b, m), learn ? &*learn : nullptr, in.guide);
       if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, at, own);
       if (settings_.adaptive_paths) extra_paths(in, camera, at, b, m, st, radii);
       glossy_count_[b / kStageChunk] = uint32_t(n_glossy);
@@ -185,7 +187,7 @@ void SppmMethod::extra_paths(const PassInputs& in, const CameraPathInputs& camer
       if (max_component(p.f) > 0.0f) {
         // Stages 3 and 4 for this one point, as gather_pass and next_event_pass do them.
         const PointBsdf* glossy = bsdf ? &*bsdf : nullptr;
-        gather_point(p, glossy, r2, in.grid, in.hits, g);
+        gather_point(p, glossy, r2, in.grid, in.hits, in.boundary, o.disc, g);
         if (in.next_event)
           o.direct += next_event_at(in.world, p, glossy, in.seed, in.pass, path_item(pixel, t));
         e.mass = std::min(e.mass, float(o.disc.mass));

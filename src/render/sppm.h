@@ -77,6 +77,7 @@ class SppmMethod final : public PhotonMethod {
   std::vector<PassSums> sums_;
   std::vector<OwnerValues> owner_;
   std::vector<uint32_t> glossy_count_;  // per chunk of the block: its glossy entries
+  std::vector<RegionTable> regions_;    // per chunk of the block: its discs' regions
   // --adaptive paths: the camera paths of each pixel this pass (chosen before it from the
   // states), each pixel's history, and one block's extra paths' side state.
   std::vector<uint8_t> paths_;

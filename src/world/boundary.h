@@ -25,6 +25,76 @@ namespace pb {
 
 class World;
 
+// The part of a kernel disc its surface reaches (ESTIMATOR.md section 11): the segments within
+// the radius, projected into the point's tangent plane (t1, t2 = orthonormal_basis(n)) about
+// the quadrature's centre (the point, moved by (sx, sy) into its own triangle when it lies on a
+// segment). The region is what the centre sees within the disc without crossing a segment;
+// BoundaryIndex::moments() integrates the kernel over it, and the gather counts the photons
+// inside it alone ("The photons of the region"): a photon beyond a segment lies on another
+// surface (the next of a row of boards, a panel beyond a gap), which the region's mass leaves
+// out.
+struct RegionSegment {
+  double ax, ay, ex, ey;  // from (ax, ay) along (ex, ey)
+};
+
+// A region's frame and segments, wherever the segments are kept (DiscRegion, RegionTable).
+struct RegionView {
+  dvec3 t1{0.0}, t2{0.0};
+  double sx = 0.0, sy = 0.0;
+  double clear2 = 0.0;  // the nearest segment's distance from the centre, squared
+  const RegionSegment* seg = nullptr;
+  int count = 0;
+  // Whether the photon at d = x_photon - point lies in the region: no segment between the centre
+  // and its projection.
+  bool contains(const vec3& d) const;
+};
+
+struct DiscRegion {
+  static constexpr int kMaxNear = 64;  // segments kept (beyond: the first found)
+  RegionSegment seg[kMaxNear];
+  int count = 0;
+  RegionView frame;  // its seg is not set: view() gives the whole
+  RegionView view() const {
+    RegionView v = frame;
+    v.seg = seg;
+    v.count = count;
+    return v;
+  }
+};
+
+// The regions of a span of points whose discs are not whole (ESTIMATOR.md section 11), in point
+// order: kept where the discs' moments are found (SPPM's camera paths, PPM's disc_pass) for the
+// gather, which would otherwise scan the boundary index again (on a house of separate boards
+// that scan is most of a pass). Its vectors keep their capacity across clear().
+class RegionTable {
+ public:
+  void clear() {
+    heads_.clear();
+    segments_.clear();
+  }
+  void add(uint32_t point, const DiscRegion& region);
+  // Reads a table alongside its points, in order.
+  class Cursor {
+   public:
+    explicit Cursor(const RegionTable* t) : t_(t) {}
+    // Point k's region, or null when its disc is whole (k ascending across calls).
+    const RegionView* at(uint32_t k);
+
+   private:
+    const RegionTable* t_;
+    size_t next_ = 0;
+    RegionView view_;
+  };
+
+ private:
+  struct Head {
+    uint32_t point = 0, first = 0;
+    RegionView frame;  // seg: null (the segments are segments_[first, first + count))
+  };
+  std::vector<Head> heads_;
+  std::vector<RegionSegment> segments_;
+};
+
 class BoundaryIndex {
  public:
   BoundaryIndex() = default;
@@ -35,6 +105,11 @@ class BoundaryIndex {
   // The disc of radius r about p, a point of triangle `triangle` whose normal on the side it is
   // seen from is n. r must not exceed the index's max_radius.
   DiscMoments moments(uint32_t triangle, const vec3& p, const vec3& n, float r) const;
+  // The region those moments integrate over; false when no segment is within r (the whole disc;
+  // `out` is then not a region).
+  bool region(uint32_t triangle, const vec3& p, const vec3& n, float r, DiscRegion& out) const;
+  // The moments of a region region() found for radius r: moments() without the scan.
+  static DiscMoments moments_of(const DiscRegion& region, float r);
   // A radius up to which moments(triangle, p, n, radius) is the whole disc: the distance from p
   // to the nearest segment within r, rounded down, or r when none is. PPM's points are fixed
   // and their radii only shrink, so one call per point at the initial radius spares every later
@@ -109,6 +184,7 @@ class BoundaryIndex {
   static bool add_blockers(const World& world, const std::vector<uint8_t>& host,
                            const std::vector<uint32_t>& first_copy, float max_radius, size_t budget,
                            Work& work, std::vector<Cut>& cuts);
+  static void in_space_order(std::vector<Cut>& cuts);
   std::vector<std::pair<uint32_t, uint32_t>> list_near(const World& world,
                                                        const std::vector<Cut>& cuts,
                                                        const std::vector<uint8_t>& host,

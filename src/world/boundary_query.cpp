@@ -30,67 +30,64 @@ const Directions& directions() {
   return d;
 }
 
-// Segments near a point, in its tangent plane about it: segment i runs from (ax, ay) along
-// (ex, ey). The polar quadrature of moments() (ESTIMATOR.md section 11) works on these.
-struct Projected {
-  static constexpr int kMaxNear = 64;
-  double ax[kMaxNear], ay[kMaxNear], ex[kMaxNear], ey[kMaxNear];
-  int count = 0;
+// The polar quadrature of moments() (ESTIMATOR.md section 11) on a region's segments.
 
-  // Whether a segment passes within 1e-4 r of the centre (r2 = r^2).
-  bool through_centre(double r2) const {
-    double min_d2 = INFINITY;
-    for (int i = 0; i < count; ++i) {
-      const double len2 = ex[i] * ex[i] + ey[i] * ey[i];
-      const double s =
-          len2 > 0.0 ? std::clamp(-(ax[i] * ex[i] + ay[i] * ey[i]) / len2, 0.0, 1.0) : 0.0;
-      const double qx = ax[i] + s * ex[i], qy = ay[i] + s * ey[i];
-      min_d2 = std::min(min_d2, qx * qx + qy * qy);
-    }
-    return min_d2 < 1e-8 * r2;
+// The distance squared from the centre to the nearest segment.
+double nearest2(const DiscRegion& g) {
+  double min_d2 = INFINITY;
+  for (int i = 0; i < g.count; ++i) {
+    const RegionSegment& q = g.seg[i];
+    const double len2 = q.ex * q.ex + q.ey * q.ey;
+    const double s = len2 > 0.0 ? std::clamp(-(q.ax * q.ex + q.ay * q.ey) / len2, 0.0, 1.0) : 0.0;
+    const double qx = q.ax + s * q.ex, qy = q.ay + s * q.ey;
+    min_d2 = std::min(min_d2, qx * qx + qy * qy);
   }
+  return min_d2;
+}
 
-  // Moves the centre 1e-3 r (at most the distance) towards (cx, cy).
-  void shift(double cx, double cy, float r) {
-    const double len = std::sqrt(cx * cx + cy * cy);
-    if (!(len > 0.0)) return;
-    const double shift = std::min(1e-3 * double(r), len);
-    for (int i = 0; i < count; ++i) {
-      ax[i] -= shift * cx / len;
-      ay[i] -= shift * cy / len;
-    }
+// Moves the centre 1e-3 r (at most the distance) towards (cx, cy).
+void shift(DiscRegion& g, double cx, double cy, float r) {
+  const double len = std::sqrt(cx * cx + cy * cy);
+  if (!(len > 0.0)) return;
+  const double shift = std::min(1e-3 * double(r), len);
+  g.frame.sx = shift * cx / len;
+  g.frame.sy = shift * cy / len;
+  for (int i = 0; i < g.count; ++i) {
+    g.seg[i].ax -= g.frame.sx;
+    g.seg[i].ay -= g.frame.sy;
   }
+}
 
-  // In each direction of the quadrature the visible extent rho (the first segment the ray meets,
-  // or r). A segment not through the centre subtends less than pi, so only the directions
-  // within the arc between its end points' angles (one more each side, for rounding) can meet
-  // it; the exact test decides.
-  void visible_extents(double r, double rho[kK]) const {
-    const Directions& dir = directions();
-    std::fill(rho, rho + kK, r);
-    constexpr double step = 2.0 * kPiD / kK;
-    for (int i = 0; i < count; ++i) {
-      const double ta = std::atan2(ay[i], ax[i]), tb = std::atan2(ay[i] + ey[i], ax[i] + ex[i]);
-      double width = tb - ta;
-      if (width > kPiD) width -= 2.0 * kPiD;
-      if (width < -kPiD) width += 2.0 * kPiD;
-      const double from = width >= 0.0 ? ta : tb;
-      // Direction k sits at (k + 0.5) step.
-      const int k0 = int(std::floor(from / step - 0.5)) - 1;
-      const int k1 = int(std::ceil((from + std::fabs(width)) / step - 0.5)) + 1;
-      for (int kk = k0; kk <= k1 && kk < k0 + kK; ++kk) {
-        const int k = ((kk % kK) + kK) % kK;
-        const double dx = dir.c[k], dy = dir.s[k];
-        // p + t d = a + s e: t = cross(a, e) / cross(d, e), s = cross(a, d) / cross(d, e).
-        const double den = dx * ey[i] - dy * ex[i];
-        if (std::fabs(den) < 1e-300) continue;
-        const double t = (ax[i] * ey[i] - ay[i] * ex[i]) / den;
-        const double s = (ax[i] * dy - ay[i] * dx) / den;
-        if (t >= 0.0 && s >= 0.0 && s <= 1.0) rho[k] = std::min(rho[k], t);
-      }
+// In each direction of the quadrature the visible extent rho (the first segment the ray meets,
+// or r). A segment not through the centre subtends less than pi, so only the directions within
+// the arc between its end points' angles (one more each side, for rounding) can meet it; the
+// exact test decides.
+void visible_extents(const DiscRegion& g, double r, double rho[kK]) {
+  const Directions& dir = directions();
+  std::fill(rho, rho + kK, r);
+  constexpr double step = 2.0 * kPiD / kK;
+  for (int i = 0; i < g.count; ++i) {
+    const double ax = g.seg[i].ax, ay = g.seg[i].ay, ex = g.seg[i].ex, ey = g.seg[i].ey;
+    const double ta = std::atan2(ay, ax), tb = std::atan2(ay + ey, ax + ex);
+    double width = tb - ta;
+    if (width > kPiD) width -= 2.0 * kPiD;
+    if (width < -kPiD) width += 2.0 * kPiD;
+    const double from = width >= 0.0 ? ta : tb;
+    // Direction k sits at (k + 0.5) step.
+    const int k0 = int(std::floor(from / step - 0.5)) - 1;
+    const int k1 = int(std::ceil((from + std::fabs(width)) / step - 0.5)) + 1;
+    for (int kk = k0; kk <= k1 && kk < k0 + kK; ++kk) {
+      const int k = ((kk % kK) + kK) % kK;
+      const double dx = dir.c[k], dy = dir.s[k];
+      // p + t d = a + s e: t = cross(a, e) / cross(d, e), s = cross(a, d) / cross(d, e).
+      const double den = dx * ey - dy * ex;
+      if (std::fabs(den) < 1e-300) continue;
+      const double t = (ax * ey - ay * ex) / den;
+      const double s = (ax * dy - ay * dx) / den;
+      if (t >= 0.0 && s >= 0.0 && s <= 1.0) rho[k] = std::min(rho[k], t);
     }
   }
-};
+}
 
 }  // namespace
 
@@ -134,12 +131,12 @@ float BoundaryIndex::clearance(uint32_t triangle, const vec3& p, float r) const 
   return std::nextafter(float(std::sqrt(nearest)), 0.0f) * (1.0f - 1e-6f);
 }
 
-DiscMoments BoundaryIndex::moments(uint32_t triangle, const vec3& p, const vec3& n, float r) const {
-  DiscMoments m;
-  if (start_.empty()) return m;
+bool BoundaryIndex::region(uint32_t triangle, const vec3& p, const vec3& n, float r,
+                           DiscRegion& out) const {
+  out.count = 0;
+  if (start_.empty()) return false;
   if (!first_copy_.empty()) triangle = first_copy_[triangle];
   // The segments within r of p, projected into p's tangent plane.
-  Projected near;
   const double r2 = double(r) * double(r);
   vec3 t1, t2;
   orthonormal_basis(n, t1, t2);
@@ -155,25 +152,78 @@ DiscMoments BoundaryIndex::moments(uint32_t triangle, const vec3& p, const vec3&
       [&](const Segment& s) {
         if (far(s.mid, s.half) || segment_distance2(p, s.a, s.b) >= r2) return true;
         const dvec3 a = dvec3(s.a) - dvec3(p), b = dvec3(s.b) - dvec3(p);
-        const int i = near.count;
-        near.ax[i] = glm::dot(a, dvec3(t1));
-        near.ay[i] = glm::dot(a, dvec3(t2));
-        near.ex[i] = glm::dot(b, dvec3(t1)) - near.ax[i];
-        near.ey[i] = glm::dot(b, dvec3(t2)) - near.ay[i];
-        return ++near.count < Projected::kMaxNear;
+        RegionSegment& q = out.seg[out.count];
+        q.ax = glm::dot(a, dvec3(t1));
+        q.ay = glm::dot(a, dvec3(t2));
+        q.ex = glm::dot(b, dvec3(t1)) - q.ax;
+        q.ey = glm::dot(b, dvec3(t2)) - q.ay;
+        return ++out.count < DiscRegion::kMaxNear;
       });
-  if (near.count == 0) return m;
+  if (out.count == 0) return false;
+  out.frame = RegionView{};
+  out.frame.t1 = dvec3(t1);
+  out.frame.t2 = dvec3(t2);
   // A point on a segment (a pixel centre that sees exactly the line where two walls meet) sees
   // nothing along it: every ray meets the segment at t = 0. Such a point belongs to the side of
   // its own triangle, so the quadrature's centre moves 1e-3 r towards that triangle's centre;
   // the moments change by O(1e-3) (the disc's part beyond the segment is then about half).
-  if (near.through_centre(r2)) {
+  out.frame.clear2 = nearest2(out);
+  if (out.frame.clear2 < 1e-8 * r2) {
     const dvec3 toward = dvec3(centre_[triangle]) - dvec3(p);
-    near.shift(glm::dot(toward, dvec3(t1)), glm::dot(toward, dvec3(t2)), r);
+    shift(out, glm::dot(toward, out.frame.t1), glm::dot(toward, out.frame.t2), r);
+    out.frame.clear2 = nearest2(out);
   }
+  return true;
+}
+
+DiscMoments BoundaryIndex::moments(uint32_t triangle, const vec3& p, const vec3& n, float r) const {
+  DiscRegion region;
+  if (!this->region(triangle, p, n, r, region)) return DiscMoments{};
+  return moments_of(region, r);
+}
+
+DiscMoments BoundaryIndex::moments_of(const DiscRegion& region, float r) {
   double rho[kK];
-  near.visible_extents(double(r), rho);
+  visible_extents(region, double(r), rho);
   return kernel::polar_moments(rho, kK, double(r));
+}
+
+bool RegionView::contains(const vec3& d) const {
+  const dvec3 dd(d);
+  const double ux = glm::dot(dd, t1) - sx, uy = glm::dot(dd, t2) - sy;
+  if (ux * ux + uy * uy < clear2) return true;  // nearer than every segment
+  // The chord from the centre to u crosses segment i where t u = a + s e with t, s in [0, 1]:
+  // t = cross(a, e) / cross(u, e), s = cross(a, u) / cross(u, e).
+  for (int i = 0; i < count; ++i) {
+    const RegionSegment& q = seg[i];
+    const double den = ux * q.ey - uy * q.ex;
+    if (den == 0.0) continue;  // parallel: it cannot cut the chord
+    const double t = (q.ax * q.ey - q.ay * q.ex) / den;
+    const double s = (q.ax * uy - q.ay * ux) / den;
+    if (t >= 0.0 && t <= 1.0 && s >= 0.0 && s <= 1.0) return false;
+  }
+  return true;
+}
+
+void RegionTable::add(uint32_t point, const DiscRegion& region) {
+  Head h;
+  h.point = point;
+  h.first = uint32_t(segments_.size());
+  h.frame = region.frame;
+  h.frame.seg = nullptr;
+  h.frame.count = region.count;
+  segments_.insert(segments_.end(), region.seg, region.seg + region.count);
+  heads_.push_back(h);
+}
+
+const RegionView* RegionTable::Cursor::at(uint32_t k) {
+  if (!t_) return nullptr;
+  while (next_ < t_->heads_.size() && t_->heads_[next_].point < k) ++next_;
+  if (next_ == t_->heads_.size() || t_->heads_[next_].point != k) return nullptr;
+  const Head& h = t_->heads_[next_];
+  view_ = h.frame;
+  view_.seg = t_->segments_.data() + h.first;
+  return &view_;
 }
 
 }  // namespace pb
