@@ -35,13 +35,13 @@ class World;
 // out.
 struct RegionSegment {
   double ax, ay, ex, ey;  // from (ax, ay) along (ex, ey)
+  double d2;              // its distance from the centre, squared (a region's are in its order)
 };
 
 // A region's frame and segments, wherever the segments are kept (DiscRegion, RegionTable).
 struct RegionView {
   dvec3 t1{0.0}, t2{0.0};
   double sx = 0.0, sy = 0.0;
-  double clear2 = 0.0;  // the nearest segment's distance from the centre, squared
   const RegionSegment* seg = nullptr;
   int count = 0;
   // Whether the photon at d = x_photon - point lies in the region: no segment between the centre

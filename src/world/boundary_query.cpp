@@ -32,16 +32,18 @@ const Directions& directions() {
 
 // The polar quadrature of moments() (ESTIMATOR.md section 11) on a region's segments.
 
+// The distance squared from the centre to segment q.
+double distance2(const RegionSegment& q) {
+  const double len2 = q.ex * q.ex + q.ey * q.ey;
+  const double s = len2 > 0.0 ? std::clamp(-(q.ax * q.ex + q.ay * q.ey) / len2, 0.0, 1.0) : 0.0;
+  const double qx = q.ax + s * q.ex, qy = q.ay + s * q.ey;
+  return qx * qx + qy * qy;
+}
+
 // The distance squared from the centre to the nearest segment.
 double nearest2(const DiscRegion& g) {
   double min_d2 = INFINITY;
-  for (int i = 0; i < g.count; ++i) {
-    const RegionSegment& q = g.seg[i];
-    const double len2 = q.ex * q.ex + q.ey * q.ey;
-    const double s = len2 > 0.0 ? std::clamp(-(q.ax * q.ex + q.ay * q.ey) / len2, 0.0, 1.0) : 0.0;
-    const double qx = q.ax + s * q.ex, qy = q.ay + s * q.ey;
-    min_d2 = std::min(min_d2, qx * qx + qy * qy);
-  }
+  for (int i = 0; i < g.count; ++i) min_d2 = std::min(min_d2, distance2(g.seg[i]));
   return min_d2;
 }
 
@@ -167,12 +169,15 @@ bool BoundaryIndex::region(uint32_t triangle, const vec3& p, const vec3& n, floa
   // nothing along it: every ray meets the segment at t = 0. Such a point belongs to the side of
   // its own triangle, so the quadrature's centre moves 1e-3 r towards that triangle's centre;
   // the moments change by O(1e-3) (the disc's part beyond the segment is then about half).
-  out.frame.clear2 = nearest2(out);
-  if (out.frame.clear2 < 1e-8 * r2) {
+  if (nearest2(out) < 1e-8 * r2) {
     const dvec3 toward = dvec3(centre_[triangle]) - dvec3(p);
     shift(out, glm::dot(toward, out.frame.t1), glm::dot(toward, out.frame.t2), r);
-    out.frame.clear2 = nearest2(out);
   }
+  // Nearest first, each with its distance: a photon's chord reaches only the segments nearer
+  // than the photon (RegionView::contains).
+  for (int i = 0; i < out.count; ++i) out.seg[i].d2 = distance2(out.seg[i]);
+  std::sort(out.seg, out.seg + out.count,
+            [](const RegionSegment& a, const RegionSegment& b) { return a.d2 < b.d2; });
   return true;
 }
 
@@ -191,11 +196,13 @@ DiscMoments BoundaryIndex::moments_of(const DiscRegion& region, float r) {
 bool RegionView::contains(const vec3& d) const {
   const dvec3 dd(d);
   const double ux = glm::dot(dd, t1) - sx, uy = glm::dot(dd, t2) - sy;
-  if (ux * ux + uy * uy < clear2) return true;  // nearer than every segment
+  const double u2 = ux * ux + uy * uy;
   // The chord from the centre to u crosses segment i where t u = a + s e with t, s in [0, 1]:
-  // t = cross(a, e) / cross(u, e), s = cross(a, u) / cross(u, e).
+  // t = cross(a, e) / cross(u, e), s = cross(a, u) / cross(u, e). Every point of the chord is
+  // within |u| of the centre, so the segments farther than that (the rest, nearest first) cannot.
   for (int i = 0; i < count; ++i) {
     const RegionSegment& q = seg[i];
+    if (q.d2 > u2) break;
     const double den = ux * q.ey - uy * q.ex;
     if (den == 0.0) continue;  // parallel: it cannot cut the chord
     const double t = (q.ax * q.ey - q.ay * q.ex) / den;
