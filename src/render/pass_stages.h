@@ -1,7 +1,7 @@
 // The stages of one pass, each a function of plain inputs and outputs; the methods (ppm.h,
 // sppm.h) run them in this order over blocks of points:
 //   0. SPPM only: camera paths trace_visible_points (camera_paths.h) -> visible points, owner
-//   values
+//   values, the regions of the discs that are not whole (RegionTable, world/boundary.h)
 //   1. trace photons          PhotonTracer::run (photon_pass.h)       -> hits of a photon range
 //   2. build the grid         build_photon_grid                       -> grid over the hits
 //   3. gather                 gather_pass: photons within each disc's  -> PassSums (phi, lap, M)
