@@ -31,7 +31,8 @@ struct Phase {
 void gather_on(const pb::World& world, const pb::CameraPassResult& eye, const pb::HashGrid& grid,
                const std::vector<pb::PhotonHit>& hits, const pb::EstimatorParams& params,
                uint64_t pass, std::vector<pb::PointState>& states, std::vector<float>& radii,
-               std::vector<pb::PassSums>& sums, std::vector<pb::OwnerValues>& owner) {
+               std::vector<pb::PassSums>& sums, std::vector<pb::OwnerValues>& owner,
+               std::vector<pb::RegionTable>& regions) {
   const pb::PassInputs in{.world = world,
                           .grid = grid,
                           .hits = hits,
@@ -40,7 +41,7 @@ void gather_on(const pb::World& world, const pb::CameraPassResult& eye, const pb
                           .seed = kSeed,
                           .pass = pass,
                           .next_event = true};
-  pb::ppm_pass(in, eye.points, {}, {}, states, radii, sums, owner, nullptr);
+  pb::ppm_pass(in, eye.points, {}, {}, states, radii, sums, owner, nullptr, regions);
 }
 
 // The same without error estimation: no Laplacian sum (gather_photons<false>) and the PPM update
@@ -95,6 +96,7 @@ PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photo
   std::vector<float> radii(n, pb::search_radius(initial.r2));
   std::vector<pb::PassSums> sums(std::min<size_t>(n, 16384));
   std::vector<pb::OwnerValues> owner(sums.size());
+  std::vector<pb::RegionTable> regions((sums.size() + pb::kStageChunk - 1) / pb::kStageChunk);
   std::vector<pb::dvec3> direct(n);  // the next-event-only timing writes here
   Phase trace, build, t_on, t_off, t_nee;
   double stored = 0.0;
@@ -114,7 +116,7 @@ PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photo
     for (int v = 0; v < 2; ++v) {
       t0 = now();
       if ((v == 0) == (p % 2 == 1)) {
-        gather_on(world, eye, grid, hits, params, pass, on, radii, sums, owner);
+        gather_on(world, eye, grid, hits, params, pass, on, radii, sums, owner, regions);
         t_on.add(t0);
       } else {
         gather_off(world, eye, grid, hits, params, pass, off);
@@ -171,7 +173,7 @@ PassLoop pass_loop(const pb::World& world, const EyeSetup& setup, uint64_t photo
     std::vector<float> scratch_radii = radii;
     const double t0 = now();
     gather_on(world, eye, grid, hits, params, uint64_t(passes + 1), scratch, scratch_radii, sums,
-              owner);
+              owner, regions);
     sgather.add(t0);
   }
   r.shrunk_grid_build = sbuild.median();

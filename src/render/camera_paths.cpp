@@ -36,9 +36,9 @@ struct CameraPath {
   dvec3 emission{0.0};  // light the path saw (and its vertices' next-event samples)
   VisiblePoint point;   // the visible point; f = 0: none
   DiscMoments disc;
-  // The region of the point's disc when it is not whole (`cut`), for the gather.
-  bool cut = false;
-  DiscRegion region;
+  // Where the region of the point's disc goes when the disc is not whole (disc.full false),
+  // for the gather: the caller's.
+  DiscRegion* region = nullptr;
   // The ray leaves a followed GGX lobe: the light it finds directly (an emitter, the
   // environment) is that vertex's direct light, which its next-event sample has counted.
   bool after_lobe = false;
@@ -203,9 +203,10 @@ Step stop_at(CameraPath& path, const CameraPathInputs& in, const Hit& hit, const
     return Step::End;
   }
   if (in.boundary) {
-    path.cut =
-        in.boundary->region(point.triangle, point.position, point.normal, radius, path.region);
-    path.disc = path.cut ? BoundaryIndex::moments_of(path.region, radius) : DiscMoments{};
+    path.disc =
+        in.boundary->region(point.triangle, point.position, point.normal, radius, *path.region)
+            ? BoundaryIndex::moments_of(*path.region, radius)
+            : DiscMoments{};
     if (path.disc.mass < kValidKernelMass)
       return pass_over(path, in, s, wo, w, bsdf, direct_counted);
   }
@@ -252,9 +253,9 @@ Step at_vertex(CameraPath& path, const CameraPathInputs& in, const Hit& hit, flo
 
 std::optional<PointBsdf> trace_visible_point(const CameraPathInputs& in, size_t pixel,
                                              uint32_t path_index, float radius, VisiblePoint& point,
-                                             OwnerValues& out, RegionTable* regions,
-                                             uint32_t index) {
+                                             OwnerValues& out, DiscRegion& region) {
   CameraPath path(in, pixel, path_index);
+  path.region = &region;
   std::optional<PointBsdf> g;
   for (;; ++path.depth) {
     Hit hit;
@@ -281,18 +282,19 @@ std::optional<PointBsdf> trace_visible_point(const CameraPathInputs& in, size_t 
   }
   point = path.point;
   out = OwnerValues{path.emission, path.disc};
-  if (regions && path.cut && max_component(point.f) > 0.0f) regions->add(index, path.region);
   return g;
 }
 
 size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
                             std::span<VisiblePoint> points, std::span<PointBsdf> glossy,
-                            std::span<OwnerValues> out, RegionTable* regions) {
+                            std::span<OwnerValues> out, RegionTable& regions) {
   size_t glossy_count = 0;
-  if (regions) regions->clear();
+  regions.clear();
+  DiscRegion region;
   for (size_t k = 0; k < points.size(); ++k) {
     std::optional<PointBsdf> g =
-        trace_visible_point(in, first + k, 0, radii[k], points[k], out[k], regions, uint32_t(k));
+        trace_visible_point(in, first + k, 0, radii[k], points[k], out[k], region);
+    if (!out[k].disc.full && max_component(points[k].f) > 0.0f) regions.add(uint32_t(k), region);
     if (g) {
       g->point = uint32_t(k);
       glossy[glossy_count++] = *g;

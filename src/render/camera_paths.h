@@ -60,16 +60,15 @@ inline uint64_t path_item(uint64_t pixel, uint32_t path) { return pixel + (uint6
 // One camera path of `pixel` (path number path_index): its visible point (f = 0: none) and
 // owner values as trace_visible_points below gives them; the PointBsdf of a non-Lambertian
 // point (its `point` member left 0).
-// With `regions`, the region of a visible point's disc that is not whole goes there as point
-// `index`'s.
+// Where out.disc is not whole, `region` holds the region it integrates (the gather's).
 std::optional<PointBsdf> trace_visible_point(const CameraPathInputs& in, size_t pixel,
                                              uint32_t path_index, float radius, VisiblePoint& point,
-                                             OwnerValues& out, RegionTable* regions = nullptr,
-                                             uint32_t index = 0);
+                                             OwnerValues& out, DiscRegion& region);
 
+// `regions` receives (cleared first) the regions of the points whose discs are not whole.
 size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
                             std::span<VisiblePoint> points, std::span<PointBsdf> glossy,
-                            std::span<OwnerValues> out, RegionTable* regions = nullptr);
+                            std::span<OwnerValues> out, RegionTable& regions);
 
 // The share of the camera's pixel-centre rays (on a grid of at most 128 x 128 of them) whose
 // first hit passed through the back of a single-sided face (World::camera_hit): what glTF's

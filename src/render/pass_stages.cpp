@@ -179,11 +179,11 @@ template void gather_photons<false>(const VisiblePoint&, const PointBsdf&, doubl
 
 void gather_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
                  const HashGrid& grid, const std::vector<PhotonHit>& hits, PointBsdfTable glossy,
-                 GatherDiscs discs, std::span<PassSums> out, GuideTally::Chunk* tally,
+                 const RegionTable* regions, std::span<PassSums> out, GuideTally::Chunk* tally,
                  const GuideInputs& guide) {
   std::fill(out.begin(), out.end(), PassSums{});
   PointBsdfCursor cursor(glossy, points.size());
-  RegionTable::Cursor regions(discs.regions);
+  RegionTable::Cursor region(regions);
   for (size_t k = 0; k < points.size(); ++k) {
     const VisiblePoint& p = points[k];
     if (!(max_component(p.f) > 0.0f)) continue;  // SPPM: a pixel without a visible point
@@ -197,27 +197,9 @@ void gather_pass(std::span<const VisiblePoint> points, std::span<const PointStat
       learn.weight = relative_error(states[k], guide.passes_done, guide.photons_per_pass) *
                      double(p.f.x + p.f.y + p.f.z) / states[k].r2;
     }
-    if (discs.regions) {
-      gather_point(p, cursor.at(k), states[k].r2, grid, hits, regions.at(uint32_t(k)), out[k],
-                   tally ? &learn : nullptr);
-    } else {
-      static const DiscMoments kWhole;
-      gather_point(p, cursor.at(k), states[k].r2, grid, hits, discs.boundary,
-                   discs.owner.empty() ? kWhole : discs.owner[k].disc, out[k],
-                   tally ? &learn : nullptr);
-    }
+    gather_point(p, cursor.at(k), states[k].r2, grid, hits, region.at(uint32_t(k)), out[k],
+                 tally ? &learn : nullptr);
   }
-}
-
-void gather_point(const VisiblePoint& p, const PointBsdf* glossy, double r2, const HashGrid& grid,
-                  const std::vector<PhotonHit>& hits, const BoundaryIndex* boundary,
-                  const DiscMoments& disc, PassSums& out, const GuideLearning* learn) {
-  DiscRegion region;
-  RegionView view;
-  const bool cut = boundary && !disc.full &&
-                   boundary->region(p.triangle, p.position, p.normal, search_radius(r2), region);
-  if (cut) view = region.view();
-  gather_point(p, glossy, r2, grid, hits, cut ? &view : nullptr, out, learn);
 }
 
 void gather_point(const VisiblePoint& p, const PointBsdf* glossy, double r2, const HashGrid& grid,
@@ -231,8 +213,8 @@ void gather_point(const VisiblePoint& p, const PointBsdf* glossy, double r2, con
 
 void disc_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
                const BoundaryIndex* boundary, std::span<const float> clearance,
-               std::span<OwnerValues> out, RegionTable* regions) {
-  if (regions) regions->clear();
+               std::span<OwnerValues> out, RegionTable& regions) {
+  regions.clear();
   DiscRegion region;
   for (size_t k = 0; k < points.size(); ++k) {
     const VisiblePoint& p = points[k];
@@ -241,7 +223,7 @@ void disc_pass(std::span<const VisiblePoint> points, std::span<const PointState>
     if (!boundary || (!clearance.empty() && r <= clearance[k])) continue;
     if (!boundary->region(p.triangle, p.position, p.normal, r, region)) continue;
     out[k].disc = BoundaryIndex::moments_of(region, r);
-    if (regions) regions->add(uint32_t(k), region);
+    regions.add(uint32_t(k), region);
   }
 }
 

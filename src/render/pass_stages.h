@@ -74,13 +74,7 @@ void gather_photons(const VisiblePoint& point, const PointBsdf& glossy, double r
                     const GuideLearning* learn = nullptr, const RegionView* region = nullptr);
 
 // The gather of one point, on its Bsdf where it has one (glossy non-null) and as a Lambertian
-// point otherwise: the two overloads above, chosen, within the region of its disc whose moments
-// `disc` holds (found again from `boundary` when the disc is not whole; null: no index).
-void gather_point(const VisiblePoint& point, const PointBsdf* glossy, double r2,
-                  const HashGrid& grid, const std::vector<PhotonHit>& hits,
-                  const BoundaryIndex* boundary, const DiscMoments& disc, PassSums& out,
-                  const GuideLearning* learn = nullptr);
-// The same with the region known (null: the whole disc).
+// point otherwise: the two overloads above, chosen, within `region` (null: the whole disc).
 void gather_point(const VisiblePoint& point, const PointBsdf* glossy, double r2,
                   const HashGrid& grid, const std::vector<PhotonHit>& hits,
                   const RegionView* region, PassSums& out, const GuideLearning* learn = nullptr);
@@ -93,9 +87,10 @@ struct PointBsdfTable {
 };
 
 // Stage 3: out[k] = the sums of the photons `hits` brings to points[k] (phi, phi_lap_r2,
-// phi_half, count) at the pass's radius states[k].r2. A point with f = 0 (SPPM: no visible point
-// this pass) gathers nothing and so does not shrink its radius. Points in `glossy` evaluate
-// their Bsdf per photon. With `tally` (--adaptive photons), every gathered photon's
+// phi_half, count) at the pass's radius states[k].r2, within the regions `regions` holds for the
+// points whose discs are not whole (null: every disc whole). A point with f = 0 (SPPM: no
+// visible point this pass) gathers nothing and so does not shrink its radius. Points in `glossy`
+// evaluate their Bsdf per photon. With `tally` (--adaptive photons), every gathered photon's
 // error-weighted contribution goes to its guide cell, the point's relative error from its state
 // after `passes_done` passes (ESTIMATOR.md section 14).
 struct GuideInputs {
@@ -103,27 +98,19 @@ struct GuideInputs {
   uint64_t passes_done = 0;
   double photons_per_pass = 1.0;
 };
-// The discs the points gather over: owner[k].disc, from stage 4's disc_pass (PPM) or the camera
-// path (SPPM), and the regions of those that are not whole (`regions`; without it, found again
-// from `boundary`).
-struct GatherDiscs {
-  const BoundaryIndex* boundary = nullptr;
-  std::span<const OwnerValues> owner;
-  const RegionTable* regions = nullptr;
-};
 void gather_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
                  const HashGrid& grid, const std::vector<PhotonHit>& hits, PointBsdfTable glossy,
-                 GatherDiscs discs, std::span<PassSums> out, GuideTally::Chunk* tally = nullptr,
-                 const GuideInputs& guide = {});
+                 const RegionTable* regions, std::span<PassSums> out,
+                 GuideTally::Chunk* tally = nullptr, const GuideInputs& guide = {});
 
 // Stage 4, PPM: out[k].disc = the kernel's moments over the reachable part of points[k]'s disc
 // at the pass's radius (ESTIMATOR.md section 11); without `boundary` every disc counts as whole.
 // `clearance` holds per point BoundaryIndex::clearance: the radius up to which its disc is whole
-// without asking. With `regions`, the regions of the discs that are not whole go there (cleared
-// first).
+// without asking. `regions` receives (cleared first) the regions of the discs that are not
+// whole, for the gather (stage 3 runs after it).
 void disc_pass(std::span<const VisiblePoint> points, std::span<const PointState> states,
                const BoundaryIndex* boundary, std::span<const float> clearance,
-               std::span<OwnerValues> out, RegionTable* regions = nullptr);
+               std::span<OwnerValues> out, RegionTable& regions);
 
 // Stage 4: adds one next-event sample (ESTIMATOR.md section 4) to out[k].direct for every
 // point with f > 0, Rng keyed by (seed, pass, first + k, DirectLight). A point on a GGX lobe's

@@ -3,6 +3,7 @@
 #include "bsdf/bsdf.h"
 #include "bsdf/scattering.h"
 #include "util/counting_sort.h"
+#include "util/morton.h"
 #include "util/parallel.h"
 #include "util/rng.h"
 
@@ -15,29 +16,11 @@ namespace pb {
 
 namespace {
 
-// Spatial order of the hits: a Morton code on a 2^10 lattice per axis (30 bits), sorted by an
-// LSD radix sort of three 10-bit digits (counting_sort.h: the order does not depend on the
+// Spatial order of the hits: a Morton code on a 2^10 lattice per axis (util/morton.h), sorted
+// by an LSD radix sort of three 10-bit digits (counting_sort.h: the order does not depend on the
 // thread count).
-constexpr int kLatticeBits = 10;
 constexpr int kDigitBits = 10;
 constexpr int kDigits = 3;
-
-// Bit i of the 10-bit x moves to bit 3i ("magic bits" Morton spreading).
-uint32_t spread_bits(uint32_t x) {
-  x &= 0x3ffu;
-  x = (x | (x << 16)) & 0x030000ffu;
-  x = (x | (x << 8)) & 0x0300f00fu;
-  x = (x | (x << 4)) & 0x030c30c3u;
-  x = (x | (x << 2)) & 0x09249249u;
-  return x;
-}
-
-// Lattice cell of v along one axis; NaN and values below the bounds go to cell 0.
-uint32_t lattice(float v, float lo, float scale) {
-  constexpr float kTop = float((1u << kLatticeBits) - 1);
-  const float u = (v - lo) * scale;
-  return u > 0.0f ? uint32_t(std::min(u, kTop)) : 0u;
-}
 
 }  // namespace
 
@@ -198,11 +181,7 @@ void PhotonTracer::order_hits(std::vector<PhotonHit>& hits) {
     lo = glm::min(lo, b.lo);
     hi = glm::max(hi, b.hi);
   }
-  const vec3 extent = hi - lo;
-  const float cells = float(1u << kLatticeBits);
-  const vec3 scale(extent.x > 0.0f ? cells / extent.x : 0.0f,
-                   extent.y > 0.0f ? cells / extent.y : 0.0f,
-                   extent.z > 0.0f ? cells / extent.z : 0.0f);
+  const vec3 scale = morton_scale(lo, hi);
 
   // Keys: Morton code in the high 32 bits, global hit index (photon order) in the low 32, so
   // sorting the codes stably leaves ties in photon order.
@@ -213,10 +192,7 @@ void PhotonTracer::order_hits(std::vector<PhotonHit>& hits) {
     for (size_t k = begin; k < end; ++k) {
       const std::vector<PhotonHit>& in = chunk_hits_[k];
       for (size_t i = 0; i < in.size(); ++i) {
-        const vec3& p = in[i].position;
-        const uint32_t code = spread_bits(lattice(p.x, lo.x, scale.x)) |
-                              spread_bits(lattice(p.y, lo.y, scale.y)) << 1 |
-                              spread_bits(lattice(p.z, lo.z, scale.z)) << 2;
+        const uint32_t code = morton_code(in[i].position, lo, scale);
         const size_t g = chunk_offset_[k] + i;
         keys_[g] = uint64_t(code) << 32 | g;
         chunk_of_[g] = uint32_t(k);

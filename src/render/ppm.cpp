@@ -56,11 +56,11 @@ bool ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
       // The discs first: the gather counts the photons of each disc's region (section 11).
       const std::span<OwnerValues> own = owner.subspan(b, m);
       std::fill(own.begin(), own.end(), OwnerValues{});
-      RegionTable* chunk_regions = regions.empty() ? nullptr : &regions[b / kStageChunk];
+      RegionTable& chunk_regions = regions[b / kStageChunk];
       disc_pass(pts, st, in.boundary, clearance.empty() ? clearance : clearance.subspan(at, m), own,
                 chunk_regions);
-      gather_pass(pts, st, in.grid, in.hits, table, {in.boundary, own, chunk_regions},
-                  sums.subspan(b, m), learn ? &*learn : nullptr, in.guide);
+      gather_pass(pts, st, in.grid, in.hits, table, &chunk_regions, sums.subspan(b, m),
+                  learn ? &*learn : nullptr, in.guide);
       if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, at, own);
     });
     if (cut.load()) return false;  // the first block: nothing folded yet

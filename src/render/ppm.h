@@ -13,13 +13,13 @@ namespace pb {
 // (with `clearance`, per point; empty: ask the boundary index for every disc) and next-event
 // samples into `owner`, the gather into `sums` within those discs, then fold into `states` and
 // `radii`. `glossy` is the points' glossy side table (CameraPassResult::glossy); `copy` (sized to
-// the points) receives the new states. `regions` (one per chunk of kStageChunk points of a block;
-// empty: none) keeps each chunk's discs' regions from the moments to the gather. False when
-// in.cutoff was reached before the first fold (nothing changed).
+// the points) receives the new states. `regions` (one per chunk of kStageChunk points of a
+// block) keeps each chunk's discs' regions from the moments to the gather. False when in.cutoff
+// was reached before the first fold (nothing changed).
 bool ppm_pass(const PassInputs& in, std::span<const VisiblePoint> points,
               std::span<const PointBsdf> glossy, std::span<const float> clearance,
               std::span<PointState> states, std::span<float> radii, std::span<PassSums> sums,
-              std::span<OwnerValues> owner, PointState* copy, std::span<RegionTable> regions = {});
+              std::span<OwnerValues> owner, PointState* copy, std::span<RegionTable> regions);
 
 class PpmMethod final : public PhotonMethod {
  public:

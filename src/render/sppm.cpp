@@ -96,12 +96,12 @@ bool SppmMethod::step(const PassInputs& in, std::span<PointState> states, std::s
       const std::span<const PointState> st = std::span<const PointState>(states).subspan(at, m);
       RegionTable& regions = regions_[b / kStageChunk];
       const size_t n_glossy = trace_visible_points(
-          camera, at, std::span<const float>(radii).subspan(at, m), pts, scratch, own, &regions);
+          camera, at, std::span<const float>(radii).subspan(at, m), pts, scratch, own, regions);
       const PointBsdfTable table{scratch.first(n_glossy), 0};  // indices into pts
       std::optional<GuideTally::Chunk> learn;
       if (in.guide.tally) learn.emplace(*in.guide.tally, b / kStageChunk);
-      gather_pass(pts, st, in.grid, in.hits, table, {in.boundary, own, &regions},
-                  std::span(sums_).subspan(b, m), learn ? &*learn : nullptr, in.guide);
+      gather_pass(pts, st, in.grid, in.hits, table, &regions, std::span(sums_).subspan(b, m),
+                  learn ? &*learn : nullptr, in.guide);
       if (in.next_event) next_event_pass(in.world, pts, table, in.seed, in.pass, at, own);
       if (settings_.adaptive_paths) extra_paths(in, camera, at, b, m, st, radii);
       glossy_count_[b / kStageChunk] = uint32_t(n_glossy);
@@ -166,6 +166,7 @@ void SppmMethod::record_visible(size_t first, std::span<const VisiblePoint> poin
 void SppmMethod::extra_paths(const PassInputs& in, const CameraPathInputs& camera, size_t at,
                              size_t b, size_t m, std::span<const PointState> states,
                              std::span<const float> radii) {
+  DiscRegion region;  // of each extra path's disc when it is not whole
   for (size_t k = 0; k < m; ++k) {
     const size_t pixel = at + k;
     ExtraPaths& e = extra_[b + k];
@@ -183,11 +184,12 @@ void SppmMethod::extra_paths(const PassInputs& in, const CameraPathInputs& camer
       OwnerValues o;
       PassSums g;
       const std::optional<PointBsdf> bsdf =
-          trace_visible_point(camera, pixel, t, radii[pixel], p, o);
+          trace_visible_point(camera, pixel, t, radii[pixel], p, o, region);
       if (max_component(p.f) > 0.0f) {
         // Stages 3 and 4 for this one point, as gather_pass and next_event_pass do them.
         const PointBsdf* glossy = bsdf ? &*bsdf : nullptr;
-        gather_point(p, glossy, r2, in.grid, in.hits, in.boundary, o.disc, g);
+        const RegionView view = region.view();
+        gather_point(p, glossy, r2, in.grid, in.hits, o.disc.full ? nullptr : &view, g);
         if (in.next_event)
           o.direct += next_event_at(in.world, p, glossy, in.seed, in.pass, path_item(pixel, t));
         e.mass = std::min(e.mass, float(o.disc.mass));

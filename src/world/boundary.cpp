@@ -1,6 +1,7 @@
 #include "world/boundary.h"
 
 #include "util/counting_sort.h"
+#include "util/morton.h"
 #include "util/parallel.h"
 #include "world/boundary_geometry.h"
 #include "world/world.h"
@@ -289,45 +290,33 @@ bool BoundaryIndex::add_blockers(const World& world, const std::vector<uint8_t>&
   return truncated;
 }
 
+// The segments in Morton order of their midpoints (util/morton.h): each triangle's list (in
+// segment order, index_pairs) then runs through space, so that the runs of kGroup and kGroup^2
+// entries are compact and a point skips all but the runs near it. Found in mesh order, a
+// ground's list of every fence picket and baluster standing on it had runs strewn across the
+// scene (ESTIMATOR.md section 11: 9% of a pass on a house of separate boards).
+void BoundaryIndex::in_space_order(std::vector<Cut>& cuts) {
+  if (cuts.size() < 2) return;
+  Bounds box;
+  for (const Cut& c : cuts) box.extend(0.5f * (c.s.a + c.s.b));
+  const vec3 scale = morton_scale(box.lo, box.hi);
+  std::vector<uint64_t> keys(cuts.size());  // code << 32 | found order: ties keep that order
+  parallel_for(cuts.size(), 16384, [&](size_t b, size_t e) {
+    for (size_t i = b; i < e; ++i)
+      keys[i] = uint64_t(morton_code(0.5f * (cuts[i].s.a + cuts[i].s.b), box.lo, scale)) << 32 | i;
+  });
+  std::sort(keys.begin(), keys.end());
+  std::vector<Cut> sorted(cuts.size());
+  for (size_t i = 0; i < keys.size(); ++i) sorted[i] = cuts[keys[i] & 0xffffffffu];
+  cuts.swap(sorted);
+}
+
 // Phase 4 (ESTIMATOR.md section 11, "Geometry"): each segment is listed for every triangle of its
 // host's surface within max_radius, as (triangle, segment) pairs. A radius far above the
 // triangles' size over a mesh with many boundary segments (an unposed skinned character at a
 // preview resolution) would list thousands of segments per triangle and take gigabytes: past
 // `budget` pairs the index is given up, every disc counts as whole, and the renderer warns
 // (truncated()).
-// The segments in Morton order of their midpoints: each triangle's list (in segment order,
-// index_pairs) then runs through space, so that the runs of kGroup and kGroup^2 entries are
-// compact and a point skips all but the runs near it. Found in mesh order, a ground's list of
-// every fence picket and baluster standing on it had runs strewn across the scene, and the
-// scans of a house of separate boards took 40% of a pass (ESTIMATOR.md section 11).
-void BoundaryIndex::in_space_order(std::vector<Cut>& cuts) {
-  if (cuts.size() < 2) return;
-  Bounds box;
-  for (const Cut& c : cuts) box.extend(0.5f * (c.s.a + c.s.b));
-  const vec3 extent = glm::max(box.hi - box.lo, vec3(1e-30f));
-  // 10 bits an axis, interleaved.
-  const auto spread = [](uint32_t v) {
-    uint64_t x = v & 0x3ffu;
-    x = (x | (x << 16)) & 0x30000ffULL;
-    x = (x | (x << 8)) & 0x300f00fULL;
-    x = (x | (x << 4)) & 0x30c30c3ULL;
-    x = (x | (x << 2)) & 0x9249249ULL;
-    return x;
-  };
-  std::vector<std::pair<uint64_t, uint32_t>> keys(cuts.size());
-  parallel_for(cuts.size(), 16384, [&](size_t b, size_t e) {
-    for (size_t i = b; i < e; ++i) {
-      const vec3 u = (0.5f * (cuts[i].s.a + cuts[i].s.b) - box.lo) / extent;
-      const auto q = [](float t) { return uint32_t(std::clamp(t, 0.0f, 1.0f) * 1023.0f); };
-      keys[i] = {spread(q(u.x)) | (spread(q(u.y)) << 1) | (spread(q(u.z)) << 2), uint32_t(i)};
-    }
-  });
-  std::sort(keys.begin(), keys.end());  // ties by the found order: deterministic
-  std::vector<Cut> sorted(cuts.size());
-  for (size_t i = 0; i < keys.size(); ++i) sorted[i] = cuts[keys[i].second];
-  cuts.swap(sorted);
-}
-
 std::vector<std::pair<uint32_t, uint32_t>> BoundaryIndex::list_near(
     const World& world, const std::vector<Cut>& found, const std::vector<uint8_t>& host,
     float max_radius, size_t budget, Work& work) {

@@ -50,7 +50,7 @@ struct RegionView {
 };
 
 struct DiscRegion {
-  static constexpr int kMaxNear = 64;  // segments kept (beyond: the first found)
+  static constexpr int kMaxNear = 64;  // segments kept (beyond: the nearest)
   RegionSegment seg[kMaxNear];
   int count = 0;
   RegionView frame;  // its seg is not set: view() gives the whole

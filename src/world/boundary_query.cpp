@@ -149,17 +149,36 @@ bool BoundaryIndex::region(uint32_t triangle, const vec3& p, const vec3& n, floa
     const float reach = (radius + r) * 1.0001f;
     return glm::dot(d, d) > reach * reach;
   };
+  // Past kMaxNear the nearest are kept (by their distance in space, held in d2 until the plane's
+  // replaces it below), so that which segments count does not depend on the lists' order (a
+  // floor under a tessellated sphere lists hundreds of short cuts of its foot).
+  int farthest = -1;  // once full: the kept segment farthest from p
   scan(
       triangle, [&](const Group& g) { return far(g.centre, g.radius); },
       [&](const Segment& s) {
-        if (far(s.mid, s.half) || segment_distance2(p, s.a, s.b) >= r2) return true;
+        if (far(s.mid, s.half)) return true;
+        const double d2 = segment_distance2(p, s.a, s.b);
+        if (d2 >= r2) return true;
+        int i = out.count;
+        if (i == DiscRegion::kMaxNear) {
+          if (d2 >= out.seg[farthest].d2) return true;
+          i = farthest;
+        } else {
+          ++out.count;
+        }
         const dvec3 a = dvec3(s.a) - dvec3(p), b = dvec3(s.b) - dvec3(p);
-        RegionSegment& q = out.seg[out.count];
+        RegionSegment& q = out.seg[i];
         q.ax = glm::dot(a, dvec3(t1));
         q.ay = glm::dot(a, dvec3(t2));
         q.ex = glm::dot(b, dvec3(t1)) - q.ax;
         q.ey = glm::dot(b, dvec3(t2)) - q.ay;
-        return ++out.count < DiscRegion::kMaxNear;
+        q.d2 = d2;
+        if (out.count == DiscRegion::kMaxNear) {
+          farthest = 0;
+          for (int j = 1; j < out.count; ++j)
+            if (out.seg[j].d2 > out.seg[farthest].d2) farthest = j;
+        }
+        return true;
       });
   if (out.count == 0) return false;
   out.frame = RegionView{};
