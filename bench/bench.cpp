@@ -77,6 +77,91 @@ std::string heavy_scene() {
   return path;
 }
 
+std::string smallvcm_twin_scene() {
+  const std::string dir = std::string(PHOTONBOUND_BENCH_DIR) + "/scenes";
+  const std::string path = dir + "/smallvcm_twin.gltf";
+  if (!std::filesystem::exists(path)) {
+    const std::string cmd = "cd '" + std::string(PHOTONBOUND_SOURCE_DIR) +
+                            "' && python3 -m tools.make_scenes --smallvcm '" + dir + "' >/dev/null";
+    if (std::system(cmd.c_str()) != 0) throw std::runtime_error("cannot generate " + path);
+  }
+  return path;
+}
+
+// Wall seconds of one whole SmallVCM process (`-s 0 -a ppm -i N`, all its OpenMP threads).
+double smallvcm_run(const std::string& bin, int iterations) {
+  const std::string out = std::filesystem::temp_directory_path().string() + "/pb_bench_svcm.bmp";
+  const std::string cmd = "'" + bin + "' -s 0 -a ppm -i " + std::to_string(iterations) + " -o '" +
+                          out + "' >/dev/null 2>&1";
+  const double t0 = now();
+  if (std::system(cmd.c_str()) != 0) throw std::runtime_error("cannot run " + cmd);
+  const double seconds = seconds_since(t0);
+  std::filesystem::remove(out);
+  return seconds;
+}
+
+// Issue 40's comparison with SmallVCM's PPM (github.com/SmallVCM/SmallVCM, `smallvcm -a ppm`):
+// its default scene as glTF (tools/make_scenes.py --smallvcm), 512x512, 262,144 photons per
+// pass (SmallVCM traces one light path per pixel per iteration), every light by photons as
+// SmallVCM's PPM does. A whole SPPM pass (pb::Renderer::step: camera paths, photons, grid,
+// gather, estimator) at SmallVCM's radius (0.003 of the scene's bounding-sphere radius) and
+// alpha (0.75) on the fixed schedule, and at photonbound's defaults; medians of `passes`
+// passes after 2 warm ones. SmallVCM's seconds per iteration, when its binary is given
+// (--smallvcm BIN or PB_SMALLVCM), are (16 iterations - 4 iterations) / 12 of whole processes,
+// which leaves out its set-up as the medians leave out ours.
+void smallvcm_twin(const std::string& smallvcm, int passes) {
+  const std::string path = smallvcm_twin_scene();
+  std::printf(
+      "\n== SmallVCM twin %s, 512x512, 262144 photons per pass (pb::Renderer, all threads)\n",
+      path.c_str());
+  const pb::Scene scene = pb::load_gltf(path);
+  const pb::vec3 extent = scene.bounds.hi - scene.bounds.lo;
+  const double scene_radius = 0.5 * double(glm::length(extent));
+  auto pass_seconds = [&](bool theirs) {
+    pb::RenderOptions o;
+    o.scene = path;
+    o.output = "unused.exr";
+    o.width = o.height = 512;
+    o.photons_per_pass = 262144;
+    o.direct = pb::DirectMode::Photons;
+    o.progress = pb::ProgressMode::Never;
+    if (theirs) {
+      o.radius = 0.003 * scene_radius;
+      o.alpha = 0.75;
+      o.adaptive_radius = false;
+    }
+    pb::Renderer r(scene, o);
+    for (int k = 0; k < 2; ++k) r.step();
+    std::vector<double> t;
+    for (int k = 0; k < passes; ++k) {
+      const double t0 = now();
+      r.step();
+      t.push_back(seconds_since(t0));
+    }
+    return median(t);
+  };
+  const double at_theirs = pass_seconds(true), at_default = pass_seconds(false);
+  std::printf("  pass at SmallVCM's radius %.5f and alpha 0.75   %.3f s\n", 0.003 * scene_radius,
+              at_theirs);
+  std::printf("  pass at the defaults                          %.3f s\n", at_default);
+  if (smallvcm.empty()) {
+    std::printf(
+        "  SmallVCM                 not measured (give its binary: --smallvcm BIN or "
+        "PB_SMALLVCM)\n");
+    return;
+  }
+  const double four = smallvcm_run(smallvcm, 4), sixteen = smallvcm_run(smallvcm, 16);
+  const double theirs = (sixteen - four) / 12.0;
+  std::printf("  SmallVCM -a ppm          %.3f s per iteration (4 iterations %.2f s, 16 %.2f s)\n",
+              theirs, four, sixteen);
+  std::printf("  SmallVCM / photonbound   %.2fx at its radius, %.2fx at the defaults\n",
+              theirs / at_theirs, theirs / at_default);
+  goal("SmallVCM twin: SmallVCM / pass, at its radius", fmt("%.2fx", theirs / at_theirs), ">= 3x",
+       theirs >= 3.0 * at_theirs);
+  goal("SmallVCM twin: SmallVCM / pass, at the defaults", fmt("%.2fx", theirs / at_default),
+       ">= 2x", theirs >= 2.0 * at_default);
+}
+
 // A 1920x1080 render of the default scene through pb::Renderer itself at `photons` per pass:
 // peak RSS of the whole render (scene, per-pixel states, photons, grid, pass buffers) and the
 // per-phase times per pass. Returns the render's memory per pixel, all included.
@@ -465,7 +550,10 @@ int run(int argc, char** argv) {
   Config c;
   std::vector<std::string> scenes;
   std::string phase;
-  bool only_checkpoint = false, only_memory = false, only_methods = false, only_probe = false;
+  bool only_checkpoint = false, only_memory = false, only_methods = false, only_probe = false,
+       only_twin = false;
+  const char* env_smallvcm = std::getenv("PB_SMALLVCM");
+  std::string smallvcm = env_smallvcm ? env_smallvcm : "";
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--profile" && i + 1 < argc) {
@@ -478,6 +566,10 @@ int run(int argc, char** argv) {
       only_methods = true;
     } else if (a == "--probe") {
       only_probe = true;
+    } else if (a == "--twin") {
+      only_twin = true;
+    } else if (a == "--smallvcm" && i + 1 < argc) {
+      smallvcm = argv[++i];
     } else if (a == "--quick") {
       c.photons = 100000;
       c.raw_rays = size_t(1) << 18;
@@ -486,7 +578,7 @@ int run(int argc, char** argv) {
     } else if (a == "--help" || a == "-h") {
       std::printf(
           "usage: photonbound-bench [--quick] [--memory] [--checkpoint] [--methods] [--probe] "
-          "[--profile "
+          "[--twin] [--smallvcm BIN] [--profile "
           "raw|trace|pass|grid] "
           "[SCENE ...]\n");
       return 0;
@@ -499,7 +591,8 @@ int run(int argc, char** argv) {
   }
   const std::string cornell = std::string(PHOTONBOUND_SOURCE_DIR) + "/scenes/cornell.gltf";
   if (!phase.empty()) return profile(phase, scenes.empty() ? cornell : scenes[0], c);
-  if (only_checkpoint || only_memory || only_methods || only_probe) {
+  if (only_checkpoint || only_memory || only_methods || only_probe || only_twin) {
+    if (only_twin) smallvcm_twin(smallvcm, c.loop_passes);
     if (only_memory) big_render(scenes.empty() ? cornell : scenes[0], c);
     if (only_methods) method_pass_ratio(scenes.empty() ? cornell : scenes[0], c.loop_passes + 2);
     if (only_probe) probe_cost(scenes.empty() ? cornell : scenes[0], c.loop_passes + 2);
@@ -519,6 +612,7 @@ int run(int argc, char** argv) {
   checkpoint_cost(cornell, c.loop_passes + 2);
   method_pass_ratio(cornell, c.loop_passes + 2);
   probe_cost(cornell, c.loop_passes + 2);
+  smallvcm_twin(smallvcm, c.loop_passes);
   for (const std::string& s : scenes) run_scene(s, c, all);
 
   std::printf(

@@ -91,6 +91,13 @@ python3 -m tools.make_scenes --heavy DIR):
                      clay-coloured Lambertian sphere of 1,046,528 triangles (1024 x 512 UV
                      grid, radius 0.33 (1 + 0.06 sin 9 theta sin 9 phi), analytic normals).
                      Benchmark scene (at least 1 M triangles); no analytic answer.
+
+Not in scenes/ either (python3 -m tools.make_scenes --smallvcm DIR; the benchmark writes it):
+
+  smallvcm_twin.gltf SmallVCM's default scene (github.com/SmallVCM/SmallVCM, `smallvcm -s 0`):
+                     its Cornell box open at the front, a mirror and a glass ball (IOR 1.6) of
+                     radius 0.5, the unlit light box and the sun, SmallVCM's camera; the floor
+                     Lambertian. For issue 40's per-pass comparison with `smallvcm -a ppm`.
 """
 
 import argparse
@@ -468,6 +475,50 @@ def build_cornell_heavy():
     bumpy = displaced_sphere((0.0, 0.0, 0.0), 0.33, 1024, 512, 0.06, 9.0)
     b.mesh_node("bumpy_sphere", [(bumpy, clay)], translation=(-0.45, 0.37, -0.35))
     b.camera_node("camera", eye=(0.0, 1.0, 3.4), target=(0.0, 1.0, 0.0), yfov=0.78)
+    return b
+
+
+def svcm(p):
+    """SmallVCM's z-up coordinates (src/scene.hxx) to glTF's y-up: (x, y, z) -> (x, z, -y)."""
+    return (p[0], p[2], -p[1])
+
+
+def build_smallvcm_twin():
+    """SmallVCM's default scene (`smallvcm -s 0`: its Cornell box, both small balls, the sun)
+    as glTF, for the benchmark's per-pass comparison with `smallvcm -a ppm` (issue 40): the same
+    box, balls, light box and camera, axes turned to glTF's y-up. The floor is Lambertian of
+    SmallVCM's total albedo 0.8 (its Phong lobe has no glTF twin); the balls are UV spheres."""
+    b = GltfBuilder()
+    white = b.lambertian("white", (0.803922,) * 3)
+    floor = b.lambertian("floor", (0.8, 0.8, 0.8))
+    green = b.lambertian("green", (0.156863, 0.803922, 0.172549))
+    red = b.lambertian("red", (0.803922, 0.152941, 0.152941))
+    blue = b.lambertian("blue", (0.156863, 0.172549, 0.803922))
+    mirror = b.mirror("mirror", (1.0, 1.0, 1.0))
+    glass = b.glass("glass", 1.6, thickness=1.0)
+    lo, hi = (-1.27029, -1.25549, -1.28002), (1.28975, 1.30455, 1.28002)  # SmallVCM's box
+    box_lo, box_hi = svcm(lo), svcm(hi)
+    walls = box_faces(tuple(map(min, box_lo, box_hi)), tuple(map(max, box_lo, box_hi)),
+                      inward=True)  # the front (+z here) is open, as in SmallVCM
+    b.mesh_node("walls", [(walls["-y"], floor), (walls["-z"], blue), (walls["+y"], white),
+                          (walls["-x"], green), (walls["+x"], red)])
+    lamp_box = box_faces((-0.25, 1.26002, -0.25), (0.25, 1.28002, 0.25))  # not emitting in -s 0
+    b.mesh_node("light_box", [(merge([lamp_box[f] for f in ("-x", "+x", "-y", "-z", "+z")]),
+                               white)])
+    small = 0.5  # SmallVCM's small balls, 2/7 of the box's width in from its side walls
+    inset = 2.0 * (hi[0] - lo[0]) / 7.0
+    wall_y, wall_z = 0.5 * (lo[1] + hi[1]), lo[2] + small
+    ball = uv_sphere((0.0, 0.0, 0.0), small)
+    b.mesh_node("mirror_ball", [(ball, mirror)],
+                translation=svcm((lo[0] + inset, wall_y, wall_z)))
+    b.mesh_node("glass_ball", [(ball, glass)], translation=svcm((hi[0] - inset, wall_y, wall_z)))
+    # SmallVCM's DirectionalLight(-1, 1.5, -1): the light travels along that direction, with
+    # irradiance (0.5, 0.2, 0) x 20.
+    b.light_node("sun", b.directional_light("sun", 10.0, (1.0, 0.4, 0.0)), svcm((-1.0, 1.5, -1.0)))
+    eye = svcm((-0.0439815, -4.12529, 0.222539))
+    forward = svcm((0.00688625, 0.998505, -0.0542161))
+    b.camera_node("camera", eye=eye, target=add(eye, forward), yfov=math.radians(45.0),
+                  up=svcm((3.73896e-4, 0.0542148, 0.998529)))
     return b
 
 
@@ -926,6 +977,7 @@ CORPUS = [
 
 
 HEAVY = ("cornell_heavy.glb", build_cornell_heavy, GltfBuilder.write_glb)
+SMALLVCM = ("smallvcm_twin.gltf", build_smallvcm_twin, GltfBuilder.write_gltf)
 
 
 def write_into(out_dir, outputs):
@@ -947,11 +999,14 @@ def main():
                                  description=__doc__.split("\n\n")[0])
     where = ap.add_mutually_exclusive_group()
     where.add_argument("--heavy", metavar="DIR", help="write only cornell_heavy.glb, into DIR")
+    where.add_argument("--smallvcm", metavar="DIR", help="write only smallvcm_twin.gltf (the "
+                       "benchmark's twin of SmallVCM's scene), into DIR")
     where.add_argument("--corpus", metavar="DIR", help="write only the exporter-style files of "
                        "tests/gltf/test_corpus.cpp, into DIR")
     args = ap.parse_args()
-    if args.heavy or args.corpus:
-        write_into(Path(args.heavy or args.corpus), [HEAVY] if args.heavy else CORPUS)
+    if args.heavy or args.corpus or args.smallvcm:
+        write_into(Path(args.heavy or args.corpus or args.smallvcm),
+                   [HEAVY] if args.heavy else [SMALLVCM] if args.smallvcm else CORPUS)
         return
     out_dir = Path(REPO) / "scenes"
     out_dir.mkdir(exist_ok=True)

@@ -25,6 +25,10 @@
 #include <span>
 #include <vector>
 
+#if defined(__SSE2__)
+#include <xmmintrin.h>
+#endif
+
 namespace pb {
 
 class HashGrid {
@@ -107,14 +111,44 @@ class HashGrid {
     return m == 0.5 ? e - 1 : e;
   }
 
+  // The distance test over entries [e, end), in their order. Four at a time where SSE2 is (the
+  // x86-64 baseline): on a surface most entries of the cells a query covers lie outside its
+  // sphere (the 8 cells of side >= 2r hold about 10 times the disc's photons), and one branch
+  // per entry on the test mispredicted often; a mask of four tests and a walk over its set
+  // bits does not. The arithmetic is distance2's, operation for operation (no contraction on
+  // this target), so the visits and their dist2 are the scalar loop's, bit for bit.
   template <class Visit>
-  static void scan(const Level& lv, size_t bucket, const vec3& c, float r2, Visit& visit) {
-    const Entry* e = lv.entries.data() + lv.start[bucket];
-    const Entry* end = lv.entries.data() + lv.start[bucket + 1];
+  static void scan_entries(const Entry* e, const Entry* end, const vec3& c, float r2,
+                           Visit& visit) {
+#if defined(__SSE2__)
+    const __m128 cx = _mm_set1_ps(c.x), cy = _mm_set1_ps(c.y), cz = _mm_set1_ps(c.z);
+    const __m128 rr = _mm_set1_ps(r2);
+    for (; end - e >= 4; e += 4) {
+      __m128 x = _mm_loadu_ps(&e[0].position.x), y = _mm_loadu_ps(&e[1].position.x);
+      __m128 z = _mm_loadu_ps(&e[2].position.x), w = _mm_loadu_ps(&e[3].position.x);
+      _MM_TRANSPOSE4_PS(x, y, z, w);  // x, y, z: the four positions' coordinates
+      const __m128 dx = _mm_sub_ps(x, cx), dy = _mm_sub_ps(y, cy), dz = _mm_sub_ps(z, cz);
+      const __m128 d2 =
+          _mm_add_ps(_mm_add_ps(_mm_mul_ps(dx, dx), _mm_mul_ps(dy, dy)), _mm_mul_ps(dz, dz));
+      int inside = _mm_movemask_ps(_mm_cmplt_ps(d2, rr));
+      if (inside == 0) continue;
+      alignas(16) float d2s[4];
+      _mm_store_ps(d2s, d2);
+      for (; inside != 0; inside &= inside - 1) {
+        const int i = __builtin_ctz(unsigned(inside));
+        visit(e[i].index, d2s[i]);
+      }
+    }
+#endif
     for (; e != end; ++e) {
       const float d2 = distance2(e->position, c);
       if (d2 < r2) visit(e->index, d2);
     }
+  }
+  template <class Visit>
+  static void scan(const Level& lv, size_t bucket, const vec3& c, float r2, Visit& visit) {
+    const Entry* e = lv.entries.data() + lv.start[bucket];
+    scan_entries(e, lv.entries.data() + lv.start[bucket + 1], c, r2, visit);
   }
 
   // build()'s phases after validation (hash_grid.cpp): the levels the radii use, a level's
@@ -158,10 +192,7 @@ void HashGrid::query(const vec3& center, float radius, Visit&& visit) const {
   if (cells > double(lv.entries.size())) {
     // More cells than photons (a radius far above the build radii): every photon of the level
     // is in entries exactly once, so one linear scan is exact and cheaper than the cell walk.
-    for (const Entry& e : lv.entries) {
-      const float d2 = distance2(e.position, center);
-      if (d2 < r2) visit(e.index, d2);
-    }
+    scan_entries(lv.entries.data(), lv.entries.data() + lv.entries.size(), center, r2, visit);
     return;
   }
 
