@@ -20,7 +20,9 @@ SRC = ROOT / "src"
 LIBRARIES = {
     "embree3/": "embree",
     "OpenImageIO/": "PkgConfig::OIIO",
+    "OpenEXR/openexr": "OpenEXR::OpenEXRCore",  # the C core library's headers (openexr*.h)
     "OpenEXR/": "OpenEXR::OpenEXR",
+    "libdeflate.h": "PkgConfig::DEFLATE",
     "tiny_gltf.h": "TinyGLTF::TinyGLTF",
     "draco/": "draco::draco",
     "meshoptimizer.h": "meshoptimizer::meshoptimizer",

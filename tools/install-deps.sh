@@ -7,7 +7,7 @@ set -euo pipefail
 
 packages=(
   cmake ninja-build g++ pkg-config
-  libembree-dev libopenimageio-dev libopenexr-dev libjpeg-dev libglm-dev libtinygltf-dev
+  libembree-dev libopenimageio-dev libopenexr-dev libdeflate-dev libjpeg-dev libglm-dev libtinygltf-dev
   libdraco-dev libmeshoptimizer-dev nlohmann-json3-dev
   libtbb-dev libboost-dev libgtest-dev
   libopenmpi-dev openmpi-bin

@@ -1,24 +1,21 @@
 #include "io/image_io.h"
 
-#include <OpenEXR/ImfChannelList.h>
-#include <OpenEXR/ImfFrameBuffer.h>
-#include <OpenEXR/ImfHeader.h>
-#include <OpenEXR/ImfOutputFile.h>
-#include <OpenEXR/ImfStringAttribute.h>
-#include <OpenEXR/ImfThreading.h>
+#include <OpenEXR/openexr.h>
 #include <dlfcn.h>
-#include <tbb/global_control.h>
+#include <libdeflate.h>
 
 #include <algorithm>
 #include <cctype>
 #include <cstring>
 #include <filesystem>
 #include <mutex>
+#include <span>
 
 #include "io/container_check.h"
 #include "io/oiio_codec.h"
 #include "util/file_io.h"
 #include "util/message_text.h"
+#include "util/parallel.h"
 
 // Defined where the module's sources are linked in (the fuzz targets); null otherwise.
 extern "C" const pb::OiioCodec* photonbound_oiio_codec() __attribute__((weak));
@@ -107,44 +104,118 @@ int ExrImage::channel_index(const std::string& name) const {
   return -1;
 }
 
-// Through OpenEXR itself, not the module: a render writes its image without loading
+namespace {
+
+// One chunk of a scan-line EXR as the file holds it: ZIP's 16 lines (OpenEXR's
+// ImfZipCompressor: the lines' channels in the file's channel order, each channel's row of
+// floats; bytes split into even and odd halves, then differences of consecutive bytes; zlib
+// format), or the packed bytes themselves where compression would not shrink them (the reader
+// tells the two apart by the size, as the format says).
+struct ExrChunk {
+  std::vector<unsigned char> bytes;
+};
+
+void pack_lines(const ExrImage& image, std::span<const size_t> order, int y0, int y1,
+                unsigned char* out) {
+  const size_t nc = image.channels.size(), w = size_t(image.width);
+  for (int y = y0; y < y1; ++y)
+    for (const size_t c : order) {
+      const float* row = image.pixels.data() + size_t(y) * w * nc + c;
+      for (size_t x = 0; x < w; ++x, out += sizeof(float)) std::memcpy(out, row + x * nc, 4);
+    }
+}
+
+void zip_predict(const unsigned char* raw, size_t n, unsigned char* out) {
+  unsigned char* even = out;
+  unsigned char* odd = out + (n + 1) / 2;
+  for (size_t i = 0; i < n; ++i) (i % 2 == 0 ? *even++ : *odd++) = raw[i];
+  int previous = out[0];
+  for (size_t i = 1; i < n; ++i) {
+    const int d = int(out[i]) - previous + (128 + 256);
+    previous = out[i];
+    out[i] = static_cast<unsigned char>(d);
+  }
+}
+
+void check(exr_result_t r, const char* what) {
+  if (r != EXR_ERR_SUCCESS)
+    throw std::runtime_error(std::string(what) + ": " + exr_get_default_error_message(r));
+}
+
+}  // namespace
+
+// Through OpenEXR's core library, not the module: a render writes its image without loading
 // OpenImageIO. The file is what OpenImageIO wrote before (float channels, sorted by name as EXR
-// keeps them, "photonbound:KEY" string attributes), less OpenImageIO's own attributes.
+// keeps them, "photonbound:KEY" string attributes), less OpenImageIO's own attributes. ZIP's
+// deflate is libdeflate's at its fastest level rather than zlib's inside OpenEXR: the bound,
+// noise and variance channels are noise-like floats that deflate shrinks little and slowly
+// (a 16-pass 512x512 render's 20 channels: zlib level 1 0.50 s of CPU, libdeflate level 1
+// 0.26 s, the files within 0.1% of each other), and the chunks are compressed on the render's
+// threads and written in order.
 void write_exr(const std::string& path, const ExrImage& image, ExrCompression compression) {
   const size_t nc = image.channels.size();
   if (image.width <= 0 || image.height <= 0 || nc == 0 ||
       image.pixels.size() != size_t(image.width) * size_t(image.height) * nc)
     throw ImageError(path + ": cannot write: the image holds no pixels");
+  const bool zip = compression == ExrCompression::Zip;
+  const int lines = zip ? 16 : 1;  // scan lines per chunk (ZIP's 16; NONE's 1)
   write_image(path, [&](const std::string& tmp) {
+    exr_context_t ctx = nullptr;
     try {
-      Imf::Header header(image.width, image.height);
-      header.compression() =
-          compression == ExrCompression::Zip ? Imf::ZIP_COMPRESSION : Imf::NO_COMPRESSION;
-      // zlib's fastest level: on a 16-pass 512x512 render's channels 0.26 s against 0.36 s at
-      // OpenEXR's default (4), and the file 0.07% smaller (the noise-like bound channels gain
-      // nothing from a longer search).
-      header.zipCompressionLevel() = 1;
-      Imf::FrameBuffer frame;
-      const size_t x_stride = nc * sizeof(float);
-      for (size_t c = 0; c < nc; ++c) {
-        header.channels().insert(image.channels[c], Imf::Channel(Imf::FLOAT));
-        // OpenEXR's slices are writable pointers; writePixels only reads them.
-        char* base = reinterpret_cast<char*>(const_cast<float*>(image.pixels.data() + c));
-        frame.insert(image.channels[c],
-                     Imf::Slice(Imf::FLOAT, base, x_stride, x_stride * size_t(image.width)));
-      }
+      exr_context_initializer_t init = EXR_DEFAULT_CONTEXT_INITIALIZER;
+      check(exr_start_write(&ctx, tmp.c_str(), EXR_WRITE_FILE_DIRECTLY, &init), "start");
+      int part = 0;
+      check(exr_add_part(ctx, "", EXR_STORAGE_SCANLINE, &part), "part");
+      check(exr_initialize_required_attr_simple(ctx, part, image.width, image.height,
+                                                zip ? EXR_COMPRESSION_ZIP : EXR_COMPRESSION_NONE),
+            "header");
+      for (const std::string& name : image.channels)
+        check(exr_add_channel(ctx, part, name.c_str(), EXR_PIXEL_FLOAT,
+                              EXR_PERCEPTUALLY_LOGARITHMIC, 1, 1),
+              "channel");
       for (const auto& [key, value] : image.metadata)
-        header.insert("photonbound:" + key, Imf::StringAttribute(value));
-      // ZIP compresses blocks of 16 lines apart: as many threads as the render may use (0.5 s
-      // of zlib at 512x512 on one thread).
-      const int threads =
-          int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-      static std::once_flag pool;
-      std::call_once(pool, [&] { Imf::setGlobalThreadCount(std::max(threads, 1)); });
-      Imf::OutputFile file(tmp.c_str(), header, std::max(threads, 1));
-      file.setFrameBuffer(frame);
-      file.writePixels(image.height);
+        check(exr_attr_set_string(ctx, part, ("photonbound:" + key).c_str(), value.c_str()),
+              "attribute");
+      check(exr_write_header(ctx), "header");
+      // The file's channel order (sorted by name) as indices into the image's.
+      const exr_attr_chlist_t* list = nullptr;
+      check(exr_get_channels(ctx, part, &list), "channels");
+      std::vector<size_t> order;
+      for (int i = 0; i < list->num_channels; ++i)
+        order.push_back(size_t(image.channel_index(list->entries[i].name.str)));
+      const int chunks = (image.height + lines - 1) / lines;
+      const size_t line_bytes = size_t(image.width) * nc * sizeof(float);
+      std::vector<ExrChunk> out(static_cast<size_t>(chunks));
+      parallel_for(size_t(chunks), 1, [&](size_t begin, size_t end) {
+        std::vector<unsigned char> raw(line_bytes * size_t(lines)), split(raw.size());
+        libdeflate_compressor* deflate = zip ? libdeflate_alloc_compressor(1) : nullptr;
+        if (zip && !deflate) throw std::bad_alloc();
+        for (size_t k = begin; k < end; ++k) {
+          const int y0 = int(k) * lines, y1 = std::min(image.height, y0 + lines);
+          const size_t n = line_bytes * size_t(y1 - y0);
+          pack_lines(image, order, y0, y1, raw.data());
+          std::vector<unsigned char>& bytes = out[k].bytes;
+          if (zip) {
+            zip_predict(raw.data(), n, split.data());
+            bytes.resize(libdeflate_zlib_compress_bound(deflate, n));
+            const size_t z =
+                libdeflate_zlib_compress(deflate, split.data(), n, bytes.data(), bytes.size());
+            if (z > 0 && z < n) {
+              bytes.resize(z);
+              continue;
+            }
+          }
+          bytes.assign(raw.begin(), raw.begin() + ptrdiff_t(n));
+        }
+        if (deflate) libdeflate_free_compressor(deflate);
+      });
+      for (int k = 0; k < chunks; ++k)
+        check(exr_write_scanline_chunk(ctx, part, k * lines, out[size_t(k)].bytes.data(),
+                                       out[size_t(k)].bytes.size()),
+              "chunk");
+      check(exr_finish(&ctx), "finish");
     } catch (const std::exception& e) {
+      if (ctx) exr_finish(&ctx);
       throw ImageError(path + ": cannot write: " + one_line(e.what()));
     }
   });

@@ -1,6 +1,7 @@
 // EXR reading and writing, and decoding the images of glTF textures. EXRs are written through
-// OpenEXR (image_io.cpp); everything that needs OpenImageIO (reads, texture decoding, PNG) is
-// in the module src/io/oiio/, which image_io.cpp loads on first use (io/oiio_codec.h).
+// OpenEXR's core library, their ZIP chunks deflated by libdeflate (image_io.cpp); everything that
+// needs OpenImageIO (reads, texture decoding, PNG) is in the module src/io/oiio/, which
+// image_io.cpp loads on first use (io/oiio_codec.h).
 #pragma once
 
 #include "scene/scene.h"
@@ -28,8 +29,9 @@ struct ExrImage {
 };
 
 // How write_exr compresses. The bound, noise and variance channels are noise-like floats that
-// ZIP shrinks by only ~6% (512x512 default scene) for ~0.4 s of CPU, so checkpoints, which are
-// rewritten every few seconds to minutes, are written uncompressed; the final image uses ZIP.
+// ZIP shrinks little (the 20 channels of a 16-pass 512x512 render of the default scene: 30% in
+// all, for 0.26 s of CPU at libdeflate's fastest level), so checkpoints, which are rewritten
+// every few seconds to minutes, are written uncompressed; the final image uses ZIP.
 enum class ExrCompression { Zip, None };
 
 // Writes float32 EXR atomically (file_io.h write_atomically): a reader never sees a partial
