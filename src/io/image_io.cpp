@@ -128,7 +128,12 @@ void pack_lines(const ExrImage& image, std::span<const size_t> order, int y0, in
 void zip_predict(const unsigned char* raw, size_t n, unsigned char* out) {
   unsigned char* even = out;
   unsigned char* odd = out + (n + 1) / 2;
-  for (size_t i = 0; i < n; ++i) (i % 2 == 0 ? *even++ : *odd++) = raw[i];
+  size_t i = 0;
+  for (; i + 1 < n; i += 2) {
+    *even++ = raw[i];
+    *odd++ = raw[i + 1];
+  }
+  if (i < n) *even = raw[i];
   int previous = out[0];
   for (size_t i = 1; i < n; ++i) {
     const int d = int(out[i]) - previous + (128 + 256);
