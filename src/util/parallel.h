@@ -5,9 +5,11 @@
 #include <algorithm>
 #include <cstddef>
 #include <memory>
+#include <utility>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
 
 namespace pb {
 
@@ -45,6 +47,13 @@ void parallel_chunks(size_t n, size_t chunk_size, Body&& body) {
                       for (size_t k = r.begin(); k < r.end(); ++k)
                         body(k, k * chunk_size, std::min(n, (k + 1) * chunk_size));
                     });
+}
+
+// Runs the calls, possibly at once; returns when all have. Each call's own arithmetic is
+// sequential, so its result does not depend on the threads.
+template <class... Calls>
+void parallel_invoke(Calls&&... calls) {
+  tbb::parallel_invoke(std::forward<Calls>(calls)...);
 }
 
 }  // namespace pb
