@@ -8,6 +8,7 @@
 #include <cctype>
 #include <cstring>
 #include <filesystem>
+#include <memory>
 #include <mutex>
 #include <span>
 
@@ -106,15 +107,11 @@ int ExrImage::channel_index(const std::string& name) const {
 
 namespace {
 
-// One chunk of a scan-line EXR as the file holds it: ZIP's 16 lines (OpenEXR's
-// ImfZipCompressor: the lines' channels in the file's channel order, each channel's row of
-// floats; bytes split into even and odd halves, then differences of consecutive bytes; zlib
-// format), or the packed bytes themselves where compression would not shrink them (the reader
-// tells the two apart by the size, as the format says).
-struct ExrChunk {
-  std::vector<unsigned char> bytes;
-};
-
+// A chunk of a scan-line EXR as the file holds it (OpenEXR's ImfZipCompressor): its lines'
+// channels in the file's channel order, each channel's row of floats; for ZIP, bytes split
+// into even and odd halves, then differences of consecutive bytes, then zlib format, or the
+// packed bytes themselves where that would not shrink them (the reader tells the two apart by
+// the size, as the format says).
 void pack_lines(const ExrImage& image, std::span<const size_t> order, int y0, int y1,
                 unsigned char* out) {
   const size_t nc = image.channels.size(), w = size_t(image.width);
@@ -135,12 +132,24 @@ void zip_predict(const unsigned char* raw, size_t n, unsigned char* out) {
   }
   if (i < n) *even = raw[i];
   int previous = out[0];
-  for (size_t i = 1; i < n; ++i) {
-    const int d = int(out[i]) - previous + (128 + 256);
-    previous = out[i];
-    out[i] = static_cast<unsigned char>(d);
+  for (size_t k = 1; k < n; ++k) {
+    const int d = int(out[k]) - previous + (128 + 256);
+    previous = out[k];
+    out[k] = static_cast<unsigned char>(d);
   }
 }
+
+struct FreeCompressor {
+  void operator()(libdeflate_compressor* c) const { libdeflate_free_compressor(c); }
+};
+
+// One chunk of a batch: its bytes as written (the first `size` of `a`), the predictor's
+// scratch `b` and a compressor, kept across batches.
+struct ChunkSlot {
+  std::vector<unsigned char> a, b;
+  std::unique_ptr<libdeflate_compressor, FreeCompressor> deflate;
+  size_t size = 0;
+};
 
 void check(exr_result_t r, const char* what) {
   if (r != EXR_ERR_SUCCESS)
@@ -189,35 +198,43 @@ void write_exr(const std::string& path, const ExrImage& image, ExrCompression co
       for (int i = 0; i < list->num_channels; ++i)
         order.push_back(size_t(image.channel_index(list->entries[i].name.str)));
       const int chunks = (image.height + lines - 1) / lines;
-      const size_t line_bytes = size_t(image.width) * nc * sizeof(float);
-      std::vector<ExrChunk> out(static_cast<size_t>(chunks));
-      parallel_for(size_t(chunks), 1, [&](size_t begin, size_t end) {
-        std::vector<unsigned char> raw(line_bytes * size_t(lines)), split(raw.size());
-        libdeflate_compressor* deflate = zip ? libdeflate_alloc_compressor(1) : nullptr;
-        if (zip && !deflate) throw std::bad_alloc();
-        for (size_t k = begin; k < end; ++k) {
-          const int y0 = int(k) * lines, y1 = std::min(image.height, y0 + lines);
-          const size_t n = line_bytes * size_t(y1 - y0);
-          pack_lines(image, order, y0, y1, raw.data());
-          std::vector<unsigned char>& bytes = out[k].bytes;
-          if (zip) {
-            zip_predict(raw.data(), n, split.data());
-            bytes.resize(libdeflate_zlib_compress_bound(deflate, n));
-            const size_t z =
-                libdeflate_zlib_compress(deflate, split.data(), n, bytes.data(), bytes.size());
-            if (z > 0 && z < n) {
-              bytes.resize(z);
-              continue;
-            }
+      const size_t chunk_bytes = size_t(image.width) * nc * sizeof(float) * size_t(lines);
+      // Chunks in batches of about 8 MB, compressed at once on the render's threads and written
+      // in order: the write holds two buffers of a batch (16 MB) beside the image, not a copy.
+      const size_t per_batch = std::clamp<size_t>((size_t(8) << 20) / chunk_bytes, 1, 64);
+      std::vector<ChunkSlot> slots(std::min(per_batch, size_t(chunks)));
+      for (ChunkSlot& slot : slots) {
+        slot.a.resize(chunk_bytes);
+        if (!zip) continue;
+        slot.b.resize(chunk_bytes);
+        slot.deflate.reset(libdeflate_alloc_compressor(1));
+        if (!slot.deflate) throw std::bad_alloc();
+      }
+      for (int first = 0; first < chunks; first += int(slots.size())) {
+        const int count = std::min(int(slots.size()), chunks - first);
+        parallel_for(size_t(count), 1, [&](size_t begin, size_t end) {
+          for (size_t j = begin; j < end; ++j) {
+            ChunkSlot& slot = slots[j];
+            const int y0 = (first + int(j)) * lines, y1 = std::min(image.height, y0 + lines);
+            const size_t n = chunk_bytes / size_t(lines) * size_t(y1 - y0);
+            pack_lines(image, order, y0, y1, slot.a.data());
+            slot.size = n;
+            if (!zip) continue;
+            zip_predict(slot.a.data(), n, slot.b.data());
+            // Room for fewer bytes than the packed ones: 0 when deflate would not shrink them.
+            const size_t z = libdeflate_zlib_compress(slot.deflate.get(), slot.b.data(), n,
+                                                      slot.a.data(), n - 1);
+            if (z > 0)
+              slot.size = z;
+            else  // stored: the packed bytes again (the compressor wrote over them)
+              pack_lines(image, order, y0, y1, slot.a.data());
           }
-          bytes.assign(raw.begin(), raw.begin() + ptrdiff_t(n));
-        }
-        if (deflate) libdeflate_free_compressor(deflate);
-      });
-      for (int k = 0; k < chunks; ++k)
-        check(exr_write_scanline_chunk(ctx, part, k * lines, out[size_t(k)].bytes.data(),
-                                       out[size_t(k)].bytes.size()),
-              "chunk");
+        });
+        for (int j = 0; j < count; ++j)
+          check(exr_write_scanline_chunk(ctx, part, (first + j) * lines, slots[size_t(j)].a.data(),
+                                         slots[size_t(j)].size),
+                "chunk");
+      }
       check(exr_finish(&ctx), "finish");
     } catch (const std::exception& e) {
       if (ctx) exr_finish(&ctx);
