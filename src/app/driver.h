@@ -84,6 +84,19 @@ double tested_quantity(const RenderOptions& options, const FilmSummary& summary)
 // A short name of it for the progress line ("mean error", "mean bound", "90% of pixels").
 std::string tested_name(const RenderOptions& options);
 
+// The pass at which the tested quantity, `value` at `pass`, reaches `target`, by the power law
+// through it and an earlier test's (`early_pass`, `early_value`); NaN where there is none (no
+// earlier test, or the quantity did not fall). The progress line's time left and the stop test's
+// schedule both extrapolate with it.
+double passes_to_target(uint64_t pass, double value, uint64_t early_pass, double early_value,
+                        double target);
+
+// The pass of the next stop test after one at `pass` that found `value` above `target`
+// (ESTIMATOR.md section 7): about 10% of the passes later, or sooner, where the power law says
+// the target is crossed before then, but never within 2.5% of the passes of this test.
+uint64_t next_check_after(uint64_t pass, double value, uint64_t early_pass, double early_value,
+                          double target);
+
 // The figures of the closing line: the quantity the stop rule tests, then the mean bound; with
 // pixels unknown, how many, and no mean at all when the known pixels are not a majority (their
 // mean is not the image's: issue 37's background of bound 0).

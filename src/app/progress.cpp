@@ -84,9 +84,9 @@ std::string ProgressPrinter::line(const PassInfo& info) {
     const double early_value = info.schedule.early_value;
     if (tested <= *o.target_error) {
       left = std::min(left, to_check);
-    } else if (early > 0 && pass > early && tested < early_value) {
-      const double k = std::log(early_value / tested) / std::log(double(pass) / double(early));
-      const double needed = double(pass) * std::pow(tested / *o.target_error, 1.0 / k);
+    } else if (const double needed =
+                   passes_to_target(pass, tested, early, early_value, *o.target_error);
+               std::isfinite(needed)) {
       left = std::min(left, std::max((needed - double(pass)) * per_pass, to_check));
     }
   }

@@ -259,5 +259,31 @@ TEST(Stop, TheReportsImageIsTheLastStatesDevelopment) {
   }
 }
 
+// The stop test's schedule (ESTIMATOR.md section 7): about 10% of the passes apart, drawn in to
+// the pass where the power law through two tests puts the target, never nearer than 2.5% of the
+// passes; any quantity without a usable trend keeps the regular schedule.
+TEST(Stop, TheNextTestIsAtTheExtrapolatedCrossingWithinTheRegularInterval) {
+  // A quantity falling exactly as passes^-0.5: 0.02 at pass 100, 0.02 * sqrt(100 / 200) at 200.
+  const double at100 = 0.02, at200 = 0.02 * std::sqrt(0.5);
+  EXPECT_NEAR(passes_to_target(200, at200, 100, at100, 0.01), 400.0, 1e-9);
+  // The target far off: the regular test, 10% on.
+  EXPECT_EQ(next_check_after(200, at200, 100, at100, 0.01), 220u);
+  // The crossing 5% on (at 210.x passes): the test there, rounded up, not at 220.
+  const double target = at200 * std::sqrt(200.0 / 210.5);
+  EXPECT_EQ(next_check_after(200, at200, 100, at100, target), 211u);
+  // The crossing 1% on: no nearer than 2.5% (5 passes).
+  EXPECT_EQ(next_check_after(200, at200, 100, at100, at200 * std::sqrt(200.0 / 202.0)), 205u);
+  // Below 40 passes the nearest is the next pass; below 20 every pass is a test anyway.
+  EXPECT_EQ(next_check_after(30, 0.0101, 16, 0.02, 0.01), 31u);
+  EXPECT_EQ(next_check_after(16, 0.5, 0, 0.0, 0.01), 17u);
+  // No earlier test, a quantity that rose, an unknown one, a met target: the regular schedule.
+  EXPECT_EQ(next_check_after(200, 0.0101, 0, 0.0, 0.01), 220u);
+  EXPECT_EQ(next_check_after(200, 0.0101, 100, 0.0100, 0.01), 220u);
+  EXPECT_EQ(next_check_after(200, INFINITY, 100, 0.02, 0.01), 220u);
+  EXPECT_EQ(next_check_after(200, NAN, 100, 0.02, 0.01), 220u);
+  EXPECT_EQ(next_check_after(200, 0.009, 100, 0.02, 0.01), 220u);
+  EXPECT_TRUE(std::isnan(passes_to_target(200, 0.0101, 200, 0.02, 0.01)));
+}
+
 }  // namespace
 }  // namespace pb
