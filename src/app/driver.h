@@ -92,8 +92,9 @@ double passes_to_target(uint64_t pass, double value, uint64_t early_pass, double
                         double target);
 
 // The pass of the next stop test after one at `pass` that found `value` above `target`
-// (ESTIMATOR.md section 7): about 10% of the passes later, or sooner, where the power law says
-// the target is crossed before then, but never within 2.5% of the passes of this test.
+// (ESTIMATOR.md section 7): about 10% of the passes later; sooner, where the power law says the
+// target is crossed before then, but never within 2.5% of the passes of this test; later, three
+// quarters of the way to the crossing, where that is further, but never beyond twice the passes.
 uint64_t next_check_after(uint64_t pass, double value, uint64_t early_pass, double early_value,
                           double target);
 

@@ -261,13 +261,21 @@ TEST(Stop, TheReportsImageIsTheLastStatesDevelopment) {
 
 // The stop test's schedule (ESTIMATOR.md section 7): about 10% of the passes apart, drawn in to
 // the pass where the power law through two tests puts the target, never nearer than 2.5% of the
-// passes; any quantity without a usable trend keeps the regular schedule.
+// passes, or put off to three quarters of the way to it, never beyond twice the passes; any
+// quantity without a usable trend keeps the regular schedule.
 TEST(Stop, TheNextTestIsAtTheExtrapolatedCrossingWithinTheRegularInterval) {
   // A quantity falling exactly as passes^-0.5: 0.02 at pass 100, 0.02 * sqrt(100 / 200) at 200.
   const double at100 = 0.02, at200 = 0.02 * std::sqrt(0.5);
   EXPECT_NEAR(passes_to_target(200, at200, 100, at100, 0.01), 400.0, 1e-9);
-  // The target far off: the regular test, 10% on.
-  EXPECT_EQ(next_check_after(200, at200, 100, at100, 0.01), 220u);
+  // The target far off (at 400 passes): three quarters of the way there, not 10% on.
+  const uint64_t later = next_check_after(200, at200, 100, at100, 0.01);
+  EXPECT_GE(later, 350u);
+  EXPECT_LE(later, 351u);  // the ceiling of 350 computed in floating point
+  // Just beyond the regular test (at 223.5): three quarters of the way falls short of the
+  // regular test, which stays.
+  EXPECT_EQ(next_check_after(200, at200, 100, at100, at200 * std::sqrt(200.0 / 223.5)), 220u);
+  // A quantity that barely falls: never beyond twice the passes.
+  EXPECT_EQ(next_check_after(200, 0.0199, 100, 0.02, 0.01), 400u);
   // The crossing 5% on (at 210.x passes): the test there, rounded up, not at 220.
   const double target = at200 * std::sqrt(200.0 / 210.5);
   EXPECT_EQ(next_check_after(200, at200, 100, at100, target), 211u);
