@@ -52,13 +52,28 @@ std::string tested_name(const RenderOptions& o) {
   return "";
 }
 
+namespace {
+
+// The exponent k of the power law U ~ passes^-k through two tests; NaN where the quantity did not
+// fall, is not finite, or there is no earlier test.
+double falling_slope(uint64_t pass, double value, uint64_t early_pass, double early_value) {
+  if (!(early_pass > 0 && pass > early_pass && std::isfinite(value) && value > 0.0 &&
+        value < early_value))
+    return NAN;
+  return std::log(early_value / value) / std::log(double(pass) / double(early_pass));
+}
+
+// The pass at which value * (pass / i)^k reaches target.
+double crossing(uint64_t pass, double value, double k, double target) {
+  return double(pass) * std::pow(value / target, 1.0 / k);
+}
+
+}  // namespace
+
 double passes_to_target(uint64_t pass, double value, uint64_t early_pass, double early_value,
                         double target) {
-  if (!(early_pass > 0 && pass > early_pass && std::isfinite(value) && value > 0.0 &&
-        value < early_value && target > 0.0))
-    return NAN;
-  const double k = std::log(early_value / value) / std::log(double(pass) / double(early_pass));
-  return double(pass) * std::pow(value / target, 1.0 / k);
+  const double k = falling_slope(pass, value, early_pass, early_value);
+  return std::isnan(k) || !(target > 0.0) ? NAN : crossing(pass, value, k, target);
 }
 
 uint64_t next_check_after(uint64_t pass, double value, uint64_t early_pass, double early_value,
@@ -70,15 +85,19 @@ uint64_t next_check_after(uint64_t pass, double value, uint64_t early_pass, doub
   // development, about a pass at 512x512. So the power law through this test and an earlier one
   // moves the next test: to the crossing where that comes before the next regular test (at
   // least 2.5% of the passes on: the tests near the target at most four times as dense), and
-  // three quarters of the way to it where it comes later (at most to twice the passes, so that
-  // a quantity that stopped falling is still tested, and the "unreachable" rule with it).
+  // three quarters of the way to it where it comes later, with the exponent taken as at least
+  // kSlowestFall and the test at most at twice the passes (a quantity that barely fell between
+  // two close tests, as where --adaptive paths begins, may fall fast after them; one that
+  // stopped falling is still tested, and the "unreachable" rule with it).
+  constexpr double kSlowestFall = 0.5;
   const uint64_t regular = pass + std::max<uint64_t>(1, pass / 10);
   const uint64_t nearest = pass + std::max<uint64_t>(1, pass / 40);
-  if (!(value > target)) return regular;
-  const double needed = passes_to_target(pass, value, early_pass, early_value, target);
-  if (std::isnan(needed)) return regular;
+  const double k = falling_slope(pass, value, early_pass, early_value);
+  if (!(value > target && target > 0.0) || std::isnan(k)) return regular;
+  const double needed = crossing(pass, value, k, target);
   if (needed < double(regular)) return std::clamp(uint64_t(std::ceil(needed)), nearest, regular);
-  const double later = std::min(double(pass) + 0.75 * (needed - double(pass)), 2.0 * double(pass));
+  const double far = crossing(pass, value, std::max(k, kSlowestFall), target);
+  const double later = std::min(double(pass) + 0.75 * (far - double(pass)), 2.0 * double(pass));
   return std::max(regular, uint64_t(std::ceil(later)));
 }
 

@@ -94,7 +94,8 @@ double passes_to_target(uint64_t pass, double value, uint64_t early_pass, double
 // The pass of the next stop test after one at `pass` that found `value` above `target`
 // (ESTIMATOR.md section 7): about 10% of the passes later; sooner, where the power law says the
 // target is crossed before then, but never within 2.5% of the passes of this test; later, three
-// quarters of the way to the crossing, where that is further, but never beyond twice the passes.
+// quarters of the way to the crossing (the power law taken as falling at least as passes^-0.5),
+// where that is further, but never beyond twice the passes.
 uint64_t next_check_after(uint64_t pass, double value, uint64_t early_pass, double early_value,
                           double target);
 
