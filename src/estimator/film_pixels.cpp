@@ -125,19 +125,19 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
 }  // namespace
 
 // ESTIMATOR.md sections 5 and 10: every pixel's sums of its states.
-std::vector<PixelResult> combine_pixels(const PixelLayout& layout,
-                                        const std::vector<PointState>& states, uint64_t passes,
-                                        const FilmSettings& s) {
+PixelResults combine_pixels(const PixelLayout& layout, const std::vector<PointState>& states,
+                            uint64_t passes, const FilmSettings& s) {
   const size_t pixels = size_t(layout.width) * size_t(layout.height);
-  std::vector<PixelResult> results(pixels);
+  PixelResults results(pixels);
   parallel_for(pixels, 1024, [&](size_t begin, size_t end) {
-    for (size_t p = begin; p < end; ++p) results[p] = combine(layout, states, p, passes, s);
+    for (size_t p = begin; p < end; ++p)
+      ::new (&results[p]) PixelResult(combine(layout, states, p, passes, s));
   });
   return results;
 }
 
 // ESTIMATOR.md section 7: the relative metric's floor, from the image's mean radiance.
-double relative_floor(const std::vector<PixelResult>& results) {
+double relative_floor(std::span<const PixelResult> results) {
   double mean_radiance = 0.0;
   for (const PixelResult& r : results)
     mean_radiance += (r.radiance.x + r.radiance.y + r.radiance.z);
@@ -148,7 +148,7 @@ double relative_floor(const std::vector<PixelResult>& results) {
 // ESTIMATOR.md sections 11b and 11c: where the samples' drift with R^2 and the Laplacian
 // disagree in more than kRefutedShare of the state-channels, or the two scales in more than
 // that share of the states, no bound of this image can be trusted.
-void check_model(const std::vector<PixelResult>& results, FilmSummary& sum) {
+void check_model(std::span<const PixelResult> results, FilmSummary& sum) {
   uint64_t slope_tested = 0, slope_disagree = 0, scale_tested = 0, scale_disagree = 0;
   for (const PixelResult& r : results) {
     slope_tested += r.slope_tested;
@@ -163,7 +163,7 @@ void check_model(const std::vector<PixelResult>& results, FilmSummary& sum) {
 }
 
 // ESTIMATOR.md section 6b: the bias prior over the known pixels with a random state.
-std::vector<dvec3> prior_of(const std::vector<PixelResult>& results, int width, int height,
+std::vector<dvec3> prior_of(std::span<const PixelResult> results, int width, int height,
                             std::span<const uint8_t> floor) {
   return bias_prior(
       [&](size_t p) {
@@ -177,7 +177,7 @@ std::vector<dvec3> prior_of(const std::vector<PixelResult>& results, int width, 
 // window), in place: each pixel keeps w4 B4 and sqrt(w4 V4). Where it is noise (a smooth radiance,
 // tau4 ~ 0) it then neither moves the bias nor dilutes the Laplacian's. Done before the
 // second-order prior, so that develop() never holds two priors at once.
-void shrink_fourth(std::vector<PixelResult>& results, int width, int height,
+void shrink_fourth(std::span<PixelResult> results, int width, int height,
                    std::span<const uint8_t> floor) {
   const std::vector<dvec3> tau4 = bias_prior(
       [&](size_t p) {
