@@ -55,10 +55,10 @@ std::string tested_name(const RenderOptions& o) {
 namespace {
 
 // The exponent k of the power law U ~ passes^-k through two tests; NaN where the quantity did not
-// fall, is not finite, or there is no earlier test.
+// fall, either is not finite (a test with a pixel unknown), or there is no earlier test.
 double falling_slope(uint64_t pass, double value, uint64_t early_pass, double early_value) {
   if (!(early_pass > 0 && pass > early_pass && std::isfinite(value) && value > 0.0 &&
-        value < early_value))
+        value < early_value && std::isfinite(early_value)))
     return NAN;
   return std::log(early_value / value) / std::log(double(pass) / double(early_pass));
 }

@@ -293,6 +293,9 @@ TEST(Stop, TheNextTestIsAtTheExtrapolatedCrossingWithinTheRegularInterval) {
   EXPECT_EQ(next_check_after(200, 0.0101, 100, 0.0100, 0.01), 220u);
   EXPECT_EQ(next_check_after(200, INFINITY, 100, 0.02, 0.01), 220u);
   EXPECT_EQ(next_check_after(200, NAN, 100, 0.02, 0.01), 220u);
+  // An earlier test with a pixel unknown (its quantity infinite) gives no trend either: not a
+  // fall so steep that the target is due at once.
+  EXPECT_EQ(next_check_after(200, 0.0101, 100, INFINITY, 0.01), 220u);
   EXPECT_EQ(next_check_after(200, 0.009, 100, 0.02, 0.01), 220u);
   EXPECT_TRUE(std::isnan(passes_to_target(200, 0.0101, 200, 0.02, 0.01)));
 }
