@@ -95,7 +95,8 @@ double passes_to_target(uint64_t pass, double value, uint64_t early_pass, double
 // (ESTIMATOR.md section 7): about 10% of the passes later; sooner, where the power law says the
 // target is crossed before then, but never within 2.5% of the passes of this test; later, three
 // quarters of the way to the crossing (the power law taken as falling at least as passes^-0.5),
-// where that is further, but never beyond twice the passes.
+// where that is further, but never beyond twice the passes; the regular test where the two tests
+// show no fall.
 uint64_t next_check_after(uint64_t pass, double value, uint64_t early_pass, double early_value,
                           double target);
 

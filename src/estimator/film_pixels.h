@@ -68,6 +68,7 @@ class PixelResults {
   // An aggregate with a trivial destructor: storage from operator new holds it, and nothing
   // needs destroying but the storage.
   static_assert(std::is_aggregate_v<PixelResult> && std::is_trivially_destructible_v<PixelResult>);
+  static_assert(alignof(PixelResult) <= __STDCPP_DEFAULT_NEW_ALIGNMENT__);
   struct Free {
     void operator()(PixelResult* p) const { ::operator delete(p); }
   };
