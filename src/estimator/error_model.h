@@ -24,8 +24,6 @@ enum class BiasModel { TwoScale, Laplacian };
 
 // E|mu + sigma Z| = sigma sqrt(2/pi) exp(-mu^2 / (2 sigma^2)) + mu erf(mu / (sigma sqrt 2)).
 double expected_abs_error(double mu, double sigma);
-// Var|mu + sigma Z| = mu^2 + sigma^2 - (E|mu + sigma Z|)^2.
-double abs_error_variance(double mu, double sigma);
 
 // Pixels whose errors are fully correlated, in effect, because their discs share photons:
 // sum over pixels j of the correlation of two kernel estimates a pixel apart, for discs of
@@ -71,6 +69,10 @@ inline constexpr double kPriorOwnFactor = 5.0;
 std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, int width,
                               int height, double noise_factor = 1.0,
                               std::span<const uint8_t> floor = {});
+// The same, each pixel's tau^2 handed to out(p, tau2) (once, from any thread).
+void bias_prior(const std::function<BiasEstimate(size_t)>& pixel, int width, int height,
+                double noise_factor, std::span<const uint8_t> floor,
+                const std::function<void(size_t, const dvec3&)>& out);
 // The noise factor of the fourth-order bias's prior (section 6c). Where the radiance is smooth
 // B4 is noise, and with k = 1 tau4^2 is still positive in about half of the windows:
 // mean(B4^2) / mean(V4) over a window's 81 pixels has an sd of sqrt(2 K / 81) under the null,

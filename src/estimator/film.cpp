@@ -212,9 +212,39 @@ const std::vector<float>& FilmImage::plane(Channel id) const {
 }
 
 // ESTIMATOR.md sections 5-7: combine, check the model, take the prior, bound and predict.
+std::byte* DevelopMemory::take(size_t bytes) {
+  {
+    const std::lock_guard lock(mutex_);
+    if (block_ && bytes_ >= bytes) return std::exchange(block_, nullptr);
+  }
+  return static_cast<std::byte*>(::operator new(bytes));
+}
+
+void DevelopMemory::give(std::byte* block, size_t bytes) {
+  std::byte* drop = block;
+  {
+    const std::lock_guard lock(mutex_);
+    if (!block_ || bytes_ < bytes) {
+      drop = std::exchange(block_, block);
+      bytes_ = bytes;
+    }
+  }
+  ::operator delete(drop);
+}
+
+void DevelopMemory::release() {
+  std::byte* drop = nullptr;
+  {
+    const std::lock_guard lock(mutex_);
+    drop = std::exchange(block_, nullptr);
+  }
+  ::operator delete(drop);
+}
+
 FilmSummary develop(const PixelLayout& layout, const std::vector<PointState>& states,
-                    uint64_t passes, const FilmSettings& s, FilmImage* image) {
-  PixelResults results = combine_pixels(layout, states, passes, s);
+                    uint64_t passes, const FilmSettings& s, FilmImage* image,
+                    DevelopMemory* memory) {
+  PixelResults results = combine_pixels(layout, states, passes, s, memory);
   const size_t pixels = results.size();
   FilmSummary sum;
   sum.relative_floor = relative_floor(results.all());
@@ -223,7 +253,7 @@ FilmSummary develop(const PixelLayout& layout, const std::vector<PointState>& st
   const std::span<const uint8_t> floor = layout.paths_taken;
   if (s.bias_model == BiasModel::TwoScale)
     shrink_fourth(results.all(), layout.width, layout.height, floor);
-  const std::vector<dvec3> tau2 = prior_of(results.all(), layout.width, layout.height, floor);
+  prior_of(results.all(), layout.width, layout.height, floor);
   const BoundRule rule(passes, s, sum.relative_floor);
   Tally tally(pixels);
   // Over fixed chunks of pixels on every thread, their sums added in chunk order: the summary
@@ -232,8 +262,8 @@ FilmSummary develop(const PixelLayout& layout, const std::vector<PointState>& st
   std::vector<TallySums> chunk_sums((pixels + kChunk - 1) / kChunk);
   parallel_chunks(pixels, kChunk, [&](size_t k, size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p)
-      bound_pixel(results[p], tau2[p], rule, sum.model_refuted, passes, p, chunk_sums[k], tally,
-                  image);
+      bound_pixel(results[p], results[p].prior, rule, sum.model_refuted, passes, p, chunk_sums[k],
+                  tally, image);
   });
   for (const TallySums& c : chunk_sums) tally.sums.add(c);
   tally.model.error = tally.sums.error;

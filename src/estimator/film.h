@@ -9,6 +9,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <mutex>
 #include <span>
 #include <string>
 #include <vector>
@@ -105,10 +106,36 @@ struct PixelLayout {
   // paths (PPM, or SPPM without --adaptive paths).
   std::vector<uint8_t> paths_taken;
 };
+// The memory one development leaves to the next: its per-pixel results (250 bytes a pixel,
+// 500 MB at 1920x1080), which a development of fresh memory faults in page by page (a fifth of
+// its time there). A stop test develops every few passes, so the block is kept between them;
+// release() frees it (before an EXR is packed, which would otherwise hold both). Two developments
+// at once (a checkpoint's beside a stop test's): one takes the block, the other allocates.
+class DevelopMemory {
+ public:
+  DevelopMemory() = default;
+  ~DevelopMemory() { release(); }
+  DevelopMemory(const DevelopMemory&) = delete;
+  DevelopMemory& operator=(const DevelopMemory&) = delete;
+  // At least `bytes`: the kept block when it is large enough (then no longer kept), else a new
+  // one (operator new's alignment).
+  std::byte* take(size_t bytes);
+  // Keeps `block` (of `bytes`, from take()) in place of a smaller one, frees the other.
+  void give(std::byte* block, size_t bytes);
+  void release();
+
+ private:
+  std::mutex mutex_;
+  std::byte* block_ = nullptr;
+  size_t bytes_ = 0;
+};
+
 // Combines the states of every pixel. With passes < 2 no bound exists: every pixel with
-// a state that is random is unknown.
+// a state that is random is unknown. `memory`: where the results' block is taken from and left
+// (none: allocated and freed here).
 FilmSummary develop(const PixelLayout& layout, const std::vector<PointState>& states,
-                    uint64_t passes, const FilmSettings& settings, FilmImage* image);
+                    uint64_t passes, const FilmSettings& settings, FilmImage* image,
+                    DevelopMemory* memory = nullptr);
 
 // The relative metric divides by max(L, floor) with floor = kRelativeFloor x mean radiance of
 // the image, so that dark pixels do not dominate the mean.

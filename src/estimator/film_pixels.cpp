@@ -126,9 +126,9 @@ PixelResult combine(const PixelLayout& layout, const std::vector<PointState>& st
 
 // ESTIMATOR.md sections 5 and 10: every pixel's sums of its states.
 PixelResults combine_pixels(const PixelLayout& layout, const std::vector<PointState>& states,
-                            uint64_t passes, const FilmSettings& s) {
+                            uint64_t passes, const FilmSettings& s, DevelopMemory* memory) {
   const size_t pixels = size_t(layout.width) * size_t(layout.height);
-  PixelResults results(pixels);
+  PixelResults results(pixels, memory);
   parallel_for(pixels, 1024, [&](size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p)
       ::new (&results[p]) PixelResult(combine(layout, states, p, passes, s));
@@ -162,36 +162,38 @@ void check_model(std::span<const PixelResult> results, FilmSummary& sum) {
       sum.slope_disagreement > kRefutedShare || sum.scale_disagreement > kRefutedShare;
 }
 
-// ESTIMATOR.md section 6b: the bias prior over the known pixels with a random state.
-std::vector<dvec3> prior_of(std::span<const PixelResult> results, int width, int height,
-                            std::span<const uint8_t> floor) {
-  return bias_prior(
+// ESTIMATOR.md section 6b: the bias prior over the known pixels with a random state. It reads
+// the bias and writes the prior: other members of the same results.
+void prior_of(std::span<PixelResult> results, int width, int height,
+              std::span<const uint8_t> floor) {
+  bias_prior(
       [&](size_t p) {
         const PixelResult& r = results[p];
         return BiasEstimate{r.bias, r.bias_variance, r.known && !r.exact};
       },
-      width, height, 1.0, floor);
+      width, height, 1.0, floor, [&](size_t p, const dvec3& tau2) { results[p].prior = tau2; });
 }
 
 // ESTIMATOR.md section 6c: the fourth-order part shrunk by a prior of its own (over the same
 // window), in place: each pixel keeps w4 B4 and sqrt(w4 V4). Where it is noise (a smooth radiance,
 // tau4 ~ 0) it then neither moves the bias nor dilutes the Laplacian's. Done before the
-// second-order prior, so that develop() never holds two priors at once.
+// second-order prior, whose place in each result it takes until then.
 void shrink_fourth(std::span<PixelResult> results, int width, int height,
                    std::span<const uint8_t> floor) {
-  const std::vector<dvec3> tau4 = bias_prior(
+  bias_prior(
       [&](size_t p) {
         const PixelResult& r = results[p];
         const dvec3 sd(r.fourth_sd);
         return BiasEstimate{dvec3(r.fourth), sd * sd, r.known && !r.exact};
       },
-      width, height, kFourthNoiseFactor, floor);
+      width, height, kFourthNoiseFactor, floor,
+      [&](size_t p, const dvec3& tau4) { results[p].prior = tau4; });
   parallel_for(results.size(), 4096, [&](size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p)
       for (int c = 0; c < 3; ++c) {
         PixelResult& r = results[p];
         const double w4 =
-            r.fourth[c] == 0.0f ? 0.0 : bias_shrinkage(tau4[p][c], squared(double(r.fourth_sd[c])));
+            r.fourth[c] == 0.0f ? 0.0 : bias_shrinkage(r.prior[c], squared(double(r.fourth_sd[c])));
         r.fourth[c] = float(r.fourth[c] * w4);
         r.fourth_sd[c] = float(r.fourth_sd[c] * std::sqrt(w4));
       }

@@ -38,6 +38,8 @@ ExrImage Renderer::image(const RunInfo& run, const RenderState& state) const {
 
 ExrImage Renderer::image(const RunInfo& run, const FilmImage& film, const FilmSummary& summary,
                          const WorkCounters& work, double initial_radius, size_t states) const {
+  // The EXR is the render's end, or a checkpoint's: the next stop test is passes away.
+  develop_memory_.release();
   ExrImage out = pack_channels(film);
   out.metadata = describe(options_);
   out.metadata.insert(out.metadata.end(),

@@ -274,7 +274,7 @@ FilmSummary Renderer::develop(const RenderState& state, FilmImage* image) const 
 FilmSummary Renderer::develop(const std::vector<PointState>& states, const RenderState* saved,
                               uint64_t passes, double max_photon_power, FilmImage* image) const {
   return pb::develop(layout(states, saved, max_photon_power), states, passes, film_settings(),
-                     image);
+                     image, &develop_memory_);
 }
 
 }  // namespace pb

@@ -152,6 +152,9 @@ class Renderer {
   PhaseTimings timings_;
   Exchange* exchange_ = nullptr;  // distributed: the other ranks; null in one process
   uint64_t collected_ = 0;        // the pass whose states rank 0 last collected
+  // The last development's per-pixel block, for the next stop test's (film.h); an EXR's
+  // packing frees it.
+  mutable DevelopMemory develop_memory_;
 };
 
 }  // namespace pb

@@ -226,4 +226,130 @@ TEST(BiasPrior, APixelsOwnBiasBeyondItsNoiseIsNotShrunkByItsWindow) {
   EXPECT_LT((mean_w_floor - mean_w_window) / count, 0.02);
 }
 
+// The prior's window sums (ESTIMATOR.md section 6b) against the definition, summed directly per
+// window in long double: tau^2 = max(0, (sum B^2 - k sum Var B) / n) over the pixels in use, and
+// the floor where the window holds a pixel with paths. A field of small biases (about 1e-4,
+// B^2 about 1e-8) with one of 1e8 in a corner: a window without the corner must keep its own
+// digits. Summed-area tables took each window as a difference of sums over the image, 1e16
+// large below and right of the corner, whose rounding (about 2) buried the 1e-8 windows there:
+// this test failed on them. The image is 70 rows of 37 pixels: the 32-row blocks end mid-window,
+// and their seams must not show. Tolerance: a direct sum of at most 81 positive terms in double
+// is within 81 ulp of the long-double one, 1e-14 relative; the difference b2 - k v cancels at
+// most 2 digits where tau^2 is not clipped to 0 (k v is below 0.99 b2 there, or clipped).
+TEST(BiasPrior, WindowSumsAreTheDirectSumsAndKeepTheirDigitsBesideALargeBias) {
+  constexpr int w = 37, h = 70;
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> z;
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  std::vector<BiasEstimate> e(size_t(w) * h);
+  std::vector<uint8_t> paths(e.size());
+  for (size_t p = 0; p < e.size(); ++p) {
+    e[p].use = u(rng) > 0.1;
+    e[p].bias = dvec3(z(rng), z(rng), z(rng)) * 1e-4;
+    e[p].variance = dvec3(u(rng), u(rng), u(rng)) * 2e-9;
+    paths[p] = u(rng) < 0.05;
+  }
+  e[0] = BiasEstimate{dvec3(1e8), dvec3(1.0), true};
+  for (double k : {1.0, 1.5})
+    for (bool floored : {false, true}) {
+      const std::vector<dvec3> tau2 =
+          bias_prior([&](size_t p) { return e[p]; }, w, h, k,
+                     floored ? std::span<const uint8_t>(paths) : std::span<const uint8_t>());
+      ASSERT_EQ(tau2.size(), e.size());
+      for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+          long double b2[3] = {0, 0, 0}, v[3] = {0, 0, 0}, n = 0;
+          bool taken = false;
+          for (int wy = std::max(0, y - kPriorWindow); wy <= std::min(h - 1, y + kPriorWindow);
+               ++wy)
+            for (int wx = std::max(0, x - kPriorWindow); wx <= std::min(w - 1, x + kPriorWindow);
+                 ++wx) {
+              const BiasEstimate& q = e[size_t(wy) * w + size_t(wx)];
+              taken = taken || paths[size_t(wy) * w + size_t(wx)];
+              if (!q.use) continue;
+              n += 1;
+              for (int c = 0; c < 3; ++c) {
+                b2[c] += (long double)q.bias[c] * q.bias[c];
+                v[c] += q.variance[c];
+              }
+            }
+          const size_t p = size_t(y) * w + size_t(x);
+          for (int c = 0; c < 3; ++c) {
+            long double want = n > 0 ? std::max(0.0L, (b2[c] - k * v[c]) / n) : 0.0L;
+            if (floored && taken && e[p].use)
+              want = std::max(want, (long double)e[p].bias[c] * e[p].bias[c] -
+                                        kPriorOwnFactor * k * e[p].variance[c]);
+            const double got = tau2[p][c];
+            EXPECT_NEAR(got, double(want),
+                        1e-12 * std::max(double(b2[c] / std::max(n, 1.0L)), 1e-300))
+                << "pixel " << x << "," << y << " channel " << c << " k " << k << " floor "
+                << floored;
+          }
+        }
+    }
+}
+
+// A development's per-pixel block (film.h): kept between developments, the larger one kept,
+// and taken by one development at a time.
+TEST(DevelopMemory, KeepsOneBlockAndHandsItToOneTakerAtATime) {
+  DevelopMemory memory;
+  std::byte* a = memory.take(1000);
+  ASSERT_NE(a, nullptr);
+  memory.give(a, 1000);
+  EXPECT_EQ(memory.take(800), a);   // large enough: the kept block
+  std::byte* b = memory.take(800);  // the block is out: another
+  EXPECT_NE(b, a);
+  memory.give(a, 1000);
+  memory.give(b, 800);  // smaller than the kept one: freed
+  EXPECT_EQ(memory.take(1000), a);
+  memory.give(a, 1000);
+  std::byte* c = memory.take(2000);  // too small to keep: a new block, which replaces it
+  EXPECT_NE(c, a);
+  memory.give(c, 2000);
+  EXPECT_EQ(memory.take(1500), c);
+  memory.give(c, 2000);
+  memory.release();
+  std::byte* d = memory.take(10);
+  EXPECT_NE(d, nullptr);
+  memory.give(d, 10);
+}
+
+// Developments through a kept block are those of fresh memory, bit for bit: every pixel's
+// result is written whole before it is read, whatever the block held before (here another
+// render's results).
+TEST(DevelopMemory, DevelopmentsThroughItAreThoseOfFreshMemory) {
+  auto states_of = [](uint64_t seed) {
+    std::mt19937_64 rng(seed);
+    std::normal_distribution<double> z;
+    std::vector<PointState> states(size_t(kSide) * kSide);
+    for (PointState& st : states) st.r2 = 1.0;
+    EstimatorParams params;
+    for (uint64_t j = 1; j <= 8; ++j)
+      for (PointState& st : states) {
+        PassSample g;
+        g.direct = dvec3(1.0 + z(rng), 0.5 + z(rng), 2.0 + z(rng));
+        g.phi_lap_r2 = dvec3(0.1 * z(rng));
+        accumulate_pass(st, g, params, j);
+      }
+    for (PointState& st : states) st.photons = 100;
+    return states;
+  };
+  PixelLayout layout;
+  layout.width = layout.height = kSide;
+  layout.footprint = 0.5;
+  const FilmSettings settings;
+  DevelopMemory memory;
+  FilmImage first, fresh, kept;
+  develop(layout, states_of(1), 8, settings, &first, &memory);
+  const std::vector<PointState> states = states_of(2);
+  const FilmSummary a = develop(layout, states, 8, settings, &fresh);
+  const FilmSummary b = develop(layout, states, 8, settings, &kept, &memory);
+  EXPECT_EQ(a.predicted_error, b.predicted_error);
+  EXPECT_EQ(a.mean_bound, b.mean_bound);
+  for (Channel c : {Channel::Radiance, Channel::ErrorBound, Channel::Bias, Channel::Noise,
+                    Channel::TargetRatio})
+    EXPECT_TRUE(fresh.plane(c) == kept.plane(c));
+  EXPECT_NE(first.plane(Channel::Radiance), kept.plane(Channel::Radiance));
+}
+
 }  // namespace
