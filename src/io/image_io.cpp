@@ -199,22 +199,29 @@ void write_exr(const std::string& path, const ExrImage& image, ExrCompression co
         order.push_back(size_t(image.channel_index(list->entries[i].name.str)));
       const int chunks = (image.height + lines - 1) / lines;
       const size_t chunk_bytes = size_t(image.width) * nc * sizeof(float) * size_t(lines);
-      // Chunks in batches of about 8 MB, compressed at once on the render's threads and written
-      // in order: the write holds two buffers of a batch (16 MB) beside the image, not a copy.
-      const size_t per_batch = std::clamp<size_t>((size_t(8) << 20) / chunk_bytes, 1, 64);
-      std::vector<ChunkSlot> slots(std::min(per_batch, size_t(chunks)));
-      for (ChunkSlot& slot : slots) {
-        slot.a.resize(chunk_bytes);
-        if (!zip) continue;
-        slot.b.resize(chunk_bytes);
-        slot.deflate.reset(libdeflate_alloc_compressor(1));
-        if (!slot.deflate) throw std::bad_alloc();
+      // Chunks in batches of about 4 MB, compressed at once on the render's threads while the
+      // batch before is written (in order): the write holds two batches' two buffers (16-20
+      // MB) beside the image, not a copy. One batch after the other, a thread idled while the
+      // other wrote (0.65 s of which about 0.1 s the writes at 1920x1080).
+      // At least two chunks a batch, for the two threads of a machine like ours.
+      const size_t per_batch = std::clamp<size_t>((size_t(4) << 20) / chunk_bytes, 2, 64);
+      const int batch = int(std::min(per_batch, size_t(chunks)));
+      std::vector<ChunkSlot> slots[2];
+      for (std::vector<ChunkSlot>& set : slots) {
+        set.resize(size_t(batch));
+        for (ChunkSlot& slot : set) {
+          slot.a.resize(chunk_bytes);
+          if (!zip) continue;
+          slot.b.resize(chunk_bytes);
+          slot.deflate.reset(libdeflate_alloc_compressor(1));
+          if (!slot.deflate) throw std::bad_alloc();
+        }
       }
-      for (int first = 0; first < chunks; first += int(slots.size())) {
-        const int count = std::min(int(slots.size()), chunks - first);
-        parallel_for(size_t(count), 1, [&](size_t begin, size_t end) {
+      auto count_at = [&](int first) { return std::min(batch, chunks - first); };
+      auto compress = [&](int first, std::vector<ChunkSlot>& set) {
+        parallel_for(size_t(count_at(first)), 1, [&](size_t begin, size_t end) {
           for (size_t j = begin; j < end; ++j) {
-            ChunkSlot& slot = slots[j];
+            ChunkSlot& slot = set[j];
             const int y0 = (first + int(j)) * lines, y1 = std::min(image.height, y0 + lines);
             const size_t n = chunk_bytes / size_t(lines) * size_t(y1 - y0);
             pack_lines(image, order, y0, y1, slot.a.data());
@@ -230,10 +237,20 @@ void write_exr(const std::string& path, const ExrImage& image, ExrCompression co
               pack_lines(image, order, y0, y1, slot.a.data());
           }
         });
-        for (int j = 0; j < count; ++j)
-          check(exr_write_scanline_chunk(ctx, part, (first + j) * lines, slots[size_t(j)].a.data(),
-                                         slots[size_t(j)].size),
+      };
+      auto write = [&](int first, const std::vector<ChunkSlot>& set) {
+        for (int j = 0; j < count_at(first); ++j)
+          check(exr_write_scanline_chunk(ctx, part, (first + j) * lines, set[size_t(j)].a.data(),
+                                         set[size_t(j)].size),
                 "chunk");
+      };
+      compress(0, slots[0]);
+      for (int first = 0, k = 0; first < chunks; first += batch, k ^= 1) {
+        const int next = first + batch;
+        if (next < chunks)
+          parallel_invoke([&] { compress(next, slots[k ^ 1]); }, [&] { write(first, slots[k]); });
+        else
+          write(first, slots[k]);
       }
       check(exr_finish(&ctx), "finish");
     } catch (const std::exception& e) {

@@ -2,6 +2,9 @@
 #include "render/renderer.h"
 
 #include "estimator/channels.h"
+#include "util/parallel.h"
+
+#include <vector>
 
 namespace pb {
 
@@ -13,14 +16,23 @@ ExrImage pack_channels(const FilmImage& film) {
   const size_t pixels = size_t(film.width) * size_t(film.height);
   const size_t nc = out.channels.size();
   out.pixels.resize(pixels * nc);
-  size_t first = 0;  // first channel of the group
-  for (const ChannelGroup& g : kChannelGroups) {
-    const std::vector<float>& plane = film.plane(g.id);
-    const size_t n = g.kind == ChannelKind::RGB ? 3 : 1;
-    for (size_t p = 0; p < pixels; ++p)
-      for (size_t k = 0; k < n; ++k) out.pixels[p * nc + first + k] = plane[n * p + k];
-    first += n;
-  }
+  // Pixel by pixel on every thread, each pixel's channels side by side: group by group over the
+  // whole image wrote every cache line of the output once per group (0.09 s of 166 MB at
+  // 1920x1080 on one thread).
+  struct Source {
+    const float* plane;
+    size_t n;
+  };
+  std::vector<Source> sources;
+  for (const ChannelGroup& g : kChannelGroups)
+    sources.push_back({film.plane(g.id).data(), g.kind == ChannelKind::RGB ? size_t(3) : 1});
+  parallel_for(pixels, 4096, [&](size_t begin, size_t end) {
+    for (size_t p = begin; p < end; ++p) {
+      float* to = out.pixels.data() + p * nc;
+      for (const Source& s : sources)
+        for (size_t k = 0; k < s.n; ++k) *to++ = s.plane[s.n * p + k];
+    }
+  });
   return out;
 }
 
