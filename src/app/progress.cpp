@@ -43,10 +43,47 @@ void ProgressPrinter::after_pass(const PassInfo& info) {
     return;
   last_print_ = info.run_seconds;
   printed_ = info.pass;
-  out_ << line(info) << std::endl;
+  out_ << line(info, earlier_) << std::endl;
+  if (info.developed) {
+    const double tested = tested_quantity(info.renderer.options(), info.summary);
+    if (std::isfinite(tested)) earlier_ = {info.pass, tested};
+  }
 }
 
-std::string ProgressPrinter::line(const PassInfo& info) {
+double seconds_left(const RenderOptions& o, const DriverState& schedule, uint64_t pass,
+                    double seconds, double run_seconds, double tested, const TestedAt& earlier,
+                    bool* bounded_only) {
+  const double per_pass = seconds / double(std::max<uint64_t>(pass, 1));
+  double left = INFINITY;
+  if (o.passes) left = std::min(left, double(*o.passes - std::min(pass, *o.passes)) * per_pass);
+  const double by_passes = left;
+  if (o.time_seconds) left = std::min(left, *o.time_seconds - run_seconds);
+  if (bounded_only) *bounded_only = o.target_error && left < by_passes;
+  if (o.target_error && std::isfinite(tested)) {
+    const double target = *o.target_error;
+    const uint64_t next = std::max(schedule.next_check, pass);
+    const double to_check = double(next - pass) * per_pass;
+    if (bounded_only) *bounded_only = false;
+    if (tested <= target) return std::min(left, to_check);
+    double needed =
+        passes_to_target(pass, tested, schedule.early_pass, schedule.early_value, target);
+    if (std::isnan(needed))
+      needed = passes_to_target(pass, tested, earlier.pass, earlier.value, target);
+    // No earlier figure at all: the noise's fall, which the schedule also takes as the slowest
+    // when it postpones a test (at 1920x1080 the first line came at the first test, and the time
+    // left it showed was the rest of --time: "~890 s" for a render that ended 9 s later).
+    const bool first = (schedule.early_pass == 0 || schedule.early_pass >= pass) &&
+                       (earlier.pass == 0 || earlier.pass >= pass);
+    if (std::isnan(needed) && first) needed = double(pass) * (tested / target) * (tested / target);
+    if (std::isfinite(needed))
+      left = std::min(left, std::max((needed - double(pass)) * per_pass, to_check));
+    else if (bounded_only)
+      *bounded_only = left < by_passes;
+  }
+  return left;
+}
+
+std::string ProgressPrinter::line(const PassInfo& info, const TestedAt& earlier) {
   const RenderOptions& o = info.renderer.options();
   const FilmSummary& s = info.summary;
   const uint64_t pass = info.pass;
@@ -70,27 +107,11 @@ std::string ProgressPrinter::line(const PassInfo& info) {
            << 100.0 * s.scale_disagreement << "% of scales disagree)";
   }
   line << " | " << seconds << " s";
-  // Time left: the smallest of what the stop conditions imply. The target's comes from the
-  // power-law decay of the tested quantity since an earlier test; once the quantity is at the
-  // target it is the time to the next scheduled test, never the rest of the budget.
-  const double per_pass = seconds / double(pass);
-  double left = INFINITY;
-  if (o.passes) left = std::min(left, double(*o.passes - pass) * per_pass);
-  if (o.time_seconds) left = std::min(left, *o.time_seconds - info.run_seconds);
-  if (o.target_error && std::isfinite(tested)) {
-    const uint64_t next = std::max(info.schedule.next_check, pass);
-    const double to_check = double(next - pass) * per_pass;
-    const uint64_t early = info.schedule.early_pass;
-    const double early_value = info.schedule.early_value;
-    if (tested <= *o.target_error) {
-      left = std::min(left, to_check);
-    } else if (const double needed =
-                   passes_to_target(pass, tested, early, early_value, *o.target_error);
-               std::isfinite(needed)) {
-      left = std::min(left, std::max((needed - double(pass)) * per_pass, to_check));
-    }
-  }
-  if (std::isfinite(left)) line << " | ~" << std::max(0.0, left) << " s left";
+  bool bounded_only = false;
+  const double left = seconds_left(o, info.schedule, pass, seconds, info.run_seconds, tested,
+                                   earlier, &bounded_only);
+  if (std::isfinite(left))
+    line << " | " << (bounded_only ? "<= " : "~") << std::max(0.0, left) << " s left";
   return line.str();
 }
 

@@ -8,6 +8,26 @@
 
 namespace pb {
 
+// A pass and the tested quantity its development found (pass 0: none).
+struct TestedAt {
+  uint64_t pass = 0;
+  double value = 0.0;
+};
+
+// The progress line's time left: the smallest of what the stop conditions imply, after `pass`
+// whose development found `tested` (not finite: none), `seconds` into the render (of which
+// `run_seconds` in this run). The target's share comes from the tested quantity's power law:
+// through the schedule's earlier test, or else `earlier` (the schedule takes the test it
+// extrapolates from anew each time the passes double, at that very pass); with neither, as the
+// noise falls, passes^-1/2 (the first test). Once the quantity is at the target it is the time to
+// the next scheduled test, never the rest of the budget. +inf: no estimate. `bounded_only`, when
+// given, is set where a target gave no estimate and the figure is only what --time leaves (the
+// line then says "<= X s left", not "~X s left": at pass 1 the budget is no estimate of a render
+// that stops on its target).
+double seconds_left(const RenderOptions& options, const DriverState& schedule, uint64_t pass,
+                    double seconds, double run_seconds, double tested, const TestedAt& earlier,
+                    bool* bounded_only = nullptr);
+
 // A progress line at most every 0.5 s (less often when developing the image takes over 25 ms:
 // at most 5% of the run) and after the last pass: pass, photons, mean bound,
 // share of pixels below the target, unknown pixels, elapsed time and time left. A pass is told
@@ -17,7 +37,8 @@ class ProgressPrinter : public PassObserver {
   explicit ProgressPrinter(std::ostream& out) : out_(out) {}
   bool wants_summary(uint64_t pass, double run_seconds) override;
   void after_pass(const PassInfo& info) override;
-  static std::string line(const PassInfo& info);
+  // `earlier`: an earlier line's pass and tested quantity (pass 0: none), for the time left.
+  static std::string line(const PassInfo& info, const TestedAt& earlier = {});
 
  private:
   double interval() const;
@@ -25,6 +46,7 @@ class ProgressPrinter : public PassObserver {
   double last_print_ = -1.0;
   double develop_seconds_ = 0.0;  // the last development's time
   uint64_t printed_ = 0;          // the last pass printed
+  TestedAt earlier_;              // the last line's tested quantity
 };
 
 // --log: one JSON object per logged pass (docs/usage.md "Logging"). Passes are logged while

@@ -2,6 +2,7 @@
 // ends"): scenes whose points all, or partly, receive no photon end with a reason in a bounded
 // number of passes, every bound finite, and the actual error within the target.
 #include "analytic.h"
+#include "app/progress.h"
 #include "render_fixture.h"
 #include "scene_builder.h"
 
@@ -298,6 +299,55 @@ TEST(Stop, TheNextTestIsAtTheExtrapolatedCrossingWithinTheRegularInterval) {
   EXPECT_EQ(next_check_after(200, 0.0101, 100, INFINITY, 0.01), 220u);
   EXPECT_EQ(next_check_after(200, 0.009, 100, 0.02, 0.01), 220u);
   EXPECT_TRUE(std::isnan(passes_to_target(200, 0.0101, 200, 0.02, 0.01)));
+}
+
+// The progress line's time left (progress.h seconds_left). README's first command at 1920x1080
+// showed "~890.7 s left" at its first test (pass 16, 9.3 s in, the mean error 0.01571 against
+// 0.01) for a render that stopped 9 s later: with no trend yet the only figure was the rest of
+// --time 900. With the noise's fall, passes^-1/2, the target is due at 16 x 1.571^2 = 39.5
+// passes, 23.5 passes of 0.58 s: 13.7 s (the render needed 11 more passes, falling faster).
+TEST(Stop, TheTimeLeftFollowsTheTestedQuantitysFall) {
+  RenderOptions o;
+  o.target_error = 0.01;
+  o.time_seconds = 900.0;
+  const double per_pass = 9.3 / 16.0;
+  // The first test: the schedule's earlier test is this one (taken at this pass), no line before.
+  DriverState first{9.3, 17, 16, 0.01571};
+  const double want = (16.0 * (1.571 * 1.571) - 16.0) * per_pass;
+  EXPECT_NEAR(seconds_left(o, first, 16, 9.3, 9.3, 0.01571, {}), want, 1e-9);
+  // When the passes double the schedule takes the test it extrapolates from anew, at that pass
+  // (32 after 16): the line's own previous figure (at 24) gives the trend then, not the budget.
+  // An exact passes^-1 fall: 0.012 at 24, 0.009 at 32 against a target of 0.006: due at 48.
+  o.target_error = 0.006;
+  const DriverState rebased{18.6, 35, 32, 0.009};
+  EXPECT_NEAR(seconds_left(o, rebased, 32, 18.6, 18.6, 0.009, {24, 0.012}), 16.0 * per_pass, 1e-9);
+  // Through the schedule's earlier test where it is an earlier pass (16, at 0.018): the same 48.
+  const DriverState trend{18.6, 35, 16, 0.018};
+  EXPECT_NEAR(seconds_left(o, trend, 32, 18.6, 18.6, 0.009, {}), 16.0 * per_pass, 1e-9);
+  bool bounded_only = true;
+  EXPECT_NEAR(seconds_left(o, trend, 32, 18.6, 18.6, 0.009, {}, &bounded_only), 16.0 * per_pass,
+              1e-9);
+  EXPECT_FALSE(bounded_only);
+  // A quantity that rose since every earlier figure, or none known yet (pass 1): no estimate
+  // from the target, only what --time leaves ("<= X s left").
+  const DriverState rose{18.6, 35, 16, 0.008};
+  EXPECT_NEAR(seconds_left(o, rose, 32, 18.6, 18.6, 0.009, {24, 0.0085}, &bounded_only),
+              900.0 - 18.6, 1e-9);
+  EXPECT_TRUE(bounded_only);
+  EXPECT_NEAR(seconds_left(o, DriverState{}, 1, 0.5, 0.5, INFINITY, {}, &bounded_only), 899.5,
+              1e-9);
+  EXPECT_TRUE(bounded_only);
+  // --passes gives an estimate of its own (its passes at the mean pass's time).
+  o.passes = 40;
+  EXPECT_NEAR(seconds_left(o, DriverState{}, 1, 0.5, 0.5, INFINITY, {}, &bounded_only), 39.0 * 0.5,
+              1e-9);
+  EXPECT_FALSE(bounded_only);
+  o.passes.reset();
+  // At the target: the time to the next scheduled test (pass 35), never the budget.
+  EXPECT_NEAR(seconds_left(o, trend, 32, 18.6, 18.6, 0.005, {}), 3.0 * per_pass, 1e-9);
+  // No target and no budget: no figure.
+  RenderOptions none;
+  EXPECT_TRUE(std::isinf(seconds_left(none, first, 16, 9.3, 9.3, 0.01571, {})));
 }
 
 }  // namespace
