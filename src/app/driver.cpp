@@ -63,17 +63,16 @@ double falling_slope(uint64_t pass, double value, uint64_t early_pass, double ea
   return std::log(early_value / value) / std::log(double(pass) / double(early_pass));
 }
 
-// The pass at which value * (pass / i)^k reaches target.
-double crossing(uint64_t pass, double value, double k, double target) {
+}  // namespace
+
+double passes_at_fall(uint64_t pass, double value, double k, double target) {
   return double(pass) * std::pow(value / target, 1.0 / k);
 }
-
-}  // namespace
 
 double passes_to_target(uint64_t pass, double value, uint64_t early_pass, double early_value,
                         double target) {
   const double k = falling_slope(pass, value, early_pass, early_value);
-  return std::isnan(k) || !(target > 0.0) ? NAN : crossing(pass, value, k, target);
+  return std::isnan(k) || !(target > 0.0) ? NAN : passes_at_fall(pass, value, k, target);
 }
 
 uint64_t next_check_after(uint64_t pass, double value, uint64_t early_pass, double early_value,
@@ -89,14 +88,13 @@ uint64_t next_check_after(uint64_t pass, double value, uint64_t early_pass, doub
   // kSlowestFall and the test at most at twice the passes (a quantity that barely fell between
   // two close tests, as where --adaptive paths begins, may fall fast after them; one that
   // stopped falling is still tested, and the "unreachable" rule with it).
-  constexpr double kSlowestFall = 0.5;
   const uint64_t regular = pass + std::max<uint64_t>(1, pass / 10);
   const uint64_t nearest = pass + std::max<uint64_t>(1, pass / 40);
   const double k = falling_slope(pass, value, early_pass, early_value);
   if (!(value > target && target > 0.0) || std::isnan(k)) return regular;
-  const double needed = crossing(pass, value, k, target);
+  const double needed = passes_at_fall(pass, value, k, target);
   if (needed < double(regular)) return std::clamp(uint64_t(std::ceil(needed)), nearest, regular);
-  const double far = crossing(pass, value, std::max(k, kSlowestFall), target);
+  const double far = passes_at_fall(pass, value, std::max(k, kSlowestFall), target);
   const double later = std::min(double(pass) + 0.75 * (far - double(pass)), 2.0 * double(pass));
   return std::max(regular, uint64_t(std::ceil(later)));
 }

@@ -90,6 +90,10 @@ std::string tested_name(const RenderOptions& options);
 // schedule both extrapolate with it.
 double passes_to_target(uint64_t pass, double value, uint64_t early_pass, double early_value,
                         double target);
+// The slowest fall the extrapolations assume where they need one: the noise's, passes^-1/2.
+inline constexpr double kSlowestFall = 0.5;
+// The pass at which `value` at `pass`, falling as passes^-k, reaches `target`.
+double passes_at_fall(uint64_t pass, double value, double k, double target);
 
 // The pass of the next stop test after one at `pass` that found `value` above `target`
 // (ESTIMATOR.md section 7): about 10% of the passes later; sooner, where the power law says the

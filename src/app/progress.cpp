@@ -58,29 +58,31 @@ double seconds_left(const RenderOptions& o, const DriverState& schedule, uint64_
   if (o.passes) left = std::min(left, double(*o.passes - std::min(pass, *o.passes)) * per_pass);
   const double by_passes = left;
   if (o.time_seconds) left = std::min(left, *o.time_seconds - run_seconds);
-  if (bounded_only) *bounded_only = o.target_error && left < by_passes;
+  // The target's estimate (+inf: none).
+  double by_target = INFINITY;
   if (o.target_error && std::isfinite(tested)) {
     const double target = *o.target_error;
     const uint64_t next = std::max(schedule.next_check, pass);
     const double to_check = double(next - pass) * per_pass;
-    if (bounded_only) *bounded_only = false;
-    if (tested <= target) return std::min(left, to_check);
-    double needed =
-        passes_to_target(pass, tested, schedule.early_pass, schedule.early_value, target);
-    if (std::isnan(needed))
-      needed = passes_to_target(pass, tested, earlier.pass, earlier.value, target);
-    // No earlier figure at all: the noise's fall, which the schedule also takes as the slowest
-    // when it postpones a test (at 1920x1080 the first line came at the first test, and the time
-    // left it showed was the rest of --time: "~890 s" for a render that ended 9 s later).
-    const bool first = (schedule.early_pass == 0 || schedule.early_pass >= pass) &&
-                       (earlier.pass == 0 || earlier.pass >= pass);
-    if (std::isnan(needed) && first) needed = double(pass) * (tested / target) * (tested / target);
-    if (std::isfinite(needed))
-      left = std::min(left, std::max((needed - double(pass)) * per_pass, to_check));
-    else if (bounded_only)
-      *bounded_only = left < by_passes;
+    if (tested <= target) {
+      by_target = to_check;
+    } else {
+      double needed =
+          passes_to_target(pass, tested, schedule.early_pass, schedule.early_value, target);
+      if (std::isnan(needed))
+        needed = passes_to_target(pass, tested, earlier.pass, earlier.value, target);
+      // No earlier figure at all: the noise's fall, which the schedule also takes as the
+      // slowest when it postpones a test (at 1920x1080 the first line came at the first test,
+      // and the time left it showed was the rest of --time: "~890 s" for a render that ended
+      // 9 s later).
+      const bool first = (schedule.early_pass == 0 || schedule.early_pass >= pass) &&
+                         (earlier.pass == 0 || earlier.pass >= pass);
+      if (std::isnan(needed) && first) needed = passes_at_fall(pass, tested, kSlowestFall, target);
+      if (std::isfinite(needed)) by_target = std::max((needed - double(pass)) * per_pass, to_check);
+    }
   }
-  return left;
+  if (bounded_only) *bounded_only = o.target_error && !std::isfinite(by_target) && left < by_passes;
+  return std::min(left, by_target);
 }
 
 std::string ProgressPrinter::line(const PassInfo& info, const TestedAt& earlier) {

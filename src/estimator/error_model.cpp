@@ -159,14 +159,6 @@ void bias_prior(const std::function<BiasEstimate(size_t)>& pixel, int width, int
   });
 }
 
-std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, int width,
-                              int height, double noise_factor, std::span<const uint8_t> floor) {
-  std::vector<dvec3> tau2(size_t(std::max(width, 0)) * size_t(std::max(height, 0)));
-  bias_prior(pixel, width, height, noise_factor, floor,
-             [&](size_t p, const dvec3& t) { tau2[p] = t; });
-  return tau2;
-}
-
 // ESTIMATOR.md section 6b: the posterior's shrinkage of the bias estimate.
 double bias_shrinkage(double prior, double bias_variance) {
   return bias_variance > 0.0 ? prior / (prior + bias_variance) : 1.0;

@@ -66,10 +66,7 @@ inline constexpr double kPriorOwnFactor = 5.0;
 // estimates to stand out of their noise before any of it counts as bias (section 6c).
 // `floor`: per pixel, 1 where paths were taken; a pixel with one in its window takes the floor
 // tau^2 >= B^2 - kPriorOwnFactor k Var B of its own estimate (empty: no pixel does).
-std::vector<dvec3> bias_prior(const std::function<BiasEstimate(size_t)>& pixel, int width,
-                              int height, double noise_factor = 1.0,
-                              std::span<const uint8_t> floor = {});
-// The same, each pixel's tau^2 handed to out(p, tau2) (once, from any thread).
+// Each pixel's tau^2 is handed to out(p, tau2), once, from any thread.
 void bias_prior(const std::function<BiasEstimate(size_t)>& pixel, int width, int height,
                 double noise_factor, std::span<const uint8_t> floor,
                 const std::function<void(size_t, const dvec3&)>& out);

@@ -65,14 +65,14 @@ struct BoundRule {
 // mean-error model added to the tally. The bias is known only through its noisy estimate B:
 // given the prior of the neighbourhood, the error's bias part is B shrunk by
 // w = tau^2 / (tau^2 + Var B), with the posterior's variance w Var B added to the noise.
-dvec3 channel_bounds(const PixelResult& r, const dvec3& tau2, const BoundRule& rule,
-                     const dvec3& denominator, size_t p, TallySums& sums, Tally& tally) {
+dvec3 channel_bounds(const PixelResult& r, const BoundRule& rule, const dvec3& denominator,
+                     size_t p, TallySums& sums, Tally& tally) {
   dvec3 bound(0.0);
   double pixel_error_sd = 0.0;
   for (int c = 0; c < 3; ++c) {
     if (r.exact) continue;
     const double vb = r.bias_variance[c];
-    const double w = bias_shrinkage(tau2[c], vb);
+    const double w = bias_shrinkage(r.prior[c], vb);
     // Section 6c: with the fourth-order part, already shrunk by its own prior.
     const double bias = w * r.bias[c] + r.fourth[c];
     const double bias_var = w * vb + squared(double(r.fourth_sd[c]));
@@ -109,8 +109,8 @@ void write_pixel(FilmImage& image, size_t p, const PixelResult& r, const dvec3& 
 
 // ESTIMATOR.md sections 5-7: every pixel's bound (+inf where unknown) into the tally and image;
 // the sums into its chunk's `sums`.
-void bound_pixel(const PixelResult& r, const dvec3& tau2, const BoundRule& rule, bool refuted,
-                 uint64_t passes, size_t p, TallySums& sums, Tally& tally, FilmImage* image) {
+void bound_pixel(const PixelResult& r, const BoundRule& rule, bool refuted, uint64_t passes,
+                 size_t p, TallySums& sums, Tally& tally, FilmImage* image) {
   const FilmSettings& s = rule.s;
   const bool known_pixel = r.exact || (passes >= 2 && r.known && (!refuted || r.photon_free));
   dvec3 noise(0.0), bound(std::numeric_limits<double>::infinity());
@@ -121,7 +121,7 @@ void bound_pixel(const PixelResult& r, const dvec3& tau2, const BoundRule& rule,
         s.metric == ErrorMetric::Relative
             ? glm::max(r.radiance, dvec3(std::max(rule.relative_floor, 1e-300)))
             : dvec3(1.0);
-    bound = channel_bounds(r, tau2, rule, denominator, p, sums, tally);
+    bound = channel_bounds(r, rule, denominator, p, sums, tally);
     const dvec3 bias = r.bias + dvec3(r.fourth);
     const dvec3 metric = bound / denominator, bias_metric = glm::abs(bias) / denominator;
     sums.bound_sum += metric.x + metric.y + metric.z;
@@ -169,8 +169,9 @@ void prepare_image(FilmImage& image, int width, int height) {
   const size_t pixels = size_t(width) * size_t(height);
   image.width = width;
   image.height = height;
-  // The planes side by side: each is fresh pages (166 MB in all at 1920x1080), and faulting
-  // them in is most of this.
+  // The planes side by side: in a first development each is fresh pages (166 MB in all at
+  // 1920x1080), and faulting them in is most of this (the driver hands later stop tests the
+  // earlier planes, which assign() fills in place).
   const std::pair<std::vector<float>*, size_t> planes[] = {
       {&image.radiance, 3 * pixels}, {&image.bound, 3 * pixels},
       {&image.bias, 3 * pixels},     {&image.noise, 3 * pixels},
@@ -211,7 +212,6 @@ const std::vector<float>& FilmImage::plane(Channel id) const {
   return radiance;
 }
 
-// ESTIMATOR.md sections 5-7: combine, check the model, take the prior, bound and predict.
 std::byte* DevelopMemory::take(size_t bytes) {
   {
     const std::lock_guard lock(mutex_);
@@ -241,6 +241,7 @@ void DevelopMemory::release() {
   ::operator delete(drop);
 }
 
+// ESTIMATOR.md sections 5-7: combine, check the model, take the prior, bound and predict.
 FilmSummary develop(const PixelLayout& layout, const std::vector<PointState>& states,
                     uint64_t passes, const FilmSettings& s, FilmImage* image,
                     DevelopMemory* memory) {
@@ -262,8 +263,7 @@ FilmSummary develop(const PixelLayout& layout, const std::vector<PointState>& st
   std::vector<TallySums> chunk_sums((pixels + kChunk - 1) / kChunk);
   parallel_chunks(pixels, kChunk, [&](size_t k, size_t begin, size_t end) {
     for (size_t p = begin; p < end; ++p)
-      bound_pixel(results[p], results[p].prior, rule, sum.model_refuted, passes, p, chunk_sums[k],
-                  tally, image);
+      bound_pixel(results[p], rule, sum.model_refuted, passes, p, chunk_sums[k], tally, image);
   });
   for (const TallySums& c : chunk_sums) tally.sums.add(c);
   tally.model.error = tally.sums.error;

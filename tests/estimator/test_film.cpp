@@ -61,6 +61,16 @@ Trial trial(uint64_t seed, int block, double shared) {
   return t;
 }
 
+// The bias prior (error_model.h hands each pixel's tau^2 to a callback) as a vector.
+std::vector<dvec3> prior_field(const std::function<BiasEstimate(size_t)>& pixel, int width,
+                               int height, double noise_factor = 1.0,
+                               std::span<const uint8_t> floor = {}) {
+  std::vector<dvec3> tau2(size_t(width) * size_t(height));
+  bias_prior(pixel, width, height, noise_factor, floor,
+             [&](size_t p, const dvec3& t) { tau2[p] = t; });
+  return tau2;
+}
+
 struct Spread {
   double mean_actual = 0.0, sd_actual = 0.0, predicted = 0.0, sd = 0.0, k = 0.0;
 };
@@ -138,7 +148,7 @@ TEST(BiasPrior, AWindowOfNoiseCountsAsBiasOnlyBeyondTheNoiseFactor) {
     biased[p] = 3.0 + z(rng);
   }
   auto prior = [&](const std::vector<double>& b, double k) {
-    return bias_prior(
+    return prior_field(
         [&](size_t p) {
           return BiasEstimate{dvec3(b[p]), dvec3(1.0), true};
         },
@@ -180,7 +190,7 @@ TEST(BiasPrior, APixelsOwnBiasBeyondItsNoiseIsNotShrunkByItsWindow) {
   // The floor acts in the windows of pixels that have had paths: here every pixel has.
   const std::vector<uint8_t> everywhere(n * n, 1), none;
   auto prior = [&](std::span<const uint8_t> paths) {
-    return bias_prior(
+    return prior_field(
         [&](size_t p) {
           return BiasEstimate{dvec3(b[p]), dvec3(1.0), true};
         },
@@ -253,8 +263,8 @@ TEST(BiasPrior, WindowSumsAreTheDirectSumsAndKeepTheirDigitsBesideALargeBias) {
   for (double k : {1.0, 1.5})
     for (bool floored : {false, true}) {
       const std::vector<dvec3> tau2 =
-          bias_prior([&](size_t p) { return e[p]; }, w, h, k,
-                     floored ? std::span<const uint8_t>(paths) : std::span<const uint8_t>());
+          prior_field([&](size_t p) { return e[p]; }, w, h, k,
+                      floored ? std::span<const uint8_t>(paths) : std::span<const uint8_t>());
       ASSERT_EQ(tau2.size(), e.size());
       for (int y = 0; y < h; ++y)
         for (int x = 0; x < w; ++x) {
