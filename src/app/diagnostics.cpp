@@ -132,7 +132,7 @@ std::vector<std::string> preflight_diagnostics(const RenderOptions& options,
 }
 
 // ESTIMATOR.md sections 11b and 11c: a refuted bias model leaves every photon bound unknown.
-std::vector<std::string> result_diagnostics(const RenderOptions& options, const ExrImage& image,
+std::vector<std::string> result_diagnostics(const RenderOptions& options, const ExrView& image,
                                             const Scene& scene, const FilmSummary& summary,
                                             uint64_t passes) {
   std::vector<std::string> lines;

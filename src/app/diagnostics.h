@@ -28,7 +28,7 @@ std::vector<std::string> option_diagnostics(const RenderOptions& options);
 std::vector<std::string> preflight_diagnostics(const RenderOptions& options,
                                                const Renderer& renderer);
 // After the render of `passes` passes: none done, a dark image, a refuted bias model.
-std::vector<std::string> result_diagnostics(const RenderOptions& options, const ExrImage& image,
+std::vector<std::string> result_diagnostics(const RenderOptions& options, const ExrView& image,
                                             const Scene& scene, const FilmSummary& summary,
                                             uint64_t passes);
 

@@ -29,6 +29,7 @@
 #include <iomanip>
 #include <iostream>
 #include <new>
+#include <optional>
 #include <sstream>
 
 namespace {
@@ -193,12 +194,15 @@ std::string start_line(const pb::RenderOptions& options, const pb::Renderer& ren
 void finish_render(const pb::RenderOptions& options, const pb::Renderer& renderer,
                    const pb::RenderReport& report, const pb::DriverState& schedule,
                    uint64_t scene_hash, bool keep_state, const std::string& state_path) {
-  // Ctrl-C keeps the work: the state is written then too.
-  const pb::ExrImage image = report.film
-                                 ? renderer.image(report.run(), *report.film, report.summary)
-                                 : renderer.image(report.run());
+  // Ctrl-C keeps the work: the state is written then too. The EXR is written from the film's
+  // planes (Renderer::image_view), not from an interleaved copy of them.
+  std::optional<pb::FilmImage> developed;
+  pb::FilmSummary summary = report.summary;
+  if (!report.film) summary = renderer.develop(&developed.emplace());
+  const pb::ExrView image =
+      renderer.image_view(report.run(), report.film ? *report.film : *developed, summary);
   pb::write_exr(options.output, image);
-  print_lines(pb::result_diagnostics(options, image, renderer.world().scene(), report.summary,
+  print_lines(pb::result_diagnostics(options, image, renderer.world().scene(), summary,
                                      report.work.passes));
   if (keep_state || report.stop == pb::StopReason::Interrupted)
     pb::save_state(state_path, {options, scene_hash, renderer.snapshot(), schedule});

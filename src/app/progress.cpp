@@ -147,7 +147,8 @@ void PassLogger::after_pass(const PassInfo& info) {
   if (reference_) {
     FilmImage film;
     info.renderer.develop(&film);
-    const CompareResult c = compare_images(pack_channels(film), *reference_, "render", "reference");
+    const CompareResult c =
+        compare_images(packed(film_view(film)), *reference_, "render", "reference");
     line.add("mae", c.mean_abs_error).add("rmse", c.rmse).add("coverage", c.coverage);
   }
   out_ << line.str() << "\n" << std::flush;

@@ -34,9 +34,33 @@ struct ExrImage {
 // every few seconds to minutes, are written uncompressed; the final image uses ZIP.
 enum class ExrCompression { Zip, None };
 
+// An image as write_exr reads it: channel c of pixel p (row-major) is
+// planes[c].data[p * planes[c].stride]. A render's film is written from its own planes through
+// one, with no interleaved copy of the image first (21 MB at 512x512, 166 MB at 1920x1080, and
+// 0.02 s of a 16-pass 512x512 render's 0.23 s outside its pass loop); an ExrImage converts to
+// one. A view holds pointers into the image it was made from, which must outlive it.
+struct ExrView {
+  struct Plane {
+    const float* data = nullptr;
+    size_t stride = 1;
+  };
+  int width = 0, height = 0;
+  std::vector<std::string> channels;
+  std::vector<Plane> planes;  // one per channel
+  std::vector<std::pair<std::string, std::string>> metadata;
+
+  ExrView() = default;
+  ExrView(const ExrImage& image);  // NOLINT(google-explicit-constructor): write_exr takes either
+  int channel_index(const std::string& name) const;  // -1 when absent
+  float at(size_t c, size_t p) const { return planes[c].data[p * planes[c].stride]; }
+};
+
+// The view's pixels interleaved, as read_exr returns an image.
+ExrImage packed(const ExrView& view);
+
 // Writes float32 EXR atomically (file_io.h write_atomically): a reader never sees a partial
 // image. Throws ImageError naming the file.
-void write_exr(const std::string& path, const ExrImage& image,
+void write_exr(const std::string& path, const ExrView& image,
                ExrCompression compression = ExrCompression::Zip);
 
 // How much a file read whole may take (its header's width x height x channels as floats), and

@@ -40,8 +40,8 @@ struct RunInfo {
   std::string stop_reason;
 };
 
-// The EXR layout of channels.def (no metadata).
-ExrImage pack_channels(const FilmImage& film);
+// The EXR layout of channels.def over the film's planes (no metadata); valid while `film` is.
+ExrView film_view(const FilmImage& film);
 
 // The default initial radius: kFootprintsPerRadius pixel footprints (median over the points),
 // or 1% of the scene without points; never below the radius floor.
@@ -101,9 +101,13 @@ class Renderer {
   ExrImage image(const RunInfo& run) const;
   ExrImage image(const RunInfo& run, const RenderState& state) const;
   // The EXR of the current states from their development (`film` and `summary`, made by
-  // develop(&film) since the last pass).
+  // develop(&film) since the last pass): as a view of the film's planes, which write_exr
+  // writes with no copy of the image (valid while `film` is), or packed.
+  ExrView image_view(const RunInfo& run, const FilmImage& film, const FilmSummary& summary) const {
+    return view(run, film, summary, work_, initial_radius_, states_.size());
+  }
   ExrImage image(const RunInfo& run, const FilmImage& film, const FilmSummary& summary) const {
-    return image(run, film, summary, work_, initial_radius_, states_.size());
+    return packed(image_view(run, film, summary));
   }
 
   const RenderOptions& options() const { return options_; }
@@ -126,8 +130,8 @@ class Renderer {
                      double max_photon_power) const;
   FilmSummary develop(const std::vector<PointState>& states, const RenderState* saved,
                       uint64_t passes, double max_photon_power, FilmImage* image) const;
-  ExrImage image(const RunInfo& run, const FilmImage& film, const FilmSummary& summary,
-                 const WorkCounters& work, double initial_radius, size_t states) const;
+  ExrView view(const RunInfo& run, const FilmImage& film, const FilmSummary& summary,
+               const WorkCounters& work, double initial_radius, size_t states) const;
 
   const RenderOptions options_;
   World world_;

@@ -93,17 +93,16 @@ std::vector<std::string> complete_scene(Scene& scene, const RenderOptions& o) {
 // the user can add instead.
 namespace {
 
-std::optional<std::string> mostly_dark_warning(const ExrImage& image, const int rgb[3],
+std::optional<std::string> mostly_dark_warning(const ExrView& image, const int rgb[3],
                                                const Scene& scene) {
   if (scene.environment) return std::nullopt;
   for (const PunctualLight& l : scene.lights)
     if (max_component(l.intensity) > 0.0f) return std::nullopt;
-  const size_t pixels = size_t(image.width) * size_t(image.height), nc = image.channels.size();
+  const size_t pixels = image.planes.empty() ? 0 : size_t(image.width) * size_t(image.height);
   size_t dark = 0;
   for (size_t p = 0; p < pixels; ++p) {
     float brightest = 0.0f;
-    for (int c = 0; c < 3; ++c)
-      brightest = std::max(brightest, image.pixels[p * nc + size_t(rgb[c])]);
+    for (int c = 0; c < 3; ++c) brightest = std::max(brightest, image.at(size_t(rgb[c]), p));
     dark += double(brightest) < kDarkRadiance;
   }
   const double share = pixels ? double(dark) / double(pixels) : 0.0;
@@ -116,14 +115,14 @@ std::optional<std::string> mostly_dark_warning(const ExrImage& image, const int 
 
 }  // namespace
 
-std::optional<std::string> dark_image_warning(const ExrImage& image, const Scene& scene) {
+std::optional<std::string> dark_image_warning(const ExrView& image, const Scene& scene) {
   int rgb[3];
   for (int c = 0; c < 3; ++c) rgb[c] = image.channel_index(channel_name(Channel::Radiance, c));
   if (rgb[0] < 0 || rgb[1] < 0 || rgb[2] < 0) return std::nullopt;
-  const size_t pixels = size_t(image.width) * size_t(image.height), nc = image.channels.size();
+  const size_t pixels = image.planes.empty() ? 0 : size_t(image.width) * size_t(image.height);
   double sum = 0.0;
   for (size_t p = 0; p < pixels; ++p)
-    for (int c = 0; c < 3; ++c) sum += double(image.pixels[p * nc + size_t(rgb[c])]);
+    for (int c = 0; c < 3; ++c) sum += double(image.at(size_t(rgb[c]), p));
   const double mean = pixels ? sum / double(3 * pixels) : 0.0;
   if (mean >= kDarkRadiance) return mostly_dark_warning(image, rgb, scene);
   std::string w = std::string(mean > 0.0 ? "the image is nearly black" : "the image is black") +

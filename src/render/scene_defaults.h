@@ -39,6 +39,6 @@ inline constexpr double kMostlyDarkShare = 0.75;
 // below kDarkRadiance), or, lit only by emissive materials (no punctual light, no environment),
 // mostly black (more than kMostlyDarkShare of its pixels below kDarkRadiance), saying what might
 // be missing; none otherwise.
-std::optional<std::string> dark_image_warning(const ExrImage& image, const Scene& scene);
+std::optional<std::string> dark_image_warning(const ExrView& image, const Scene& scene);
 
 }  // namespace pb

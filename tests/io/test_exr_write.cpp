@@ -18,6 +18,8 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <limits>
 #include <random>
 
@@ -147,6 +149,72 @@ TEST(ExrWrite, ReadExrAgrees) {
   }
   EXPECT_EQ(differ, 0u);
   std::filesystem::remove(path);
+}
+
+std::vector<char> file_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// A render writes its film through a view of its planes (an RGB plane of stride 3 beside planes
+// of stride 1, none in the file's order): the file must be, byte for byte, the one its packed
+// image gives, and packed() must interleave the view's values where they belong.
+TEST(ExrWrite, AViewOfPlanesWritesTheFileItsPackedImageWrites) {
+  const ExrImage source = test_image(45, 37, 4);  // 37 lines: a last ZIP chunk of 5
+  const size_t pixels = size_t(source.width) * size_t(source.height);
+  const size_t nc = source.channels.size();
+  // The source's channels regrouped as planes: the first three as one RGB plane, each other
+  // one alone.
+  std::vector<float> rgb(3 * pixels);
+  std::vector<std::vector<float>> single(nc - 3, std::vector<float>(pixels));
+  for (size_t p = 0; p < pixels; ++p) {
+    for (size_t c = 0; c < 3; ++c) rgb[3 * p + c] = source.pixels[p * nc + c];
+    for (size_t c = 3; c < nc; ++c) single[c - 3][p] = source.pixels[p * nc + c];
+  }
+  ExrView view;
+  view.width = source.width;
+  view.height = source.height;
+  view.channels = source.channels;
+  view.metadata = source.metadata;
+  for (size_t c = 0; c < 3; ++c) view.planes.push_back({rgb.data() + c, 3});
+  for (size_t c = 3; c < nc; ++c) view.planes.push_back({single[c - 3].data(), 1});
+
+  const ExrImage back = packed(view);
+  EXPECT_EQ(back.channels, source.channels);
+  EXPECT_EQ(back.metadata, source.metadata);
+  ASSERT_EQ(back.pixels.size(), source.pixels.size());
+  size_t differ = 0;
+  for (size_t k = 0; k < back.pixels.size(); ++k)
+    differ += bits(back.pixels[k]) != bits(source.pixels[k]);
+  EXPECT_EQ(differ, 0u);
+
+  for (const ExrCompression compression : {ExrCompression::Zip, ExrCompression::None}) {
+    const std::string from_view = temp_path("view.exr"), from_image = temp_path("image.exr");
+    write_exr(from_view, view, compression);
+    write_exr(from_image, source, compression);
+    EXPECT_EQ(file_bytes(from_view), file_bytes(from_image));
+    std::filesystem::remove(from_view);
+    std::filesystem::remove(from_image);
+  }
+}
+
+// An image whose pixels do not fill it, or a view missing a plane, is refused naming the file,
+// and nothing is left behind.
+TEST(ExrWrite, AnImageWithoutItsPixelsIsRefusedAndLeavesNoFile) {
+  ExrImage short_of_pixels = test_image(8, 8, 2);
+  short_of_pixels.pixels.pop_back();
+  ExrView missing_plane = test_image(8, 8, 3);
+  missing_plane.planes[2].data = nullptr;
+  for (const ExrView& bad : {ExrView(short_of_pixels), missing_plane}) {
+    const std::string path = temp_path("bad.exr");
+    try {
+      write_exr(path, bad);
+      ADD_FAILURE() << "written";
+    } catch (const ImageError& e) {
+      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+    EXPECT_FALSE(std::filesystem::exists(path));
+  }
 }
 
 }  // namespace
