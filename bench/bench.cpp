@@ -463,8 +463,9 @@ void run_scene(const std::string& path, const Config& c, int all) {
        phn.rays_per_s >= 0.6 * rawn.rays_per_s);
   goal(name + ": photon pass / raw rays (1 thr)", fmt("%.2f", ph1.rays_per_s / raw1.rays_per_s),
        ">= 0.60", ph1.rays_per_s >= 0.6 * raw1.rays_per_s);
+  // Issue 40's figure (issue 5 asked 1.8x).
   goal(name + ": photon pass scaling " + std::to_string(all) + "/1 threads", fmt("%.2fx", scaling),
-       ">= 1.8x", scaling >= 1.8);
+       ">= 1.9x", scaling >= 1.9);
 
   const EyeSetup eye = eye_setup(world, c.width, c.height);
   std::printf("  camera pass                 %.3f s at %dx%d (%zu points)\n", eye.seconds, c.width,
@@ -507,8 +508,9 @@ void run_scene(const std::string& path, const Config& c, int all) {
       double(L.grid_bytes) / double(L.points), double(L.grid_bytes) / kMiB);
   std::printf("  peak RSS so far          %.0f MiB\n", peak_rss_bytes() / kMiB);
 
-  goal(name + ": error-estimation overhead", fmt("%.1f%%", 100.0 * overhead), "<= 10%",
-       overhead <= 0.10);
+  // Issue 40's figure (issue 5 asked 10%).
+  goal(name + ": error-estimation overhead", fmt("%.1f%%", 100.0 * overhead), "<= 5%",
+       overhead <= 0.05);
   goal(name + ": grid rebuild / pass (512^2)", fmt("%.1f%%", 100.0 * grid / pass), "<= 10%",
        grid <= 0.1 * pass);
   goal(name + ": same, radii shrunk 100x", fmt("%.1f%%", 100.0 * sgrid / spass), "<= 10%",
