@@ -1,6 +1,8 @@
 // HashGrid against brute force: exact index sets (so a missed, extra or repeated photon fails),
 // dist2 values, determinism of the visit order, and input validation.
+#include "estimator/kernel.h"
 #include "render/hash_grid.h"
+#include "render/pass_stages.h"
 #include "util/rng.h"
 
 #include <gtest/gtest.h>
@@ -300,6 +302,60 @@ TEST(HashGrid, EmptyPhotonSetOrNoRadii) {
   count = 0;
   grid.query(vec3(0.0f), 1.0f, [&](uint32_t, float) { ++count; });
   EXPECT_EQ(count, 1u);
+}
+
+// The gather's three kernel sums (pass_stages.cpp, kept two doubles at a time) against their
+// definitions over the photons found by brute force: w(t) Phi, w_lap(t) R^2 Phi and, within
+// R / 2 only, w(2 t) Phi, with t = |x_p - x| / R. A flat Lambertian plane (every photon on the
+// point's side, shading = geometric normal, f = 1), photons of random powers; the sums differ
+// from the scalar loop's only in the order of addition (the grid's cells), so 1e-12.
+TEST(HashGrid, TheGatherSumsAreTheKernelsOverThePhotonsWithinTheRadius) {
+  const double r2 = 0.04;  // R = 0.2
+  std::vector<PhotonHit> hits;
+  for (size_t i = 0; i < 4000; ++i) {
+    Rng rng(41, 0, i, Stream::Test);
+    PhotonHit h;
+    h.position = vec3(rng.next_float() - 0.5f, rng.next_float() - 0.5f, 0.0f);
+    h.wi = vec3(0.0f, 0.0f, 1.0f);
+    h.normal = vec3(0.0f, 0.0f, 1.0f);
+    h.flux = vec3(rng.next_float(), 2.0f * rng.next_float(), 0.5f + rng.next_float());
+    hits.push_back(h);
+  }
+  std::vector<vec3> positions;
+  HashGrid grid;
+  const float radius = search_radius(r2);
+  build_photon_grid(hits, std::vector<float>{radius}, positions, grid);
+  for (const vec3 at : {vec3(0.0f), vec3(0.13f, -0.07f, 0.0f), vec3(-0.41f, 0.44f, 0.0f)}) {
+    VisiblePoint p;
+    p.position = at;
+    p.normal = p.shading = vec3(0.0f, 0.0f, 1.0f);
+    p.f = vec3(1.0f);
+    PassSums got;
+    gather_photons<true>(p, r2, grid, hits, got);
+    dvec3 phi(0.0), lap(0.0), half(0.0);
+    double count = 0.0;
+    size_t halves = 0;
+    for (const PhotonHit& h : hits) {
+      const float d2 = HashGrid::distance2(h.position, at);
+      if (!(d2 < radius * radius)) continue;
+      const double t = std::min(1.0, std::sqrt(double(d2) / r2));
+      const dvec3 flux(h.flux);
+      phi += kernel::weight(t) * flux;
+      lap += kernel::laplacian_weight_r2(t) * flux;
+      if (t < 0.5) {
+        half += kernel::weight(2.0 * t) * flux;
+        ++halves;
+      }
+      count += 1.0;
+    }
+    ASSERT_GT(halves, 10u);  // the half-radius sum is tested on photons, not on none
+    EXPECT_EQ(got.count, count);
+    for (int c = 0; c < 3; ++c) {
+      EXPECT_NEAR(got.phi[c], phi[c], 1e-12 * std::abs(phi[c])) << c;
+      EXPECT_NEAR(got.phi_lap_r2[c], lap[c], 1e-12 * std::abs(phi[c]) * 105.0) << c;
+      EXPECT_NEAR(got.phi_half[c], half[c], 1e-12 * std::abs(half[c])) << c;
+    }
+  }
 }
 
 }  // namespace
