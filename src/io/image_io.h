@@ -1,5 +1,5 @@
 // EXR reading and writing, and decoding the images of glTF textures. EXRs are written through
-// OpenEXR's core library, their ZIP chunks deflated by libdeflate (image_io.cpp); everything that
+// OpenEXR's core library, their ZIP chunks deflated by libdeflate (exr_write.cpp); everything that
 // needs OpenImageIO (reads, texture decoding, PNG) is in the module src/io/oiio/, which
 // image_io.cpp loads on first use (io/oiio_codec.h).
 #pragma once
@@ -55,7 +55,7 @@ struct ExrView {
   float at(size_t c, size_t p) const { return planes[c].data[p * planes[c].stride]; }
 };
 
-// The view's pixels interleaved, as read_exr returns an image.
+// The view's pixels interleaved, as read_exr returns an image (none where a plane is missing).
 ExrImage packed(const ExrView& view);
 
 // Writes float32 EXR atomically (file_io.h write_atomically): a reader never sees a partial

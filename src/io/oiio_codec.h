@@ -3,7 +3,7 @@
 // shared libraries, and a process that links it spends 0.3-0.35 s in the dynamic loader before
 // main (bench/README.md "Outside the pass loop"), a tenth of a 16-pass 512x512 render and a
 // third of a small one, whether it reads an image or not. A render of a scene without textures
-// writes its EXR through OpenEXR (image_io.cpp) and never loads the module.
+// writes its EXR through OpenEXR (exr_write.cpp) and never loads the module.
 //
 // Exceptions do not cross the module's edge: each call reports a CodecFailure, and image_io.cpp
 // throws the ImageError it describes. Both sides are built from these declarations by the same
