@@ -52,6 +52,9 @@ struct DirectSample {
 bool sample_spherical_triangle(const vec3& v0, const vec3& v1, const vec3& v2, const vec3& p,
                                float u0, float u1, vec3& dir, float& solid_angle);
 
+// atan2(y, x) for y >= 0, in [0, pi], within 1e-5 (next-event choice weights, lights_direct.cpp).
+float atan2_upper(float y, float x);
+
 // The power formulas the light sampler and the loader's range check share (W per channel).
 // A one-sided Lambertian emitter of radiance Le and area A emits pi A Le; a double-sided one
 // twice that.

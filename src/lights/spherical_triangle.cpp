@@ -10,31 +10,37 @@ namespace pb {
 bool sample_spherical_triangle(const vec3& v0, const vec3& v1, const vec3& v2, const vec3& p,
                                float u0, float u1, vec3& dir, float& solid_angle) {
   // Arvo 1995, "Stratified sampling of spherical triangles", in the form of pbrt-v4's
-  // SampleSphericalTriangle, in double: the arcs and angles lose float precision quickly.
+  // SampleSphericalTriangle, in double: the arcs and angles lose float precision quickly. The
+  // solid angle is Van Oosterom & Strackee's (1983) for unit vectors,
+  //   tan(omega / 2) = |a.(b x c)| / (1 + a.b + b.c + c.a),
+  // one atan2 where the spherical excess alpha + beta + gamma - pi needs three acos and loses
+  // the small triangle's area to cancellation against pi; the angle alpha at a enters only
+  // through its cosine and sine, the dot and cross of the two great circles' unit normals.
   using glm::dvec3;
   const dvec3 a = glm::normalize(dvec3(v0) - dvec3(p));
   const dvec3 b = glm::normalize(dvec3(v1) - dvec3(p));
   const dvec3 c = glm::normalize(dvec3(v2) - dvec3(p));
-  dvec3 n_ab = glm::cross(a, b), n_bc = glm::cross(b, c), n_ca = glm::cross(c, a);
-  const double l_ab = glm::length(n_ab), l_bc = glm::length(n_bc), l_ca = glm::length(n_ca);
-  if (!(l_ab > 1e-12 && l_bc > 1e-12 && l_ca > 1e-12)) return false;
+  dvec3 n_ab = glm::cross(a, b), n_ca = glm::cross(c, a);
+  const dvec3 n_bc = glm::cross(b, c);
+  const double l_ab = glm::length(n_ab), l_ca = glm::length(n_ca);
+  if (!(l_ab > 1e-12 && glm::dot(n_bc, n_bc) > 1e-24 && l_ca > 1e-12)) return false;
   n_ab /= l_ab;
-  n_bc /= l_bc;
   n_ca /= l_ca;
-  auto angle = [](const dvec3& x, const dvec3& y) {
-    return std::acos(std::clamp(glm::dot(x, y), -1.0, 1.0));
-  };
-  const double alpha = angle(n_ab, -n_ca), beta = angle(n_bc, -n_ab), gamma = angle(n_ca, -n_bc);
-  const double area = alpha + beta + gamma - kPiD;  // spherical excess = solid angle
-  // Below this the excess is dominated by rounding; above 2 pi - eps the receiver is almost in
-  // the triangle's plane. Both fall back to area sampling.
+  const double area =  // the solid angle, in [0, 2 pi]
+      2.0 * std::atan2(std::fabs(glm::dot(a, n_bc)),
+                       1.0 + glm::dot(a, b) + glm::dot(b, c) + glm::dot(c, a));
+  // Below this the triangle is too small to sample by its arcs; above 2 pi - eps the receiver
+  // is almost in the triangle's plane. Both fall back to area sampling.
   if (!(area > 3e-4 && area < 6.22)) return false;
+  const double cos_alpha = std::clamp(glm::dot(n_ab, -n_ca), -1.0, 1.0);
+  const double sin_alpha = glm::length(glm::cross(n_ab, n_ca));
 
   // Choose the sub-triangle area A' uniformly, then the point on arc b-c' for it.
-  const double ap_pi = kPiD + double(u0) * area;  // A' + pi
-  const double cos_alpha = std::cos(alpha), sin_alpha = std::sin(alpha);
-  const double sin_phi = std::sin(ap_pi) * cos_alpha - std::cos(ap_pi) * sin_alpha;
-  const double cos_phi = std::cos(ap_pi) * cos_alpha + std::sin(ap_pi) * sin_alpha;
+  // Arvo's phi = A' + pi - alpha, through sin(A' + pi) = -sin A' and cos(A' + pi) = -cos A'.
+  const double sub = double(u0) * area;  // A'
+  const double sin_ap = -std::sin(sub), cos_ap = -std::cos(sub);
+  const double sin_phi = sin_ap * cos_alpha - cos_ap * sin_alpha;
+  const double cos_phi = cos_ap * cos_alpha + sin_ap * sin_alpha;
   const double k1 = cos_phi + cos_alpha;
   const double k2 = sin_phi - sin_alpha * glm::dot(a, b);
   double cos_bp = (k2 + (k2 * cos_phi - k1 * sin_phi) * cos_alpha) /

@@ -83,6 +83,52 @@ TEST(SphericalTriangle, RefusesDegenerateAndTinySolidAngles) {
                                          vec3(0, 0, 100), 0.5f, 0.5f, d, omega));
 }
 
+// The solid angle the sampler returns is the triangle's: the two halves of an a x b rectangle
+// seen from a point at height d over one corner subtend atan(ab / (d sqrt(a^2 + b^2 + d^2)))
+// together (the rectangle's closed form, independent of both triangle formulas), from a
+// rectangle near the refusal threshold (each half 6.2e-4 sr) to one that fills most of the
+// hemisphere; and the octant triangle subtends pi / 2. Float output: 2e-6 relative.
+TEST(SphericalTriangle, TheSolidAngleIsTheTrianglesOwn) {
+  const double cases[][3] = {{0.025, 0.05, 1.0}, {0.3, 0.2, 1.0}, {2.0, 3.0, 0.5}, {10, 10, 0.1}};
+  for (const auto& c : cases) {
+    const float a = float(c[0]), b = float(c[1]), d = float(c[2]);
+    const vec3 p(0.0f), p00(0, 0, d), pa0(a, 0, d), pab(a, b, d), p0b(0, b, d);
+    vec3 dir;
+    float half1 = 0.0f, half2 = 0.0f;
+    ASSERT_TRUE(sample_spherical_triangle(p00, pa0, pab, p, 0.3f, 0.6f, dir, half1));
+    ASSERT_TRUE(sample_spherical_triangle(p00, pab, p0b, p, 0.7f, 0.2f, dir, half2));
+    const double ad = double(a), bd = double(b), dd = double(d);
+    const double exact = std::atan(ad * bd / (dd * std::sqrt(ad * ad + bd * bd + dd * dd)));
+    EXPECT_NEAR(double(half1) + double(half2), exact, 2e-6 * exact) << a << " x " << b;
+  }
+  vec3 dir;
+  float octant = 0.0f;
+  ASSERT_TRUE(sample_spherical_triangle(vec3(1, 0, 0), vec3(0, 1, 0), vec3(0, 0, 1), vec3(0.0f),
+                                        0.5f, 0.5f, dir, octant));
+  EXPECT_NEAR(double(octant), kPiD / 2.0, 2e-6);
+}
+
+// The next-event choice weights' atan2: within its 1e-5 of libm's over every quadrant of the
+// upper half-plane and ratios from 1e-6 to 1e6, relatively close for small angles (where the
+// weight is the solid angle of a far emitter), and positive wherever the angle is.
+TEST(NextEventChoice, TheWeightsAtan2IsWithinItsBound) {
+  double worst = 0.0, worst_rel = 0.0;
+  for (int i = -120; i <= 120; ++i) {
+    const float ratio = std::pow(10.0f, float(i) / 20.0f);
+    for (const float x : {1.0f, -1.0f, 0.0f}) {
+      const float y = x == 0.0f ? ratio : ratio * std::fabs(x);
+      const double want = std::atan2(double(y), double(x)), got = double(atan2_upper(y, x));
+      worst = std::max(worst, std::fabs(got - want));
+      worst_rel = std::max(worst_rel, std::fabs(got - want) / want);
+      EXPECT_GT(got, 0.0) << y << " " << x;
+    }
+  }
+  EXPECT_LT(worst, 1.2e-5);      // the polynomial's 1e-5 and float rounding
+  EXPECT_LT(worst_rel, 1.5e-4);  // its leading coefficient 0.999866
+  EXPECT_EQ(atan2_upper(0.0f, 1.0f), 0.0f);
+  EXPECT_EQ(atan2_upper(0.0f, -1.0f), kPi);
+}
+
 // ---------------------------------------------------------------------------------------------
 // Textured and double-sided emitters
 
