@@ -184,7 +184,9 @@ RenderReport Driver::run(const std::atomic<bool>* interrupt,
 
     const bool check = o.target_error && pass >= state_.next_check;
     bool want = check;
-    for (PassObserver* obs : observers) want = obs->wants_summary(pass, run_seconds) || want;
+    const uint64_t next_test = o.target_error ? state_.next_check : 0;
+    for (PassObserver* obs : observers)
+      want = obs->wants_summary(pass, run_seconds, next_test) || want;
     developed = false;
     develop_seconds = 0.0;
     // A stop test develops the image with its summary: if the render stops here, that is the

@@ -59,8 +59,11 @@ class PassObserver {
   // snapshot), or null.
   virtual std::vector<PointState>* snapshot_buffer(double /*run_seconds*/) { return nullptr; }
   // Whether this pass's summary is wanted (developing the image costs a fraction of a pass). The
-  // last pass is always developed.
-  virtual bool wants_summary(uint64_t /*pass*/, double /*run_seconds*/) { return false; }
+  // last pass is always developed. `next_test`: the pass of the next stop test, which develops
+  // the image anyway (0: none, no --target-error).
+  virtual bool wants_summary(uint64_t /*pass*/, double /*run_seconds*/, uint64_t /*next_test*/) {
+    return false;
+  }
   virtual void after_pass(const PassInfo& /*info*/) {}
   // Once, after the last pass; may rethrow what a background job threw.
   virtual void finish() {}

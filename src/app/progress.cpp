@@ -32,16 +32,31 @@ std::string format_count(double v) {
 // the line costs at most 5% of the run.
 double ProgressPrinter::interval() const { return std::max(0.5, 20.0 * develop_seconds_); }
 
-bool ProgressPrinter::wants_summary(uint64_t, double run_seconds) {
-  return run_seconds - last_print_ >= interval();
+bool ProgressPrinter::wants_summary(uint64_t pass, double run_seconds, uint64_t next_test) {
+  // Pass 1's line has no figures (a variance needs two passes).
+  if (pass < 2 || run_seconds - last_figures_ < interval()) return false;
+  if (next_test > 0) {
+    // The first test is near (16 passes) and the cost of a development not yet known: wait.
+    if (!developed_) return false;
+    // A test within the interval develops the image anyway.
+    const double per_pass = run_seconds / double(pass);
+    if (double(next_test - std::min(next_test, pass)) * per_pass < interval()) return false;
+  }
+  return true;
 }
 
 void ProgressPrinter::after_pass(const PassInfo& info) {
   if (info.pass == printed_) return;
-  if (info.developed) develop_seconds_ = info.develop_seconds;
-  if (info.stop == StopReason::None && !(info.run_seconds - last_print_ >= 0.5 && info.developed))
-    return;
+  if (info.developed) {
+    develop_seconds_ = info.develop_seconds;
+    developed_ = true;
+  }
+  const double since = info.run_seconds - last_print_;
+  const bool figures = info.developed && since >= 0.5;
+  const bool quiet = !developed_ && (printed_ == 0 || since >= kQuietSeconds);
+  if (info.stop == StopReason::None && !figures && !quiet) return;
   last_print_ = info.run_seconds;
+  if (info.developed) last_figures_ = info.run_seconds;
   printed_ = info.pass;
   out_ << line(info, earlier_) << std::endl;
   if (info.developed) {
@@ -94,8 +109,9 @@ std::string ProgressPrinter::line(const PassInfo& info, const TestedAt& earlier)
   line.precision(4);
   line << "pass " << pass << " | " << format_count(double(info.renderer.work().photons))
        << " photons";
-  const double tested = tested_quantity(o, s);
-  if (pass >= 2) {
+  // The summary is this pass's only where it was developed (an earlier one's otherwise).
+  const double tested = info.developed ? tested_quantity(o, s) : NAN;
+  if (pass >= 2 && info.developed) {
     if (o.target_error) {
       // The quantity the stop rule tests, next to the target (docs/error-bounds.md "Stopping").
       line << " | " << tested_name(o) << " " << (o.stop_rule == StopRule::MeanError ? "<= " : "")
@@ -117,7 +133,7 @@ std::string ProgressPrinter::line(const PassInfo& info, const TestedAt& earlier)
   return line.str();
 }
 
-bool PassLogger::wants_summary(uint64_t, double run_seconds) {
+bool PassLogger::wants_summary(uint64_t, double run_seconds, uint64_t) {
   want_ = log_seconds_ <= max_overhead_ * run_seconds;
   return want_;
 }

@@ -32,19 +32,28 @@ double seconds_left(const RenderOptions& options, const DriverState& schedule, u
 // at most 5% of the run) and after the last pass: pass, photons, mean bound,
 // share of pixels below the target, unknown pixels, elapsed time and time left. A pass is told
 // again when the next one was cut short (Driver::run): not printed twice, and pass 0 never.
+// The figures come from a development; the printer asks for one of its own only where no stop
+// test brings one within its interval (README's first command at 1920x1080 developed at pass 1,
+// whose line shows no figure, and at pass 15, a pass before the first test: 0.6 s of 13 s).
+// Until the first development the lines, every kQuietSeconds, have no figures.
 class ProgressPrinter : public PassObserver {
  public:
   explicit ProgressPrinter(std::ostream& out) : out_(out) {}
-  bool wants_summary(uint64_t pass, double run_seconds) override;
+  bool wants_summary(uint64_t pass, double run_seconds, uint64_t next_test) override;
   void after_pass(const PassInfo& info) override;
   // `earlier`: an earlier line's pass and tested quantity (pass 0: none), for the time left.
+  // Without a development of this pass (info.developed) the line has no figures.
   static std::string line(const PassInfo& info, const TestedAt& earlier = {});
+  // The lines before the first development, which have only the pass, photons and times.
+  static constexpr double kQuietSeconds = 2.0;
 
  private:
   double interval() const;
   std::ostream& out_;
   double last_print_ = -1.0;
+  double last_figures_ = -1.0;    // when the last line with figures was printed
   double develop_seconds_ = 0.0;  // the last development's time
+  bool developed_ = false;        // a development was seen
   uint64_t printed_ = 0;          // the last pass printed
   TestedAt earlier_;              // the last line's tested quantity
 };
@@ -57,7 +66,7 @@ class PassLogger : public PassObserver {
  public:
   PassLogger(std::ostream& out, const ExrImage* reference, double max_overhead = 0.03)
       : out_(out), reference_(reference), max_overhead_(max_overhead) {}
-  bool wants_summary(uint64_t pass, double run_seconds) override;
+  bool wants_summary(uint64_t pass, double run_seconds, uint64_t next_test) override;
   void after_pass(const PassInfo& info) override;
 
  private:

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include <sstream>
+
 namespace pb {
 namespace {
 
@@ -348,6 +350,56 @@ TEST(Stop, TheTimeLeftFollowsTheTestedQuantitysFall) {
   // No target and no budget: no figure.
   RenderOptions none;
   EXPECT_TRUE(std::isinf(seconds_left(none, first, 16, 9.3, 9.3, 0.01571, {})));
+}
+
+// The progress line's developments (ProgressPrinter): pass 1's line has no figure and asks for
+// none; with a target, none before the first test, whose cost is not known yet (README's first
+// command at 1920x1080 developed at pass 1 and at pass 15, a pass before its first test: 0.3 s
+// each); after a development of 0.3 s (an interval of 20 x 0.3 = 6 s) one of its own only where
+// the next test is more than the interval away; without a target, from pass 2 at its interval.
+// The lines before the first development show the pass, photons and times, every 2 s.
+TEST(Stop, TheProgressLineDevelopsOnlyWhereNoStopTestBringsItsFigures) {
+  RenderOptions o = test::quick_options("plane_point.gltf", 8, 1);
+  o.target_error = 0.01;
+  o.time_seconds = 900.0;
+  Renderer r(load_gltf(o.scene), o);
+  r.step();
+  r.step();
+  std::ostringstream out;
+  ProgressPrinter printer(out);
+  DriverState state{0.4, 16, 0, 0.0};
+  const FilmSummary empty;
+  auto after = [&](uint64_t pass, double seconds, bool developed, const FilmSummary& s) {
+    state.seconds = seconds;
+    printer.after_pass(
+        PassInfo{r, state, pass, seconds, developed, s, StopReason::None, developed ? 0.3 : 0.0});
+  };
+  EXPECT_FALSE(printer.wants_summary(1, 0.4, 16));
+  after(1, 0.4, false, empty);
+  EXPECT_FALSE(printer.wants_summary(2, 0.8, 16));   // the first test is at 16
+  EXPECT_FALSE(printer.wants_summary(15, 6.0, 16));  // its cost is not known yet
+  after(2, 0.8, false, empty);                       // within 2 s of pass 1's line: not printed
+  after(6, 2.4, false, empty);
+  // The first test, then a test near (17) and one far (30) at 0.4 s a pass.
+  const FilmSummary tested = r.develop();
+  after(16, 6.4, true, tested);
+  EXPECT_FALSE(printer.wants_summary(17, 6.8, 17));
+  EXPECT_FALSE(printer.wants_summary(25, 10.0, 30));  // 6 s after pass 16's line, 2 s to a test
+  EXPECT_TRUE(printer.wants_summary(25, 12.5, 60));   // 6.1 s after it, 14 s to the next test
+  EXPECT_FALSE(printer.wants_summary(25, 12.3, 60));  // within the interval of pass 16's line
+  // Printed: pass 1 and 6 without figures, 16 with them.
+  const std::string text = out.str();
+  EXPECT_NE(text.find("pass 1 |"), std::string::npos) << text;
+  EXPECT_EQ(text.find("pass 2 |"), std::string::npos) << text;
+  const size_t six = text.find("pass 6 |"), sixteen = text.find("pass 16 |");
+  ASSERT_NE(six, std::string::npos) << text;
+  ASSERT_NE(sixteen, std::string::npos) << text;
+  EXPECT_EQ(text.substr(0, sixteen).find("mean error"), std::string::npos) << text;
+  EXPECT_NE(text.find("mean error", sixteen), std::string::npos) << text;
+  // Without a target: from pass 2, then at the interval.
+  ProgressPrinter plain(out);
+  EXPECT_FALSE(plain.wants_summary(1, 0.4, 0));
+  EXPECT_TRUE(plain.wants_summary(2, 0.8, 0));
 }
 
 }  // namespace
