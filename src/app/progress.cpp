@@ -34,15 +34,17 @@ double ProgressPrinter::interval() const { return std::max(0.5, 20.0 * develop_s
 
 bool ProgressPrinter::wants_summary(uint64_t pass, double run_seconds, uint64_t next_test) {
   // Pass 1's line has no figures (a variance needs two passes).
-  if (pass < 2 || run_seconds - last_figures_ < interval()) return false;
-  if (next_test > 0) {
-    // The first test is near (16 passes) and the cost of a development not yet known: wait.
-    if (!developed_) return false;
-    // A test within the interval develops the image anyway.
-    const double per_pass = run_seconds / double(pass);
-    if (double(next_test - std::min(next_test, pass)) * per_pass < interval()) return false;
-  }
-  return true;
+  if (pass < 2) return false;
+  const double per_pass = run_seconds / double(pass);
+  // Before any development its cost is not known: with a target, taken as a pass's (about a
+  // development's at 512x512, more than one at 1920x1080), so that the first test, 16 passes
+  // in by default, brings the first figures; without one, the first line with figures is pass
+  // 2's, as far as it costs.
+  const double every =
+      developed_ ? interval() : (next_test > 0 ? std::max(0.5, 20.0 * per_pass) : 0.5);
+  if (run_seconds - last_figures_ < every) return false;
+  // A stop test within the interval develops the image anyway.
+  return !(next_test > 0 && double(next_test - std::min(next_test, pass)) * per_pass < every);
 }
 
 void ProgressPrinter::after_pass(const PassInfo& info) {

@@ -353,10 +353,11 @@ TEST(Stop, TheTimeLeftFollowsTheTestedQuantitysFall) {
 }
 
 // The progress line's developments (ProgressPrinter): pass 1's line has no figure and asks for
-// none; with a target, none before the first test, whose cost is not known yet (README's first
-// command at 1920x1080 developed at pass 1 and at pass 15, a pass before its first test: 0.3 s
-// each); after a development of 0.3 s (an interval of 20 x 0.3 = 6 s) one of its own only where
-// the next test is more than the interval away; without a target, from pass 2 at its interval.
+// none; with a target, before any development (its cost unknown, taken as a pass's: an interval
+// of 20 passes), none where the first test is within the interval (README's first command at
+// 1920x1080 developed at pass 1 and at pass 15, a pass before its first test: 0.3 s each);
+// after a development of 0.3 s (an interval of 20 x 0.3 = 6 s) one of its own only where the
+// next test is more than the interval away; without a target, from pass 2 at its interval.
 // The lines before the first development show the pass, photons and times, every 2 s.
 TEST(Stop, TheProgressLineDevelopsOnlyWhereNoStopTestBringsItsFigures) {
   RenderOptions o = test::quick_options("plane_point.gltf", 8, 1);
@@ -376,9 +377,12 @@ TEST(Stop, TheProgressLineDevelopsOnlyWhereNoStopTestBringsItsFigures) {
   };
   EXPECT_FALSE(printer.wants_summary(1, 0.4, 16));
   after(1, 0.4, false, empty);
-  EXPECT_FALSE(printer.wants_summary(2, 0.8, 16));   // the first test is at 16
-  EXPECT_FALSE(printer.wants_summary(15, 6.0, 16));  // its cost is not known yet
-  after(2, 0.8, false, empty);                       // within 2 s of pass 1's line: not printed
+  EXPECT_FALSE(printer.wants_summary(2, 0.8, 16));   // the first test is at 16, within 20
+  EXPECT_FALSE(printer.wants_summary(15, 6.0, 16));  // passes (the interval before a development)
+  // A first test far away (--min-passes 1000): figures once the interval, 20 passes' time, is up.
+  EXPECT_FALSE(printer.wants_summary(10, 4.0, 1000));
+  EXPECT_TRUE(printer.wants_summary(30, 12.0, 1000));
+  after(2, 0.8, false, empty);  // within 2 s of pass 1's line: not printed
   after(6, 2.4, false, empty);
   // The first test, then a test near (17) and one far (30) at 0.4 s a pass.
   const FilmSummary tested = r.develop();
