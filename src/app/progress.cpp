@@ -42,7 +42,8 @@ bool ProgressPrinter::wants_summary(uint64_t pass, double run_seconds, uint64_t 
   // 2's, as far as it costs.
   const double every =
       developed_ ? interval() : (next_test > 0 ? std::max(0.5, 20.0 * per_pass) : 0.5);
-  if (run_seconds - last_figures_ < every) return false;
+  // Its line must be due too (at most every 0.5 s), or the development is wasted.
+  if (run_seconds - last_figures_ < every || run_seconds - last_print_ < 0.5) return false;
   // A stop test within the interval develops the image anyway.
   return !(next_test > 0 && double(next_test - std::min(next_test, pass)) * per_pass < every);
 }

@@ -370,6 +370,10 @@ TEST(Stop, TheProgressLineDevelopsOnlyWhereNoStopTestBringsItsFigures) {
   ProgressPrinter printer(out);
   DriverState state{0.4, 16, 0, 0.0};
   const FilmSummary empty;
+  auto after_pass_of = [&](ProgressPrinter& p, uint64_t pass, double seconds) {
+    state.seconds = seconds;
+    p.after_pass(PassInfo{r, state, pass, seconds, false, empty, StopReason::None, 0.0});
+  };
   auto after = [&](uint64_t pass, double seconds, bool developed, const FilmSummary& s) {
     state.seconds = seconds;
     printer.after_pass(
@@ -400,10 +404,13 @@ TEST(Stop, TheProgressLineDevelopsOnlyWhereNoStopTestBringsItsFigures) {
   ASSERT_NE(sixteen, std::string::npos) << text;
   EXPECT_EQ(text.substr(0, sixteen).find("mean error"), std::string::npos) << text;
   EXPECT_NE(text.find("mean error", sixteen), std::string::npos) << text;
-  // Without a target: from pass 2, then at the interval.
+  // Without a target: from pass 2, where pass 1's line is 0.5 s old (a development whose line
+  // would not be printed is wasted).
   ProgressPrinter plain(out);
-  EXPECT_FALSE(plain.wants_summary(1, 0.4, 0));
-  EXPECT_TRUE(plain.wants_summary(2, 0.8, 0));
+  EXPECT_FALSE(plain.wants_summary(1, 0.2, 0));
+  after_pass_of(plain, 1, 0.2);
+  EXPECT_FALSE(plain.wants_summary(2, 0.4, 0));
+  EXPECT_TRUE(plain.wants_summary(3, 0.8, 0));
 }
 
 }  // namespace
