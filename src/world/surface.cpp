@@ -172,6 +172,10 @@ Surface World::surface(const Hit& hit) const {
     s.bsdf = Bsdf(BsdfParams::of(Material::lambertian(vec3(0.0f))), s.ng, s.ns, mirror_roughness_);
     return s;
   }
+  if (mesh.plain) {
+    s.bsdf = mesh.plain->with_frame(s.ng, s.ns);
+    return s;
+  }
   if (!mesh.textured) {
     BsdfParams p = BsdfParams::of(m);
     p.follows_transmission = follows_transmission_;

@@ -23,6 +23,16 @@ World::World(Scene scene, float mirror_roughness, bool follows_transmission)
   size_t triangles = 0;
   for (const Mesh& m : scene_.meshes) triangles += m.indices.size() / 3;
   face_normals_.resize(triangles);
+  // Every material's Bsdf at a frame of its own, for the untextured meshes whose Bsdf a frame
+  // moves (World::surface); built whole before any mesh points into the vector.
+  std::vector<bool> frame_free;
+  plain_bsdfs_.reserve(scene_.materials.size());
+  for (const Material& mat : scene_.materials) {
+    BsdfParams p = BsdfParams::of(mat);
+    p.follows_transmission = follows_transmission_;
+    frame_free.push_back(!mat.unlit && Bsdf::frame_free(p));
+    plain_bsdfs_.emplace_back(p, vec3(0, 0, 1), vec3(0, 0, 1), mirror_roughness_);
+  }
   size_t first = 0;
   for (const Mesh& m : scene_.meshes) {
     const size_t n = m.indices.size() / 3;
@@ -55,7 +65,8 @@ World::World(Scene scene, float mirror_roughness, bool follows_transmission)
                        {uv(0), uv(1)},
                        m.tangents.empty() ? nullptr : m.tangents.data(),
                        m.colors.empty() ? nullptr : m.colors.data(),
-                       textured});
+                       textured,
+                       !textured && frame_free[m.material] ? &plain_bsdfs_[m.material] : nullptr});
     first += n;
   }
   first_triangle_.push_back(uint32_t(first));

@@ -170,11 +170,14 @@ class World {
     const glm::vec4* tangents;  // null without a normal texture
     const glm::vec4* colors;    // COLOR_0, null without it
     bool textured;  // the material has a texture (or a MASK cut-out), or the mesh COLOR_0
+    // Untextured with a frame-free Bsdf (Bsdf::frame_free): that Bsdf, at any frame.
+    const Bsdf* plain;
   };
 
   const Scene scene_;
   std::vector<vec3> face_normals_;  // all meshes, concatenated
   std::vector<MeshView> meshes_;
+  std::vector<Bsdf> plain_bsdfs_;         // per material, for MeshView::plain
   std::vector<uint32_t> first_triangle_;  // per mesh, and the total last
   Accel accel_;
   Lights lights_;

@@ -12,7 +12,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <numbers>
+#include <string>
 #include <vector>
 
 namespace pb {
@@ -591,6 +593,71 @@ TEST(SpecularBranches, TiltedShadingNormalKeepsDirectionsOnCorrectSide) {
       }
     }
   }
+}
+
+}  // namespace
+}  // namespace pb
+
+namespace pb {
+namespace {
+
+// World keeps one Bsdf per untextured material and moves it to each hit's frame
+// (Bsdf::with_frame): where Bsdf::frame_free says so, that is the Bsdf built at the hit, bit for
+// bit: eval, the delta probability and every draw (the same random numbers), over random frames
+// with tilted shading normals and random directions, for the glTF parts that may be frame free.
+// A clear coat or an anisotropy direction depends on the frame: not frame free.
+TEST(BsdfFrame, AFrameFreeBsdfMovedToAFrameIsTheOneBuiltThere) {
+  std::vector<Material> mats = {Material::lambertian(vec3(0.6f, 0.3f, 0.2f)),
+                                Material::metal(vec3(0.9f, 0.6f, 0.3f), 0.4f),
+                                Material::metal(vec3(0.9f), 0.01f), Material::glass(1.5f)};
+  Material dielectric = Material::metal(vec3(0.5f), 0.3f);
+  dielectric.metallic = 0.0f;
+  mats.push_back(dielectric);
+  Material rough_glass = Material::glass(1.4f);
+  rough_glass.roughness = 0.3f;
+  mats.push_back(rough_glass);
+  Material sheen = Material::lambertian(vec3(0.4f));
+  sheen.sheen_color = vec3(0.8f, 0.5f, 0.2f);
+  sheen.sheen_roughness = 0.5f;
+  mats.push_back(sheen);
+  Material dt = dielectric;
+  dt.diffuse_transmission = 0.5f;
+  mats.push_back(dt);
+  Material film = dielectric;
+  film.iridescence = 1.0f;
+  mats.push_back(film);
+  for (size_t k = 0; k < mats.size(); ++k) {
+    SCOPED_TRACE("material " + std::to_string(k));
+    const BsdfParams p = BsdfParams::of(mats[k]);
+    ASSERT_TRUE(Bsdf::frame_free(p));
+    const Bsdf plain(p, vec3(0, 0, 1), vec3(0, 0, 1));
+    for (uint64_t i = 0; i < 200; ++i) {
+      Rng rng(11, k, i, Stream::Test);
+      const vec3 ng = sample_uniform_sphere(rng.next_float(), rng.next_float());
+      const vec3 ns =
+          glm::normalize(ng + 0.3f * sample_uniform_sphere(rng.next_float(), rng.next_float()));
+      const Bsdf built(p, ng, ns), moved = plain.with_frame(ng, ns);
+      const vec3 wo = sample_uniform_sphere(rng.next_float(), rng.next_float());
+      const vec3 wi = sample_uniform_sphere(rng.next_float(), rng.next_float());
+      const vec3 a = built.eval(wo, wi), b = moved.eval(wo, wi);
+      ASSERT_EQ(std::memcmp(&a, &b, sizeof a), 0) << i;
+      ASSERT_EQ(built.delta_probability(wo), moved.delta_probability(wo)) << i;
+      Rng r1(12, k, i, Stream::Test), r2(12, k, i, Stream::Test);
+      BsdfSample s1, s2;
+      const bool ok1 = built.sample(wo, r1, Transport::Importance, s1);
+      ASSERT_EQ(ok1, moved.sample(wo, r2, Transport::Importance, s2)) << i;
+      if (!ok1) continue;
+      ASSERT_EQ(std::memcmp(&s1.wi, &s2.wi, sizeof s1.wi), 0) << i;
+      ASSERT_EQ(std::memcmp(&s1.weight, &s2.weight, sizeof s1.weight), 0) << i;
+      ASSERT_EQ(s1.pdf, s2.pdf) << i;
+    }
+  }
+  Material coat = dielectric;
+  coat.clearcoat = 0.5f;
+  EXPECT_FALSE(Bsdf::frame_free(BsdfParams::of(coat)));
+  Material aniso = dielectric;
+  aniso.anisotropy = 0.5f;
+  EXPECT_FALSE(Bsdf::frame_free(BsdfParams::of(aniso)));
 }
 
 }  // namespace
