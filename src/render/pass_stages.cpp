@@ -148,14 +148,14 @@ void gather_kernel(const VisiblePoint& point, double r2, const HashGrid& grid,
     // against the shading cosine, hence cos_s / cos_g.
     const dvec3 flux = photon_flux(h) * double(cos_s / cos_g);
     const double t = std::min(1.0, std::sqrt(double(dist2) * inv_r2));
+    double w = 0.0;
     if constexpr (kLaplacian) {
-      const double w = sums.add(t, flux);
-      if (learn) learn->chunk->add(h.cell, learn->weight * w * (flux.x + flux.y + flux.z));
+      w = sums.add(t, flux);
     } else {
-      const double w = kernel::weight(t);
+      w = kernel::weight(t);
       phi += w * flux;
-      if (learn) learn->chunk->add(h.cell, learn->weight * w * (flux.x + flux.y + flux.z));
     }
+    if (learn) learn->chunk->add(h.cell, learn->weight * w * (flux.x + flux.y + flux.z));
   });
   const dvec3 f(point.f);
   if constexpr (kLaplacian) {
