@@ -249,22 +249,18 @@ Step at_vertex(CameraPath& path, const CameraPathInputs& in, const Hit& hit, flo
   return Step::Continue;
 }
 
-}  // namespace
-
-std::optional<PointBsdf> trace_visible_point(const CameraPathInputs& in, size_t pixel,
-                                             uint32_t path_index, float radius, VisiblePoint& point,
-                                             OwnerValues& out, DiscRegion& region) {
-  CameraPath path(in, pixel, path_index);
-  path.region = &region;
+// The path on from its camera ray's first hit (found: the ray met a surface) to its visible
+// point or its end.
+std::optional<PointBsdf> follow_path(CameraPath& path, const CameraPathInputs& in, float radius,
+                                     bool found, Hit hit) {
   std::optional<PointBsdf> g;
   for (;; ++path.depth) {
-    Hit hit;
-    // BLEND surfaces are met by chance, by a key of the path's stream (World::ray_key).
-    const uint64_t key = in.world.ray_key(path.rng);
-    const bool found = path.depth == 0
-                           ? in.world.camera_hit(path.origin, path.dir, hit, nullptr, key)
-                           : in.world.trace(path.origin, path.origin_normal, path.origin_error,
-                                            path.dir, hit, key);
+    if (path.depth > 0) {
+      // BLEND surfaces are met by chance, by a key of the path's stream (World::ray_key).
+      const uint64_t key = in.world.ray_key(path.rng);
+      found =
+          in.world.trace(path.origin, path.origin_normal, path.origin_error, path.dir, hit, key);
+    }
     if (!found) {  // the environment (black without one), seen along the path
       if (!path.after_lobe) {
         path.emission += dvec3(path.weight * in.world.lights().environment_radiance(path.dir));
@@ -280,6 +276,20 @@ std::optional<PointBsdf> trace_visible_point(const CameraPathInputs& in, size_t 
     }
     if (at_vertex(path, in, hit, radius, g) == Step::End) break;
   }
+  return g;
+}
+
+}  // namespace
+
+std::optional<PointBsdf> trace_visible_point(const CameraPathInputs& in, size_t pixel,
+                                             uint32_t path_index, float radius, VisiblePoint& point,
+                                             OwnerValues& out, DiscRegion& region) {
+  CameraPath path(in, pixel, path_index);
+  path.region = &region;
+  Hit hit;
+  const uint64_t key = in.world.ray_key(path.rng);
+  const bool found = in.world.camera_hit(path.origin, path.dir, hit, nullptr, key);
+  std::optional<PointBsdf> g = follow_path(path, in, radius, found, hit);
   point = path.point;
   out = OwnerValues{path.emission, path.disc};
   return g;
@@ -291,13 +301,36 @@ size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<
   size_t glossy_count = 0;
   regions.clear();
   DiscRegion region;
-  for (size_t k = 0; k < points.size(); ++k) {
-    std::optional<PointBsdf> g =
-        trace_visible_point(in, first + k, 0, radii[k], points[k], out[k], region);
-    if (!out[k].disc.full && max_component(points[k].f) > 0.0f) regions.add(uint32_t(k), region);
-    if (g) {
-      g->point = uint32_t(k);
-      glossy[glossy_count++] = *g;
+  constexpr int kGroup = Accel::kPacket;
+  for (size_t k0 = 0; k0 < points.size(); k0 += kGroup) {
+    // The camera rays of kGroup neighbouring pixels first, traced as one packet (they leave one
+    // eye through neighbouring image points: one walk of the BVH serves them all), then each
+    // path on alone. Each path draws its jitter and its ray's key as trace_visible_point does
+    // (from its own stream), so the paths are the same bit for bit.
+    const int n = int(std::min(points.size() - k0, size_t(kGroup)));
+    std::optional<CameraPath> paths[kGroup];
+    vec3 dirs[kGroup];
+    uint64_t keys[kGroup];
+    Hit hits[kGroup];
+    bool found[kGroup];
+    for (int i = 0; i < n; ++i) {
+      CameraPath& path = paths[i].emplace(in, first + k0 + size_t(i), 0);
+      keys[i] = in.world.ray_key(path.rng);
+      dirs[i] = path.dir;
+    }
+    in.world.camera_hits(in.camera.origin(), dirs, keys, n, hits, found);
+    for (int i = 0; i < n; ++i) {
+      const size_t k = k0 + size_t(i);
+      CameraPath& path = *paths[i];
+      path.region = &region;
+      std::optional<PointBsdf> g = follow_path(path, in, radii[k], found[i], hits[i]);
+      points[k] = path.point;
+      out[k] = OwnerValues{path.emission, path.disc};
+      if (!out[k].disc.full && max_component(points[k].f) > 0.0f) regions.add(uint32_t(k), region);
+      if (g) {
+        g->point = uint32_t(k);
+        glossy[glossy_count++] = *g;
+      }
     }
   }
   return glossy_count;

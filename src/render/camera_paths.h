@@ -66,6 +66,8 @@ std::optional<PointBsdf> trace_visible_point(const CameraPathInputs& in, size_t 
                                              OwnerValues& out, DiscRegion& region);
 
 // `regions` receives (cleared first) the regions of the points whose discs are not whole.
+// The camera rays of neighbouring pixels are traced as packets (World::camera_hits); every path
+// is trace_visible_point's, bit for bit.
 size_t trace_visible_points(const CameraPathInputs& in, size_t first, std::span<const float> radii,
                             std::span<VisiblePoint> points, std::span<PointBsdf> glossy,
                             std::span<OwnerValues> out, RegionTable& regions);

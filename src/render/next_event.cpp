@@ -22,9 +22,9 @@ bool environment_mis_applies(const World& world, const Bsdf& draws, const Bsdf& 
          has_lobe_below(whole, kMisRoughness);
 }
 
-dvec3 direct_light(const World& world, const VisiblePoint& point, const PointBsdf* glossy, Rng& rng,
-                   const EnvironmentMis* mis) {
-  dvec3 total(0.0);
+int direct_light_tests(const World& world, const VisiblePoint& point, const PointBsdf* glossy,
+                       Rng& rng, const EnvironmentMis* mis, ShadowTest* tests) {
+  int n = 0;
   DirectSample s;
   if (world.lights().sample_direct(point.position, point.shading, rng, s)) {
     const float cos_s = glm::dot(s.wi, point.shading);
@@ -38,24 +38,46 @@ dvec3 direct_light(const World& world, const VisiblePoint& point, const PointBsd
         }
       }
       // No shadow ray for nothing.
-      if ((!glossy || max_component(f) > 0.0f) &&
-          !world.occluded(point.position, s.wi, s.distance, s.margin, world.ray_key(rng)))
-        total += dvec3(f * s.li * cos_s);
+      if (!glossy || max_component(f) > 0.0f) {
+        ShadowTest& t = tests[n++];
+        t.traced = World::shadow_ray(point.position, s.wi, s.distance, s.margin, world.ray_key(rng),
+                                     t.ray);
+        t.value = dvec3(f * s.li * cos_s);
+      }
     }
   }
-  if (!mis || !mis->draw) return total;
+  if (!mis || !mis->draw) return n;
   BsdfSample b;
-  if (!mis->bsdf->sample_non_delta_part(mis->wo, rng, b) || !(b.pdf > 0.0f)) return total;
-  if (!(glm::dot(b.wi, point.shading) > 0.0f) || !(glm::dot(b.wi, point.normal) > 0.0f))
-    return total;
+  if (!mis->bsdf->sample_non_delta_part(mis->wo, rng, b) || !(b.pdf > 0.0f)) return n;
+  if (!(glm::dot(b.wi, point.shading) > 0.0f) || !(glm::dot(b.wi, point.normal) > 0.0f)) return n;
   const float p_l = world.lights().environment_pdf(point.position, point.shading, b.wi);
-  if (!(p_l > 0.0f)) return total;  // the light sample covers what its density reaches
+  if (!(p_l > 0.0f)) return n;  // the light sample covers what its density reaches
   const vec3 value = point.f * b.weight * world.lights().environment_radiance(b.wi);
-  if (!(max_component(value) > 0.0f) ||
-      world.occluded(point.position, b.wi, INFINITY, 0.0f, world.ray_key(rng)))
-    return total;
+  if (!(max_component(value) > 0.0f)) return n;
+  ShadowTest& t = tests[n++];
+  t.traced = World::shadow_ray(point.position, b.wi, INFINITY, 0.0f, world.ray_key(rng), t.ray);
   const float p_b = mis->share * b.pdf;
-  return total + dvec3(value * (p_b / (p_b + p_l)));
+  t.value = dvec3(value * (p_b / (p_b + p_l)));
+  return n;
+}
+
+dvec3 shadow_sum(const World& world, const ShadowTest* tests, int n, const bool* blocked) {
+  dvec3 total(0.0);
+  for (int i = 0; i < n; ++i) {
+    const ShadowTest& t = tests[i];
+    const bool b = blocked ? blocked[i]
+                           : t.traced && world.accel().occluded(t.ray.origin, t.ray.dir,
+                                                                t.ray.tnear, t.ray.tfar, t.ray.key);
+    if (!b) total += t.value;
+  }
+  return total;
+}
+
+dvec3 direct_light(const World& world, const VisiblePoint& point, const PointBsdf* glossy, Rng& rng,
+                   const EnvironmentMis* mis) {
+  ShadowTest tests[kMaxShadowTests];
+  const int n = direct_light_tests(world, point, glossy, rng, mis, tests);
+  return shadow_sum(world, tests, n);
 }
 
 dvec3 direct_light_through(const World& world, const Surface& s, const vec3& wo, const vec3& weight,

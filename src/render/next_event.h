@@ -40,6 +40,21 @@ inline dvec3 direct_light(const World& world, const VisiblePoint& point, const P
 inline dvec3 direct_light(const World& world, const VisiblePoint& point, Rng& rng) {
   return direct_light(world, point, nullptr, rng, nullptr);
 }
+// A sample's shadow ray and the light it brings where nothing blocks the ray (traced false: the
+// segment is empty, and the value counts).
+struct ShadowTest {
+  Accel::Ray ray;
+  dvec3 value{0.0};
+  bool traced = true;
+};
+inline constexpr int kMaxShadowTests = 2;  // the light sample and the environment's MIS draw
+// direct_light up to its shadow rays: its samples' tests, in order (returns how many, at most
+// kMaxShadowTests). The direct light is the sum, in order, of the values of those not blocked
+// (shadow_sum), so the tests of many points may be traced together (next_event_pass).
+int direct_light_tests(const World& world, const VisiblePoint& point, const PointBsdf* glossy,
+                       Rng& rng, const EnvironmentMis* mis, ShadowTest* tests);
+// The sum of tests[i].value over the tests not blocked (blocked null: each traced alone).
+dvec3 shadow_sum(const World& world, const ShadowTest* tests, int n, const bool* blocked = nullptr);
 // One light sample through the surface at s (Bsdf::eval_transmission: diffuse transmission, and
 // rough glass with `glass`), seen from wo, from the other side, times the path weight.
 dvec3 direct_light_through(const World& world, const Surface& s, const vec3& wo, const vec3& weight,

@@ -271,28 +271,77 @@ void disc_pass(std::span<const VisiblePoint> points, std::span<const PointState>
   }
 }
 
-void next_event_pass(const World& world, std::span<const VisiblePoint> points,
-                     PointBsdfTable glossy, uint64_t seed, uint64_t pass, size_t first,
-                     std::span<OwnerValues> out) {
-  PointBsdfCursor cursor(glossy, points.size());
-  for (size_t k = 0; k < points.size(); ++k) {
-    if (!(max_component(points[k].f) > 0.0f)) continue;
-    out[k].direct += next_event_at(world, points[k], cursor.at(k), seed, pass, first + k);
-  }
-}
+namespace {
 
-dvec3 next_event_at(const World& world, const VisiblePoint& point, const PointBsdf* glossy,
-                    uint64_t seed, uint64_t pass, uint64_t item) {
-  if (glossy && is_base_part(glossy->bsdf)) return dvec3(0.0);  // its camera path counted it
+// next_event_at up to its shadow rays (direct_light_tests); 0 tests for a point on a GGX lobe's
+// diffuse base.
+int next_event_tests(const World& world, const VisiblePoint& point, const PointBsdf* glossy,
+                     uint64_t seed, uint64_t pass, uint64_t item, ShadowTest* tests) {
+  if (glossy && is_base_part(glossy->bsdf)) return 0;  // its camera path counted it
   Rng rng(seed, pass, item, Stream::DirectLight);
   // A glossy point gathered whole (not SPPM's restricted base): its Bsdf's own draws are the
   // environment's other strategy (next_event.h).
   if (glossy && !glossy->bsdf.is_restricted() &&
       environment_mis_applies(world, glossy->bsdf, glossy->bsdf)) {
     const EnvironmentMis mis{&glossy->bsdf, glossy->wo, 1.0f, true};
-    return direct_light(world, point, glossy, rng, &mis);
+    return direct_light_tests(world, point, glossy, rng, &mis, tests);
   }
-  return direct_light(world, point, glossy, rng);
+  return direct_light_tests(world, point, glossy, rng, nullptr, tests);
+}
+
+}  // namespace
+
+void next_event_pass(const World& world, std::span<const VisiblePoint> points,
+                     PointBsdfTable glossy, uint64_t seed, uint64_t pass, size_t first,
+                     std::span<OwnerValues> out) {
+  // The samples of kGroup points first, then their shadow rays Accel::kPacket at a time (the rays
+  // of neighbouring pixels toward one light are coherent: one walk of the BVH serves a packet),
+  // then each point's sum: the draws, rays and sums of next_event_at, point by point.
+  constexpr size_t kGroup = 64;
+  PointBsdfCursor cursor(glossy, points.size());
+  ShadowTest tests[kGroup * kMaxShadowTests];
+  bool blocked[kGroup * kMaxShadowTests];
+  int count[kGroup];
+  for (size_t k0 = 0; k0 < points.size(); k0 += kGroup) {
+    const size_t m = std::min(kGroup, points.size() - k0);
+    size_t n = 0;
+    for (size_t i = 0; i < m; ++i) {
+      const size_t k = k0 + i;
+      count[i] = -1;  // no visible point: nothing added
+      if (!(max_component(points[k].f) > 0.0f)) continue;
+      count[i] = next_event_tests(world, points[k], cursor.at(k), seed, pass, first + k, tests + n);
+      n += size_t(count[i]);
+    }
+    Accel::Ray rays[Accel::kPacket];
+    size_t lane_test[Accel::kPacket];
+    int lanes = 0;
+    const auto trace = [&] {
+      bool b[Accel::kPacket];
+      world.accel().occluded_packet(rays, lanes, b);
+      for (int l = 0; l < lanes; ++l) blocked[lane_test[l]] = b[l];
+      lanes = 0;
+    };
+    for (size_t t = 0; t < n; ++t) {
+      blocked[t] = false;
+      if (!tests[t].traced) continue;
+      rays[lanes] = tests[t].ray;
+      lane_test[lanes++] = t;
+      if (lanes == Accel::kPacket) trace();
+    }
+    if (lanes > 0) trace();
+    for (size_t i = 0, t = 0; i < m; ++i) {
+      if (count[i] < 0) continue;
+      out[k0 + i].direct += shadow_sum(world, tests + t, count[i], blocked + t);
+      t += size_t(count[i]);
+    }
+  }
+}
+
+dvec3 next_event_at(const World& world, const VisiblePoint& point, const PointBsdf* glossy,
+                    uint64_t seed, uint64_t pass, uint64_t item) {
+  ShadowTest tests[kMaxShadowTests];
+  const int n = next_event_tests(world, point, glossy, seed, pass, item, tests);
+  return shadow_sum(world, tests, n);
 }
 
 void fold_pass(std::span<PointState> states, std::span<const PassSums> sums,

@@ -34,11 +34,12 @@ struct CoveredMesh {
   std::span<const Image> images;
 };
 
-// Embree's context, extended by the ray's coverage key (Embree 3 "rtcInitIntersectContext": an
-// application may append its own data and read it back in its filter functions).
+// Embree's context, extended by the rays' coverage keys, ray id i's at keys[i] (Embree 3
+// "rtcInitIntersectContext": an application may append its own data and read it back in its
+// filter functions).
 struct KeyedContext {
   RTCIntersectContext context;
-  uint64_t key;
+  const uint64_t* keys;
 };
 
 // Embree's filter function for MASK and BLEND meshes, on closest-hit and occlusion rays alike:
@@ -48,10 +49,11 @@ struct KeyedContext {
 // of vertices 1 and 2).
 void coverage_filter(const RTCFilterFunctionNArguments* args) {
   const auto* m = static_cast<const CoveredMesh*>(args->geometryUserPtr);
-  const uint64_t key = reinterpret_cast<const KeyedContext*>(args->context)->key;
-  if (m->material->blended() && key == 0) return;  // met: the caller weighs it
+  const uint64_t* keys = reinterpret_cast<const KeyedContext*>(args->context)->keys;
   for (unsigned i = 0; i < args->N; ++i) {
     if (args->valid[i] != -1) continue;
+    const uint64_t key = keys[RTCRayN_id(args->ray, args->N, i)];
+    if (m->material->blended() && key == 0) continue;  // met: the caller weighs it
     const unsigned prim = RTCHitN_primID(args->hit, args->N, i);
     const float u = RTCHitN_u(args->hit, args->N, i), v = RTCHitN_v(args->hit, args->N, i);
     const vec2 uv[2] = {mesh_uv(*m->mesh, prim, 0, u, v), mesh_uv(*m->mesh, prim, 1, u, v)};
@@ -122,7 +124,7 @@ bool Accel::intersect(const vec3& o, const vec3& d, float tnear, float tfar, Hit
                       uint64_t key) const {
   KeyedContext context;
   rtcInitIntersectContext(&context.context);
-  context.key = key;
+  context.keys = &key;
   RTCRayHit rh;
   rh.ray.org_x = o.x;
   rh.ray.org_y = o.y;
@@ -148,10 +150,76 @@ bool Accel::intersect(const vec3& o, const vec3& d, float tnear, float tfar, Hit
   return true;
 }
 
+namespace {
+
+// Fills packet `r` (RTCRay8 or the ray part of RTCRayHit8) and its valid mask with rays[0, n)
+// and their keys; lanes beyond n repeat ray 0 (their results unread), so every lane holds finite
+// data.
+template <class Ray8>
+void fill_packet(const Accel::Ray* rays, int n, Ray8& r, int* valid, uint64_t* keys) {
+  for (int i = 0; i < Accel::kPacket; ++i) {
+    const Accel::Ray& a = rays[i < n ? i : 0];
+    valid[i] = i < n ? -1 : 0;
+    keys[i] = a.key;
+    r.org_x[i] = a.origin.x;
+    r.org_y[i] = a.origin.y;
+    r.org_z[i] = a.origin.z;
+    r.dir_x[i] = a.dir.x;
+    r.dir_y[i] = a.dir.y;
+    r.dir_z[i] = a.dir.z;
+    r.tnear[i] = a.tnear;
+    r.tfar[i] = a.tfar;
+    r.time[i] = 0.0f;
+    r.mask[i] = 0xffffffffu;
+    r.id[i] = unsigned(i);
+    r.flags[i] = 0;
+  }
+}
+
+}  // namespace
+
+void Accel::intersect_packet(const Ray* rays, int n, Hit* hits, bool* found) const {
+  static_assert(kPacket == 8, "rtcIntersect8");
+  uint64_t keys[kPacket];
+  KeyedContext context;
+  rtcInitIntersectContext(&context.context);
+  context.keys = keys;
+  alignas(32) int valid[kPacket];
+  alignas(32) RTCRayHit8 rh;
+  fill_packet(rays, n, rh.ray, valid, keys);
+  for (int i = 0; i < kPacket; ++i) {
+    rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+    rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
+  }
+  rtcIntersect8(valid, impl_->scene, &context.context, &rh);
+  for (int i = 0; i < n; ++i) {
+    found[i] = rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
+    if (!found[i]) continue;
+    hits[i].t = rh.ray.tfar[i];
+    hits[i].mesh = rh.hit.geomID[i];
+    hits[i].prim = rh.hit.primID[i];
+    hits[i].u = rh.hit.u[i];
+    hits[i].v = rh.hit.v[i];
+  }
+}
+
+void Accel::occluded_packet(const Ray* rays, int n, bool* blocked) const {
+  uint64_t keys[kPacket];
+  KeyedContext context;
+  rtcInitIntersectContext(&context.context);
+  context.keys = keys;
+  alignas(32) int valid[kPacket];
+  alignas(32) RTCRay8 ray;
+  fill_packet(rays, n, ray, valid, keys);
+  rtcOccluded8(valid, impl_->scene, &context.context, &ray);
+  // Embree sets tfar to -inf where a ray is occluded.
+  for (int i = 0; i < n; ++i) blocked[i] = ray.tfar[i] < 0.0f;
+}
+
 bool Accel::occluded(const vec3& o, const vec3& d, float tnear, float tfar, uint64_t key) const {
   KeyedContext context;
   rtcInitIntersectContext(&context.context);
-  context.key = key;
+  context.keys = &key;
   RTCRay ray;
   ray.org_x = o.x;
   ray.org_y = o.y;

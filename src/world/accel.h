@@ -42,9 +42,23 @@ class Accel {
   // stops_ray below. Key 0 meets every BLEND surface, whose caller weighs it by a itself.
   bool intersect(const vec3& origin, const vec3& dir, float tnear, float tfar, Hit& hit,
                  uint64_t key = 0) const;
+  // A ray of a packet: intersect()'s arguments.
+  struct Ray {
+    vec3 origin{0.0f}, dir{0.0f, 0.0f, 1.0f};
+    float tnear = 0.0f, tfar = 0.0f;
+    uint64_t key = 0;
+  };
+  static constexpr int kPacket = 8;
+  // The closest hits of n <= kPacket rays traced together (Embree 3's rtcIntersect8: one walk
+  // of the BVH for the packet, which pays where the rays are coherent, as a row of camera rays
+  // is): found[i] and hits[i] are what intersect() gives rays[i] alone.
+  void intersect_packet(const Ray* rays, int n, Hit* hits, bool* found) const;
   // True when anything lies along the segment (tnear, tfar); BLEND surfaces as above.
   bool occluded(const vec3& origin, const vec3& dir, float tnear, float tfar,
                 uint64_t key = 0) const;
+  // occluded() for n <= kPacket rays traced together (rtcOccluded8): blocked[i] is what
+  // occluded() gives rays[i] alone.
+  void occluded_packet(const Ray* rays, int n, bool* blocked) const;
 
   // Calls visit(mesh, prim) for every triangle whose bounding box meets the sphere (a superset
   // of the triangles within `radius` of `center`; the caller tests the geometry itself).

@@ -92,6 +92,19 @@ bool World::camera_hit(const vec3& origin, const vec3& dir, Hit& hit, int* culle
   // One key for the whole line: a BLEND surface beyond a culled face gets the same choice when
   // the ray goes on from that face.
   if (!accel_.intersect(origin, dir, 0.0f, INFINITY, hit, key)) return false;
+  return beyond_culled(dir, hit, culled, key);
+}
+
+void World::camera_hits(const vec3& origin, const vec3* dirs, const uint64_t* keys, int n,
+                        Hit* hits, bool* found) const {
+  Accel::Ray rays[Accel::kPacket];
+  for (int i = 0; i < n; ++i) rays[i] = {origin, dirs[i], 0.0f, INFINITY, keys[i]};
+  accel_.intersect_packet(rays, n, hits, found);
+  for (int i = 0; i < n; ++i)
+    if (found[i]) found[i] = beyond_culled(dirs[i], hits[i], nullptr, keys[i]);
+}
+
+bool World::beyond_culled(const vec3& dir, Hit& hit, int* culled, uint64_t key) const {
   for (int k = 0; k < kMaxCulledFaces; ++k) {
     const Material& m = *meshes_[hit.mesh].material;
     const uint32_t t = triangle_index(hit);

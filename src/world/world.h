@@ -118,6 +118,11 @@ class World {
   // the last one is what the ray sees).
   bool camera_hit(const vec3& origin, const vec3& dir, Hit& hit, int* culled = nullptr,
                   uint64_t key = 0) const;
+  // camera_hit for n <= Accel::kPacket rays from `origin` (directions dirs, keys keys), their
+  // first hits traced as one packet (Accel::intersect_packet): found[i] and hits[i] are
+  // camera_hit's for ray i, bit for bit.
+  void camera_hits(const vec3& origin, const vec3* dirs, const uint64_t* keys, int n, Hit* hits,
+                   bool* found) const;
   static constexpr int kMaxCulledFaces = 64;
 
   // Whether the camera at p is enclosed: in none of 256 directions spread over the sphere does
@@ -139,8 +144,15 @@ class World {
   // A BLEND surface blocks it by the ray's key (ray_key; key 0: always).
   bool occluded(const vec3& origin, const vec3& dir, float dist, float margin,
                 uint64_t key = 0) const {
-    const float tfar = (dist - margin) * kShadowLengthFactor;
-    return tfar > 0.0f && accel_.occluded(origin, dir, 0.0f, tfar, key);
+    Accel::Ray r;
+    return shadow_ray(origin, dir, dist, margin, key, r) &&
+           accel_.occluded(r.origin, r.dir, r.tnear, r.tfar, r.key);
+  }
+  // The segment occluded() tests, as a ray; false where it is empty (nothing can block it).
+  static bool shadow_ray(const vec3& origin, const vec3& dir, float dist, float margin,
+                         uint64_t key, Accel::Ray& ray) {
+    ray = {origin, dir, 0.0f, (dist - margin) * kShadowLengthFactor, key};
+    return ray.tfar > 0.0f;
   }
 
   // Triangles by one global index (mesh after mesh, in Scene order), for the boundary index.
@@ -173,6 +185,8 @@ class World {
     // Untextured with a frame-free Bsdf (Bsdf::frame_free): that Bsdf, at any frame.
     const Bsdf* plain;
   };
+  // camera_hit's part after the first hit: through the backs of culled faces.
+  bool beyond_culled(const vec3& dir, Hit& hit, int* culled, uint64_t key) const;
 
   const Scene scene_;
   std::vector<vec3> face_normals_;  // all meshes, concatenated
