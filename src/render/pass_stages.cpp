@@ -108,6 +108,7 @@ void gather_kernel(const VisiblePoint& point, double r2, const HashGrid& grid,
       1e-3f * radius + 1e-5f * std::max({std::abs(p.x), std::abs(p.y), std::abs(p.z)});
   // With the Laplacian, the three kernel sums are kept in pairs of doubles (KernelSums): the
   // same products and sums, lane by lane, in half the instructions.
+  const bool flat = point.shading == point.normal;
   dvec3 phi(0.0);
   KernelSums sums;
   uint64_t count = 0;
@@ -141,12 +142,16 @@ void gather_kernel(const VisiblePoint& point, double r2, const HashGrid& grid,
     // outside it (on the next of a row of coplanar boards, on a panel beyond a gap) is not the
     // point's: counted, it would be renormalised by a mass that leaves its surface out.
     if (region && !region->contains(d)) return;
-    const float cos_s = glm::dot(h.wi, point.shading);
     ++count;  // it could contribute, so it counts toward the radius reduction
-    if (cos_s <= 0.0f) return;
     // Photon density is flux per area of the true surface; reflected radiance integrates
-    // against the shading cosine, hence cos_s / cos_g.
-    const dvec3 flux = photon_flux(h) * double(cos_s / cos_g);
+    // against the shading cosine, hence cos_s / cos_g: exactly 1 where the shading normal is
+    // the true one (a flat surface), whose photons skip the dot product and the division.
+    dvec3 flux = photon_flux(h);
+    if (!flat) {
+      const float cos_s = glm::dot(h.wi, point.shading);
+      if (cos_s <= 0.0f) return;
+      flux *= double(cos_s / cos_g);
+    }
     const double t = std::min(1.0, std::sqrt(double(dist2) * inv_r2));
     double w = 0.0;
     if constexpr (kLaplacian) {

@@ -37,19 +37,21 @@ Scene cluttered() {
   return b.scene;
 }
 
-bool same_bits(float a, float b) { return std::bit_cast<uint32_t>(a) == std::bit_cast<uint32_t>(b); }
+bool same_bits(float a, float b) {
+  return std::bit_cast<uint32_t>(a) == std::bit_cast<uint32_t>(b);
+}
 
 // Traces rays[0, n) as one packet and each alone, as closest-hit rays and as shadow rays;
 // counts the lanes compared, their hits and the shadow rays blocked.
-void expect_packet_is_single_rays(const Accel& accel, const Accel::Ray* rays, int n,
-                                  size_t& lanes, size_t& hits, size_t& occluded) {
+void expect_packet_is_single_rays(const Accel& accel, const Accel::Ray* rays, int n, size_t& lanes,
+                                  size_t& hits, size_t& occluded) {
   Hit packet[Accel::kPacket];
   bool found[Accel::kPacket];
   accel.intersect_packet(rays, n, packet, found);
   for (int i = 0; i < n; ++i) {
     Hit alone;
-    const bool f = accel.intersect(rays[i].origin, rays[i].dir, rays[i].tnear, rays[i].tfar,
-                                   alone, rays[i].key);
+    const bool f = accel.intersect(rays[i].origin, rays[i].dir, rays[i].tnear, rays[i].tfar, alone,
+                                   rays[i].key);
     ++lanes;
     ASSERT_EQ(found[i], f) << "lane " << i << " of " << n;
     if (!f) continue;
