@@ -112,15 +112,15 @@ void disc_pass(std::span<const VisiblePoint> points, std::span<const PointState>
                const BoundaryIndex* boundary, std::span<const float> clearance,
                std::span<OwnerValues> out, RegionTable& regions);
 
+// One point's next-event sample (stage 4), Rng keyed by (seed, pass, item, DirectLight); 0 for a
+// point on a GGX lobe's diffuse base, whose camera path took its sample.
+dvec3 next_event_at(const World& world, const VisiblePoint& point, const PointBsdf* glossy,
+                    uint64_t seed, uint64_t pass, uint64_t item);
 // Stage 4: adds one next-event sample (ESTIMATOR.md section 4) to out[k].direct for every
 // point with f > 0, Rng keyed by (seed, pass, first + k, DirectLight). A point on a GGX lobe's
 // diffuse base (is_base_part, render/lobe_split.h) is skipped: its camera path took its sample.
 // The shadow rays of neighbouring points are traced as packets (Accel::occluded_packet); each
 // point's sum is next_event_at's, bit for bit.
-// One point's next-event sample (stage 4), Rng keyed by (seed, pass, item, DirectLight); 0 for a
-// point on a GGX lobe's diffuse base, whose camera path took its sample.
-dvec3 next_event_at(const World& world, const VisiblePoint& point, const PointBsdf* glossy,
-                    uint64_t seed, uint64_t pass, uint64_t item);
 void next_event_pass(const World& world, std::span<const VisiblePoint> points,
                      PointBsdfTable glossy, uint64_t seed, uint64_t pass, size_t first,
                      std::span<OwnerValues> out);
