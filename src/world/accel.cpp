@@ -155,6 +155,17 @@ namespace {
 // Fills packet `r` (RTCRay8 or the ray part of RTCRayHit8) and its valid mask with rays[0, n)
 // and their keys; lanes beyond n repeat ray 0 (their results unread), so every lane holds finite
 // data.
+// A packet's keys and the context its filters read them from.
+struct PacketKeys {
+  uint64_t keys[Accel::kPacket] = {};
+  KeyedContext context;
+  PacketKeys() {
+    rtcInitIntersectContext(&context.context);
+    context.keys = keys;
+  }
+  PacketKeys(const PacketKeys&) = delete;  // context points into it
+};
+
 template <class Ray8>
 void fill_packet(const Accel::Ray* rays, int n, Ray8& r, int* valid, uint64_t* keys) {
   for (int i = 0; i < Accel::kPacket; ++i) {
@@ -180,18 +191,15 @@ void fill_packet(const Accel::Ray* rays, int n, Ray8& r, int* valid, uint64_t* k
 
 void Accel::intersect_packet(const Ray* rays, int n, Hit* hits, bool* found) const {
   static_assert(kPacket == 8, "rtcIntersect8");
-  uint64_t keys[kPacket];
-  KeyedContext context;
-  rtcInitIntersectContext(&context.context);
-  context.keys = keys;
+  PacketKeys k;
   alignas(32) int valid[kPacket];
   alignas(32) RTCRayHit8 rh;
-  fill_packet(rays, n, rh.ray, valid, keys);
+  fill_packet(rays, n, rh.ray, valid, k.keys);
   for (int i = 0; i < kPacket; ++i) {
     rh.hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
     rh.hit.instID[0][i] = RTC_INVALID_GEOMETRY_ID;
   }
-  rtcIntersect8(valid, impl_->scene, &context.context, &rh);
+  rtcIntersect8(valid, impl_->scene, &k.context.context, &rh);
   for (int i = 0; i < n; ++i) {
     found[i] = rh.hit.geomID[i] != RTC_INVALID_GEOMETRY_ID;
     if (!found[i]) continue;
@@ -204,14 +212,11 @@ void Accel::intersect_packet(const Ray* rays, int n, Hit* hits, bool* found) con
 }
 
 void Accel::occluded_packet(const Ray* rays, int n, bool* blocked) const {
-  uint64_t keys[kPacket];
-  KeyedContext context;
-  rtcInitIntersectContext(&context.context);
-  context.keys = keys;
+  PacketKeys k;
   alignas(32) int valid[kPacket];
   alignas(32) RTCRay8 ray;
-  fill_packet(rays, n, ray, valid, keys);
-  rtcOccluded8(valid, impl_->scene, &context.context, &ray);
+  fill_packet(rays, n, ray, valid, k.keys);
+  rtcOccluded8(valid, impl_->scene, &k.context.context, &ray);
   // Embree sets tfar to -inf where a ray is occluded.
   for (int i = 0; i < n; ++i) blocked[i] = ray.tfar[i] < 0.0f;
 }

@@ -15,7 +15,9 @@
 namespace pb {
 namespace {
 
-bool same_bits(double a, double b) { return std::bit_cast<uint64_t>(a) == std::bit_cast<uint64_t>(b); }
+bool same_bits(double a, double b) {
+  return std::bit_cast<uint64_t>(a) == std::bit_cast<uint64_t>(b);
+}
 
 // A ground y = 0 (Lambertian; rough metal for the glossy points) under a sky and a lamp at y = 2,
 // with BLEND cards of alpha 0.5 at y = 1 over part of it.
