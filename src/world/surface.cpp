@@ -173,7 +173,8 @@ Surface World::surface(const Hit& hit) const {
     return s;
   }
   if (mesh.plain) {
-    s.bsdf = mesh.plain->with_frame(s.ng, s.ns);
+    s.bsdf = *mesh.plain;
+    s.bsdf.move_to_frame(s.ng, s.ns);
     return s;
   }
   if (!mesh.textured) {
