@@ -140,19 +140,14 @@ class Bsdf {
       : Bsdf(BsdfParams::of(m), ng, ns, mirror_roughness) {}
   // Whether a Bsdf of these parameters depends on its surface frame through ng and ns alone
   // (no anisotropy direction, no clear coat normal): then one built at any frame and moved to
-  // another by with_frame is the one built there, bit for bit (World keeps one per untextured
+  // another by move_to_frame is the one built there, bit for bit (World keeps one per untextured
   // material: the construction was 3% of a render's instructions).
   static bool frame_free(const BsdfParams& p) {
     return !(p.anisotropy > 0.0f) && !(std::clamp(p.clearcoat, 0.0f, 1.0f) > 0.0f);
   }
-  Bsdf with_frame(const vec3& ng, const vec3& ns) const {
-    Bsdf b = *this;
-    b.move_to_frame(ng, ns);
-    return b;
-  }
-  // with_frame in place: a copy assigned where it is kept and then moved, so that no copy is
-  // read back in 16-byte pieces across the normals just written (a stalled store forwarding
-  // was a quarter of World::surface's time).
+  // In place, on a copy assigned where it is kept: a copy returned by value and then read back
+  // in 16-byte pieces across the normals just written stalled store forwarding (a quarter of
+  // World::surface's time).
   void move_to_frame(const vec3& ng, const vec3& ns) {
     ng_ = ng;
     ns_ = ns;

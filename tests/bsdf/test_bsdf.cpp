@@ -602,7 +602,7 @@ namespace pb {
 namespace {
 
 // World keeps one Bsdf per untextured material and moves it to each hit's frame
-// (Bsdf::with_frame): where Bsdf::frame_free says so, that is the Bsdf built at the hit, bit for
+// (Bsdf::move_to_frame): where Bsdf::frame_free says so, that is the Bsdf built at the hit, bit for
 // bit: eval, the delta probability and every draw (the same random numbers), over random frames
 // with tilted shading normals and random directions, for the glTF parts that may be frame free.
 // A clear coat or an anisotropy direction depends on the frame: not frame free.
@@ -636,7 +636,9 @@ TEST(BsdfFrame, AFrameFreeBsdfMovedToAFrameIsTheOneBuiltThere) {
       const vec3 ng = sample_uniform_sphere(rng.next_float(), rng.next_float());
       const vec3 ns =
           glm::normalize(ng + 0.3f * sample_uniform_sphere(rng.next_float(), rng.next_float()));
-      const Bsdf built(p, ng, ns), moved = plain.with_frame(ng, ns);
+      const Bsdf built(p, ng, ns);
+      Bsdf moved = plain;
+      moved.move_to_frame(ng, ns);
       const vec3 wo = sample_uniform_sphere(rng.next_float(), rng.next_float());
       const vec3 wi = sample_uniform_sphere(rng.next_float(), rng.next_float());
       const vec3 a = built.eval(wo, wi), b = moved.eval(wo, wi);
